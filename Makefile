@@ -1,0 +1,56 @@
+# Thin wrapper over CMake. `make demo` and `make test` do all their own set-up on a fresh machine.
+BUILD     ?= build
+JOBS      ?= $(shell nproc)
+BUILD_TYPE ?= Release
+# CI (CI=true in the environment) builds with -Werror.
+WERROR    ?= $(if $(CI),ON,OFF)
+CMAKE_FLAGS ?=
+TETRAPAGE := $(BUILD)/tools/tetrapage
+DEMO_DIR  ?= out/demo
+
+# Exactly the Debian packages the project needs.
+DEB_PACKAGES := cmake make g++ pkg-config \
+  libeigen3-dev libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev \
+  libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
+  libgtest-dev libbenchmark-dev
+
+.PHONY: deps configure build test demo bench clean format
+
+deps:
+	@missing=""; for p in $(DEB_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -z "$$missing" ]; then echo "deps: all $(words $(DEB_PACKAGES)) packages present"; \
+	else \
+	  if [ "$$(id -u)" -eq 0 ]; then SUDO=""; else SUDO="sudo"; fi; \
+	  echo "deps: installing$$missing"; \
+	  $$SUDO apt-get update -q && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -q --no-install-recommends $$missing; \
+	fi
+
+configure: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DTETRAPAGE_WERROR=$(WERROR) $(CMAKE_FLAGS)
+
+build: configure
+	cmake --build $(BUILD) -j $(JOBS)
+
+test: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 1200
+
+demo: build
+	@mkdir -p $(DEMO_DIR)
+	$(TETRAPAGE) generate scene --triangles 1000000 --seed 1 -o $(DEMO_DIR)/scene.ply
+	$(TETRAPAGE) generate object --triangles 2000 -o $(DEMO_DIR)/object.ply
+	$(TETRAPAGE) generate flight --env $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
+	  --steps 10000 --seed 1 -o $(DEMO_DIR)/flight.csv --answers $(DEMO_DIR)/answers.csv \
+	  --report $(DEMO_DIR)/flight.json
+	$(TETRAPAGE) replay $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
+	  --path $(DEMO_DIR)/flight.csv --check $(DEMO_DIR)/answers.csv --report $(DEMO_DIR)/replay.json
+
+bench: build
+	$(BUILD)/bench/tetrapage_bench_formats --benchmark_out=$(BUILD)/bench_formats.json --benchmark_out_format=json
+
+format:
+	find formats runtime preprocess tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i
+
+clean:
+	rm -rf $(BUILD)
