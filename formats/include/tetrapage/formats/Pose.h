@@ -1,0 +1,45 @@
+#pragma once
+/// @file Pose.h
+/// Rigid poses of a flying object and the pose-file format (CSV `tx,ty,tz,qw,qx,qy,qz`).
+/// A pose maps the object's own coordinates x to R(q) x + t, q a unit quaternion.
+
+#include <array>
+#include <filesystem>
+#include <span>
+#include <vector>
+
+#include "tetrapage/formats/TriangleSoup.h"
+
+namespace tetrapage {
+
+struct Pose {
+  Vec3 translation{0.0, 0.0, 0.0};
+  std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion qw, qx, qy, qz
+};
+
+/// Row-major 3x3 rotation matrix of a unit quaternion (not normalised here: pass a unit q,
+/// as read_poses returns them). The identity quaternion gives exactly the identity.
+std::array<double, 9> rotation_matrix(const std::array<double, 4>& q);
+
+/// R(q) x + t, computed in double the one canonical way: every component of the product
+/// in the order r0*x + r1*y + r2*z, then + t. The collision answers are defined on these
+/// world coordinates.
+Vec3 apply_pose(const std::array<double, 9>& rotation, const Vec3& translation, const Vec3& x);
+inline Vec3 apply_pose(const Pose& pose, const Vec3& x) {
+  return apply_pose(rotation_matrix(pose.rotation), pose.translation, x);
+}
+
+/// Reads a pose file: the header `tx,ty,tz,qw,qx,qy,qz` exactly (blanks around the names, a
+/// UTF-8 byte-order mark and CRLF line ends are tolerated), then one pose per line; blank lines
+/// are skipped. Quaternions are normalised on read (one that is unit up to rounding, within
+/// 8 epsilon in its squared norm, is kept bit for bit, so write_poses + read_poses is exact).
+/// @throw IoError if the file cannot be read; FormatError for a wrong header or a malformed
+///        line; InputError for NaN/infinite values or a zero quaternion (names line and value).
+std::vector<Pose> read_poses(const std::filesystem::path& path);
+
+/// Writes poses with round-trip precision (shortest exact form of every double), under a
+/// temporary name (`<path>.tmp`) renamed on success.
+/// @throw InputError for a non-finite value; IoError on failure (naming the file).
+void write_poses(const std::filesystem::path& path, std::span<const Pose> poses);
+
+}  // namespace tetrapage

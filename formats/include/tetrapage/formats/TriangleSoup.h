@@ -1,0 +1,80 @@
+#pragma once
+/// @file TriangleSoup.h
+/// The in-memory triangle set every reader returns and every stage consumes: double
+/// coordinates, indexed triangles, and a part id per triangle.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace tetrapage {
+
+using Vec3 = std::array<double, 3>;
+using TriangleIndices = std::array<std::uint32_t, 3>;
+
+/// Axis-aligned bounding box; empty while lo > hi.
+struct BoundingBox {
+  Vec3 lo{1e300, 1e300, 1e300};
+  Vec3 hi{-1e300, -1e300, -1e300};
+
+  bool empty() const { return lo[0] > hi[0]; }
+  void extend(const Vec3& p) {
+    for (int a = 0; a < 3; ++a) {
+      if (p[a] < lo[a]) lo[a] = p[a];
+      if (p[a] > hi[a]) hi[a] = p[a];
+    }
+  }
+  void extend(const BoundingBox& b) {
+    if (b.empty()) return;
+    extend(b.lo);
+    extend(b.hi);
+  }
+  Vec3 size() const { return {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}; }
+  Vec3 center() const {
+    return {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2])};
+  }
+};
+
+/// Indexed triangles with a part id per triangle. Parts are the assembly's instances:
+/// part_names[part_of[t]] names the part triangle t belongs to.
+struct TriangleSoup {
+  std::vector<Vec3> vertices;
+  std::vector<TriangleIndices> triangles;
+  std::vector<std::uint32_t> part_of;  ///< one per triangle
+  std::vector<std::string> part_names;
+
+  std::size_t triangle_count() const { return triangles.size(); }
+  std::size_t part_count() const { return part_names.size(); }
+
+  /// The three corners of triangle t.
+  std::array<Vec3, 3> corners(std::size_t t) const {
+    const auto& tri = triangles[t];
+    return {vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]};
+  }
+
+  BoundingBox bounds() const {
+    BoundingBox box;
+    for (const auto& v : vertices) box.extend(v);
+    return box;
+  }
+
+  /// Appends another soup's triangles as new parts (vertex indices are shifted).
+  void append(const TriangleSoup& other);
+};
+
+/// What a reader saw besides the triangles it kept.
+struct ReadReport {
+  std::string path;
+  std::string format;                       ///< "obj", "stl", "ply", "off", "assimp:gltf", ...
+  std::uint64_t triangles_read = 0;         ///< after fan-triangulating, degenerate ones included
+  std::uint64_t degenerate_dropped = 0;     ///< zero area (exactly) or repeated indices
+  std::uint64_t polygons_triangulated = 0;  ///< faces with more than three corners
+  std::uint64_t bytes = 0;                  ///< file size
+  double seconds = 0.0;
+  /// "ascii", "binary", "binary_little_endian", "binary_big_endian"; empty through Assimp.
+  std::string encoding;
+};
+
+}  // namespace tetrapage

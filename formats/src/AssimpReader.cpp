@@ -1,0 +1,130 @@
+// glTF/GLB and every other format Assimp imports. Assimp holds the whole scene in memory and,
+// as Debian builds it (no ASSIMP_DOUBLE_PRECISION), in single precision: coordinates read this
+// way are floats widened to double. The node transforms are composed in double.
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <array>
+#include <assimp/Importer.hpp>
+#include <set>
+#include <vector>
+
+#include "ReaderSupport.h"
+
+namespace tetrapage::detail {
+namespace {
+
+using Matrix = std::array<double, 16>;  // row-major 4x4, as aiMatrix4x4
+
+Matrix to_matrix(const aiMatrix4x4& m) {
+  return {m.a1, m.a2, m.a3, m.a4, m.b1, m.b2, m.b3, m.b4,
+          m.c1, m.c2, m.c3, m.c4, m.d1, m.d2, m.d3, m.d4};
+}
+
+Matrix multiply(const Matrix& a, const Matrix& b) {
+  Matrix product{};
+  for (int row = 0; row < 4; ++row) {
+    for (int column = 0; column < 4; ++column) {
+      double sum = 0;
+      for (int k = 0; k < 4; ++k) sum += a[4 * row + k] * b[4 * k + column];
+      product[4 * row + column] = sum;
+    }
+  }
+  return product;
+}
+
+Vec3 transform_point(const Matrix& m, const aiVector3D& p) {
+  const double x = p.x, y = p.y, z = p.z;
+  return {m[0] * x + m[1] * y + m[2] * z + m[3], m[4] * x + m[5] * y + m[6] * z + m[7],
+          m[8] * x + m[9] * y + m[10] * z + m[11]};
+}
+
+struct MeshInstance {
+  const aiNode* node;
+  Matrix transform;
+};
+
+void collect_instances(const aiNode* node, const Matrix& parent,
+                       std::vector<MeshInstance>& instances) {
+  const Matrix transform = multiply(parent, to_matrix(node->mTransformation));
+  if (node->mNumMeshes > 0) instances.push_back({node, transform});
+  for (unsigned c = 0; c < node->mNumChildren; ++c)
+    collect_instances(node->mChildren[c], transform, instances);
+}
+
+}  // namespace
+
+TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) {
+  {
+    // Our own open first: a missing or unreadable file is an IoError with the system's reason,
+    // which Assimp's message would not tell apart from a malformed file.
+    InputFile probe(path, 4096);
+    report.bytes = probe.size();
+  }
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
+  if (scene != nullptr && scene->mNumMeshes == 0) {
+    // Assimp flags a scene without meshes as incomplete; to us it is a valid, empty file.
+    throw InputError(path.string() + ": the mesh has no triangle (no mesh in the scene)");
+  }
+  if (scene == nullptr || (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 ||
+      scene->mRootNode == nullptr) {
+    const std::string reason = importer.GetErrorString();
+    throw FormatError(path.string() + ": Assimp cannot import it: " +
+                      (reason.empty() ? std::string("no reason given") : reason));
+  }
+  std::vector<MeshInstance> instances;
+  const Matrix identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+  collect_instances(scene->mRootNode, identity, instances);
+
+  const std::string stem = path.stem().string();
+  SoupBuilder soup(path.string(), report);
+  std::set<std::string> used_names;
+  std::vector<std::uint32_t> corners;
+  for (std::size_t i = 0; i < instances.size(); ++i) {
+    const aiNode* node = instances[i].node;
+    std::string name = stem;
+    if (instances.size() > 1) {
+      const std::string node_name =
+          node->mName.length > 0 ? std::string(node->mName.C_Str()) : "node" + std::to_string(i);
+      name = stem + "/" + node_name;
+    }
+    // Instances of one node name (or unnamed nodes) still get distinct part names.
+    const std::string base_name = name;
+    for (int k = 2; used_names.count(name) > 0; ++k) name = base_name + "#" + std::to_string(k);
+    used_names.insert(name);
+    soup.begin_part(name);
+    for (unsigned m = 0; m < node->mNumMeshes; ++m) {
+      const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
+      if (soup.vertex_count() + mesh->mNumVertices > max_vertices) {
+        throw InputError(path.string() + ": more vertices than a soup can index");
+      }
+      const auto base = static_cast<std::uint32_t>(soup.vertex_count());
+      const std::string where = path.string() + ": node '" + node->mName.C_Str() + "' mesh " +
+                                std::to_string(node->mMeshes[m]);
+      for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+        const Vec3 p = transform_point(instances[i].transform, mesh->mVertices[v]);
+        if (!is_finite(p)) throw_not_finite(where + " vertex " + std::to_string(v) + ": ", p);
+        soup.add_vertex(p);
+      }
+      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+        const aiFace& face = mesh->mFaces[f];
+        if (face.mNumIndices < 3) continue;  // points and lines bound no surface
+        corners.clear();
+        for (unsigned k = 0; k < face.mNumIndices; ++k) {
+          if (face.mIndices[k] >= mesh->mNumVertices) {
+            throw InputError(where + " face " + std::to_string(f) + ": vertex index " +
+                             std::to_string(face.mIndices[k]) + " out of range (" +
+                             std::to_string(mesh->mNumVertices) + " vertices)");
+          }
+          corners.push_back(base + face.mIndices[k]);
+        }
+        soup.add_polygon(corners);
+      }
+    }
+  }
+  return soup.finish();
+}
+
+}  // namespace tetrapage::detail

@@ -1,0 +1,146 @@
+// read_mesh: picks the reader by extension, times it and fills the report; the degenerate
+// filter every reader shares (SoupBuilder::finish).
+
+#include "tetrapage/formats/MeshReader.h"
+
+#include <assimp/cimport.h>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <algorithm>
+#include <cctype>
+#include <chrono>
+
+#include "ReaderSupport.h"
+
+namespace tetrapage {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+}  // namespace
+
+MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
+  const std::string extension = lower_extension(path);
+  if (extension == ".obj") return MeshFormat::obj;
+  if (extension == ".stl") return MeshFormat::stl;
+  if (extension == ".ply") return MeshFormat::ply;
+  if (extension == ".off") return MeshFormat::off;
+  if (extension == ".gltf") return MeshFormat::gltf;
+  if (extension == ".glb") return MeshFormat::glb;
+  if (extension.size() > 1 && aiIsExtensionSupported(extension.c_str()) == AI_TRUE)
+    return MeshFormat::assimp_other;
+  throw InputError("'" + path.string() + "': no mesh reader for the extension '" + extension +
+                   "' (readable: .obj, .stl, .ply, .off, .gltf, .glb and the formats Assimp "
+                   "imports)");
+}
+
+bool is_degenerate_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Filtered exact predicate: interval arithmetic first, exact only in the rare close calls.
+  return CGAL::collinear(Kernel::Point_3(a[0], a[1], a[2]), Kernel::Point_3(b[0], b[1], b[2]),
+                         Kernel::Point_3(c[0], c[1], c[2]));
+}
+
+namespace detail {
+
+TriangleSoup SoupBuilder::finish() {
+  auto& triangles = soup_.triangles;
+  auto& part_of = soup_.part_of;
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& tri = triangles[t];
+    const bool repeated = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
+    if (repeated || is_degenerate_triangle(soup_.vertices[tri[0]], soup_.vertices[tri[1]],
+                                           soup_.vertices[tri[2]])) {
+      ++report_.degenerate_dropped;
+      continue;
+    }
+    triangles[kept] = tri;
+    part_of[kept] = part_of[t];
+    ++kept;
+  }
+  triangles.resize(kept);
+  part_of.resize(kept);
+  if (kept == 0) {
+    if (report_.triangles_read == 0) throw InputError(file_name_ + ": the mesh has no triangle");
+    throw InputError(file_name_ + ": no triangle left after dropping " +
+                     std::to_string(report_.degenerate_dropped) + " degenerate triangles");
+  }
+  triangles.shrink_to_fit();
+  part_of.shrink_to_fit();
+  soup_.vertices.shrink_to_fit();
+  return std::move(soup_);
+}
+
+}  // namespace detail
+
+namespace {
+
+TriangleSoup read_with(TriangleSoup (*reader)(detail::InputFile&, ReadReport&),
+                       const std::filesystem::path& path, const char* format, ReadReport& report) {
+  detail::InputFile file(path);
+  report.bytes = file.size();
+  report.format = format;
+  return reader(file, report);
+}
+
+std::uint64_t file_size_or_zero(const std::filesystem::path& path) {
+  std::error_code error;
+  const auto size = std::filesystem::file_size(path, error);
+  return error ? 0 : size;
+}
+
+}  // namespace
+
+TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  ReadReport local;
+  ReadReport& out = report != nullptr ? *report : local;
+  out = ReadReport{};
+  out.path = path.string();
+  const MeshFormat format = mesh_format_from_path(path);
+  TriangleSoup soup;
+  switch (format) {
+    case MeshFormat::obj:
+      soup = read_with(detail::read_obj, path, "obj", out);
+      break;
+    case MeshFormat::stl:
+      soup = read_with(detail::read_stl, path, "stl", out);
+      break;
+    case MeshFormat::ply:
+      soup = read_with(detail::read_ply, path, "ply", out);
+      break;
+    case MeshFormat::off:
+      soup = read_with(detail::read_off, path, "off", out);
+      break;
+    case MeshFormat::gltf:
+    case MeshFormat::glb:
+    case MeshFormat::assimp_other:
+      soup = read_mesh_with_assimp(path, &out);
+      break;
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return soup;
+}
+
+TriangleSoup read_mesh_with_assimp(const std::filesystem::path& path, ReadReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  ReadReport local;
+  ReadReport& out = report != nullptr ? *report : local;
+  out = ReadReport{};
+  out.path = path.string();
+  const std::string extension = lower_extension(path);
+  out.format = "assimp:" + (extension.empty() ? std::string() : extension.substr(1));
+  out.bytes = file_size_or_zero(path);
+  TriangleSoup soup = detail::read_assimp(path, out);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return soup;
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,554 @@
+// Streaming mesh writers. Text numbers are printed in the shortest form that reads back as
+// the same double (std::to_chars), so OBJ/PLY/OFF round trips are exact; nothing depends on
+// the clock or the locale, so the same parts give the same bytes.
+
+#include "tetrapage/formats/MeshWriter.h"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "OutputFile.h"
+#include "TextNumbers.h"
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage {
+
+class MeshWriter::Impl {
+ public:
+  explicit Impl(const std::filesystem::path& path)
+      : path_(path), output_(temporary(path, ".tmp"), path) {}
+  virtual ~Impl() = default;
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  virtual void add_part(std::span<const Vec3> vertices,
+                        std::span<const TriangleIndices> triangles) = 0;
+  /// Writes what is left (headers, counts, buffered data) into output_.
+  virtual void finish() = 0;
+
+  void commit() {
+    if (committed_) return;
+    if (failed_) {
+      throw IoError("cannot commit '" + path_.string() + "': an earlier commit failed");
+    }
+    try {
+      finish();
+      output_.rename_to(path_);
+    } catch (...) {
+      failed_ = true;  // the temporary is half finished: never finish it twice
+      throw;
+    }
+    committed_ = true;
+  }
+  bool committed() const { return committed_; }
+
+  const std::filesystem::path& path() const { return path_; }
+
+  std::uint64_t triangles = 0;
+  std::uint64_t vertices = 0;
+
+ protected:
+  static std::filesystem::path temporary(const std::filesystem::path& path, const char* suffix) {
+    return std::filesystem::path(path.string() + suffix);
+  }
+
+  std::filesystem::path path_;
+  detail::OutputFile output_;
+  bool committed_ = false;
+  bool failed_ = false;
+};
+
+namespace {
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+void check_part(const std::filesystem::path& path, std::span<const Vec3> vertices,
+                std::span<const TriangleIndices> triangles) {
+  for (std::size_t v = 0; v < vertices.size(); ++v) {
+    const Vec3& p = vertices[v];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      throw InputError("writing '" + path.string() + "': vertex " + std::to_string(v) +
+                       " of the part is not finite");
+    }
+  }
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    for (const auto index : triangles[t]) {
+      if (index >= vertices.size()) {
+        throw InputError("writing '" + path.string() + "': triangle " + std::to_string(t) +
+                         " uses vertex " + std::to_string(index) + " but the part has " +
+                         std::to_string(vertices.size()) + " vertices");
+      }
+    }
+  }
+}
+
+/// Formats "<prefix>a b c\n" for three doubles.
+char* format_vertex(char* out, const char* prefix, const Vec3& p) {
+  while (*prefix != '\0') *out++ = *prefix++;
+  for (int axis = 0; axis < 3; ++axis) {
+    out = detail::write_double(out, p[axis]);
+    *out++ = axis < 2 ? ' ' : '\n';
+  }
+  return out;
+}
+
+char* format_face(char* out, const char* prefix, std::uint64_t a, std::uint64_t b,
+                  std::uint64_t c) {
+  while (*prefix != '\0') *out++ = *prefix++;
+  const std::uint64_t corners[3] = {a, b, c};
+  for (int k = 0; k < 3; ++k) {
+    out = std::to_chars(out, out + 24, corners[k]).ptr;
+    *out++ = k < 2 ? ' ' : '\n';
+  }
+  return out;
+}
+
+constexpr std::size_t line_room = 4 * detail::max_double_chars + 16;
+
+class ObjWriter final : public MeshWriter::Impl {
+ public:
+  explicit ObjWriter(const std::filesystem::path& path) : Impl(path) {
+    output_.write("# written by tetrapage\n");
+  }
+
+  void add_part(std::span<const Vec3> part_vertices,
+                std::span<const TriangleIndices> part_triangles) override {
+    // OBJ indices are global and 1-based: shift by the vertices of the earlier parts.
+    const std::uint64_t base = vertices + 1;
+    for (const auto& p : part_vertices) {
+      char* line = output_.reserve(line_room);
+      output_.advance(static_cast<std::size_t>(format_vertex(line, "v ", p) - line));
+    }
+    for (const auto& t : part_triangles) {
+      char* line = output_.reserve(line_room);
+      output_.advance(static_cast<std::size_t>(
+          format_face(line, "f ", base + t[0], base + t[1], base + t[2]) - line));
+    }
+  }
+  void finish() override {}
+};
+
+class StlWriter final : public MeshWriter::Impl {
+ public:
+  explicit StlWriter(const std::filesystem::path& path) : Impl(path) {
+    // 80 bytes that must not start with "solid" (which would suggest ASCII STL), then the
+    // triangle count, patched by finish().
+    char header[84] = {};
+    const std::string_view text = "binary STL written by tetrapage";
+    std::memcpy(header, text.data(), text.size());
+    output_.write(header, sizeof header);
+  }
+
+  void add_part(std::span<const Vec3> part_vertices,
+                std::span<const TriangleIndices> part_triangles) override {
+    if (triangles + part_triangles.size() > std::numeric_limits<std::uint32_t>::max()) {
+      throw InputError("writing '" + path_.string() +
+                       "': binary STL holds at most 2^32-1 triangles");
+    }
+    for (const auto& t : part_triangles) {
+      const Vec3& a = part_vertices[t[0]];
+      const Vec3& b = part_vertices[t[1]];
+      const Vec3& c = part_vertices[t[2]];
+      const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+      const Vec3 v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (length > 0 && std::isfinite(length)) {
+        for (double& component : n) component /= length;
+      } else {
+        n = {0, 0, 0};
+      }
+      float record[12];
+      for (int k = 0; k < 3; ++k) {
+        record[k] = static_cast<float>(n[k]);
+        record[3 + k] = static_cast<float>(a[k]);
+        record[6 + k] = static_cast<float>(b[k]);
+        record[9 + k] = static_cast<float>(c[k]);
+      }
+      static_assert(std::endian::native == std::endian::little, "STL is little-endian");
+      const std::uint16_t attributes = 0;
+      output_.write(record, sizeof record);
+      output_.write(&attributes, sizeof attributes);
+    }
+  }
+
+  void finish() override {
+    const auto count = static_cast<std::uint32_t>(triangles);
+    output_.write_at(80, &count, sizeof count);
+  }
+};
+
+/// PLY and OFF need the counts in the header: vertices and faces stream into two side files,
+/// assembled behind the header by finish().
+class CountedHeaderWriter : public MeshWriter::Impl {
+ public:
+  explicit CountedHeaderWriter(const std::filesystem::path& path)
+      : Impl(path),
+        vertex_file_(temporary(path, ".vertices.tmp"), path),
+        face_file_(temporary(path, ".faces.tmp"), path) {}
+
+  void finish() override {
+    output_.write(header());
+    output_.append_file(vertex_file_);
+    output_.append_file(face_file_);
+  }
+
+ protected:
+  virtual std::string header() const = 0;
+
+  detail::OutputFile vertex_file_;
+  detail::OutputFile face_file_;
+};
+
+class PlyWriter final : public CountedHeaderWriter {
+ public:
+  using CountedHeaderWriter::CountedHeaderWriter;
+
+  void add_part(std::span<const Vec3> part_vertices,
+                std::span<const TriangleIndices> part_triangles) override {
+    if (vertices + part_vertices.size() > std::numeric_limits<std::uint32_t>::max()) {
+      throw InputError("writing '" + path_.string() + "': more than 2^32-1 vertices");
+    }
+    static_assert(std::endian::native == std::endian::little, "written as little-endian");
+    for (const auto& p : part_vertices) vertex_file_.write(p.data(), sizeof(double) * 3);
+    const auto base = static_cast<std::uint32_t>(vertices);
+    for (const auto& t : part_triangles) {
+      char record[13];
+      record[0] = 3;
+      const std::uint32_t corners[3] = {base + t[0], base + t[1], base + t[2]};
+      std::memcpy(record + 1, corners, sizeof corners);
+      face_file_.write(record, sizeof record);
+    }
+  }
+
+ private:
+  std::string header() const override {
+    return "ply\nformat binary_little_endian 1.0\ncomment written by tetrapage\n"
+           "element vertex " +
+           std::to_string(vertices) +
+           "\nproperty double x\nproperty double y\nproperty double z\n"
+           "element face " +
+           std::to_string(triangles) + "\nproperty list uchar uint vertex_indices\nend_header\n";
+  }
+};
+
+class OffWriter final : public CountedHeaderWriter {
+ public:
+  using CountedHeaderWriter::CountedHeaderWriter;
+
+  void add_part(std::span<const Vec3> part_vertices,
+                std::span<const TriangleIndices> part_triangles) override {
+    for (const auto& p : part_vertices) {
+      char* line = vertex_file_.reserve(line_room);
+      vertex_file_.advance(static_cast<std::size_t>(format_vertex(line, "", p) - line));
+    }
+    const std::uint64_t base = vertices;
+    for (const auto& t : part_triangles) {
+      char* line = face_file_.reserve(line_room);
+      face_file_.advance(static_cast<std::size_t>(
+          format_face(line, "3 ", base + t[0], base + t[1], base + t[2]) - line));
+    }
+  }
+
+ private:
+  std::string header() const override {
+    return "OFF\n" + std::to_string(vertices) + " " + std::to_string(triangles) + " 0\n";
+  }
+};
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+  static constexpr char alphabet[] =
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string text;
+  text.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const std::uint32_t group =
+        (std::uint32_t{bytes[i]} << 16) | (std::uint32_t{bytes[i + 1]} << 8) | bytes[i + 2];
+    for (int shift = 18; shift >= 0; shift -= 6) text.push_back(alphabet[(group >> shift) & 63]);
+  }
+  if (i < bytes.size()) {
+    const bool two = i + 1 < bytes.size();
+    const std::uint32_t group =
+        (std::uint32_t{bytes[i]} << 16) | (two ? std::uint32_t{bytes[i + 1]} << 8 : 0);
+    text.push_back(alphabet[(group >> 18) & 63]);
+    text.push_back(alphabet[(group >> 12) & 63]);
+    text.push_back(two ? alphabet[(group >> 6) & 63] : '=');
+    text.push_back('=');
+  }
+  return text;
+}
+
+/// glTF 2.0 (.gltf with the buffer embedded as a base64 data URI, or .glb). One mesh and one
+/// node per part, float positions, uint32 indices. Buffered in memory until commit().
+class GltfWriter final : public MeshWriter::Impl {
+ public:
+  GltfWriter(const std::filesystem::path& path, bool binary) : Impl(path), binary_(binary) {}
+
+  void add_part(std::span<const Vec3> part_vertices,
+                std::span<const TriangleIndices> part_triangles) override {
+    if (part_triangles.empty()) return;  // glTF accessors cannot be empty
+    Part part;
+    part.vertex_offset = buffer_.size();
+    part.vertex_count = part_vertices.size();
+    for (const auto& p : part_vertices) {
+      for (int axis = 0; axis < 3; ++axis) {
+        const float value = static_cast<float>(p[axis]);
+        part.lo[axis] = std::min(part.lo[axis], value);
+        part.hi[axis] = std::max(part.hi[axis], value);
+        append(&value, sizeof value);
+      }
+    }
+    part.index_offset = buffer_.size();
+    part.index_count = 3 * part_triangles.size();
+    for (const auto& t : part_triangles) append(t.data(), sizeof(std::uint32_t) * 3);
+    parts_.push_back(part);
+  }
+
+  void finish() override {
+    using nlohmann::json;
+    json document;
+    document["asset"] = {{"version", "2.0"}, {"generator", "tetrapage"}};
+    document["scene"] = 0;
+    json scene;
+    scene["nodes"] = json::array();
+    json nodes = json::array();
+    json meshes = json::array();
+    json accessors = json::array();
+    json buffer_views = json::array();
+    for (std::size_t k = 0; k < parts_.size(); ++k) {
+      const Part& part = parts_[k];
+      json positions_view;
+      positions_view["buffer"] = 0;
+      positions_view["byteOffset"] = part.vertex_offset;
+      positions_view["byteLength"] = part.index_offset - part.vertex_offset;
+      positions_view["target"] = 34962;  // ARRAY_BUFFER
+      json indices_view;
+      indices_view["buffer"] = 0;
+      indices_view["byteOffset"] = part.index_offset;
+      indices_view["byteLength"] = 4 * part.index_count;
+      indices_view["target"] = 34963;  // ELEMENT_ARRAY_BUFFER
+      buffer_views.push_back(positions_view);
+      buffer_views.push_back(indices_view);
+
+      json positions;
+      positions["bufferView"] = 2 * k;
+      positions["componentType"] = 5126;  // FLOAT
+      positions["count"] = part.vertex_count;
+      positions["type"] = "VEC3";
+      positions["min"] = json::array({part.lo[0], part.lo[1], part.lo[2]});
+      positions["max"] = json::array({part.hi[0], part.hi[1], part.hi[2]});
+      json indices;
+      indices["bufferView"] = 2 * k + 1;
+      indices["componentType"] = 5125;  // UNSIGNED_INT
+      indices["count"] = part.index_count;
+      indices["type"] = "SCALAR";
+      accessors.push_back(positions);
+      accessors.push_back(indices);
+
+      json primitive;
+      primitive["attributes"]["POSITION"] = 2 * k;
+      primitive["indices"] = 2 * k + 1;
+      primitive["mode"] = 4;  // TRIANGLES
+      json mesh;
+      mesh["primitives"] = json::array({primitive});
+      meshes.push_back(mesh);
+
+      json node;
+      node["mesh"] = k;
+      node["name"] = "part" + std::to_string(k);
+      nodes.push_back(node);
+      scene["nodes"].push_back(k);
+    }
+    if (parts_.empty()) {
+      // A file with no geometry is still valid glTF: one empty scene, no node, mesh or buffer
+      // (the schema forbids empty top-level arrays).
+      document["scenes"] = json::array({json::object()});
+    } else {
+      document["scenes"] = json::array({scene});
+      document["nodes"] = nodes;
+      document["meshes"] = meshes;
+      document["accessors"] = accessors;
+      document["bufferViews"] = buffer_views;
+      json buffer;
+      buffer["byteLength"] = buffer_.size();
+      if (!binary_) buffer["uri"] = "data:application/octet-stream;base64," + base64(buffer_);
+      document["buffers"] = json::array({buffer});
+    }
+    std::string text = document.dump();
+    if (!binary_) {
+      output_.write(text);
+      output_.write("\n");
+      return;
+    }
+    while (text.size() % 4 != 0) text.push_back(' ');
+    while (buffer_.size() % 4 != 0) buffer_.push_back(0);
+    const bool has_binary = !buffer_.empty();
+    const std::uint64_t total = 12 + 8 + text.size() + (has_binary ? 8 + buffer_.size() : 0);
+    if (total > std::numeric_limits<std::uint32_t>::max()) {
+      throw InputError("writing '" + path_.string() + "': " + std::to_string(total) +
+                       " bytes are more than a GLB file can hold (4 GiB)");
+    }
+    const std::uint32_t header[3] = {0x46546C67u, 2u,
+                                     static_cast<std::uint32_t>(total)};  // "glTF", v2
+    output_.write(header, sizeof header);
+    const std::uint32_t json_chunk[2] = {static_cast<std::uint32_t>(text.size()), 0x4E4F534Au};
+    output_.write(json_chunk, sizeof json_chunk);
+    output_.write(text);
+    if (has_binary) {
+      const std::uint32_t binary_chunk[2] = {static_cast<std::uint32_t>(buffer_.size()),
+                                             0x004E4942u};
+      output_.write(binary_chunk, sizeof binary_chunk);
+      output_.write(buffer_.data(), buffer_.size());
+    }
+  }
+
+ private:
+  struct Part {
+    std::size_t vertex_offset = 0;
+    std::size_t vertex_count = 0;
+    std::size_t index_offset = 0;
+    std::size_t index_count = 0;
+    std::array<float, 3> lo{std::numeric_limits<float>::max(), std::numeric_limits<float>::max(),
+                            std::numeric_limits<float>::max()};
+    std::array<float, 3> hi{std::numeric_limits<float>::lowest(),
+                            std::numeric_limits<float>::lowest(),
+                            std::numeric_limits<float>::lowest()};
+  };
+
+  void append(const void* data, std::size_t size) {
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    buffer_.insert(buffer_.end(), bytes, bytes + size);
+  }
+
+  bool binary_;
+  std::vector<unsigned char> buffer_;
+  std::vector<Part> parts_;
+};
+
+}  // namespace
+
+bool can_write_mesh(const std::filesystem::path& path) {
+  const std::string extension = lower_extension(path);
+  for (const char* writable : {".obj", ".stl", ".ply", ".off", ".gltf", ".glb"}) {
+    if (extension == writable) return true;
+  }
+  return false;
+}
+
+MeshWriter::MeshWriter(const std::filesystem::path& path) {
+  const std::string extension = lower_extension(path);
+  if (extension == ".obj") {
+    impl_ = std::make_unique<ObjWriter>(path);
+  } else if (extension == ".stl") {
+    impl_ = std::make_unique<StlWriter>(path);
+  } else if (extension == ".ply") {
+    impl_ = std::make_unique<PlyWriter>(path);
+  } else if (extension == ".off") {
+    impl_ = std::make_unique<OffWriter>(path);
+  } else if (extension == ".gltf" || extension == ".glb") {
+    impl_ = std::make_unique<GltfWriter>(path, extension == ".glb");
+  } else {
+    throw InputError("'" + path.string() + "': cannot write meshes with the extension '" +
+                     extension + "' (writable: .obj, .stl, .ply, .off, .gltf, .glb)");
+  }
+}
+
+MeshWriter::~MeshWriter() = default;
+
+void MeshWriter::add_part(std::span<const Vec3> vertices,
+                          std::span<const TriangleIndices> triangles) {
+  if (impl_->committed()) {
+    throw InputError("'" + impl_->path().string() + "': add_part after commit");
+  }
+  check_part(impl_->path(), vertices, triangles);
+  impl_->add_part(vertices, triangles);
+  impl_->vertices += vertices.size();
+  impl_->triangles += triangles.size();
+}
+
+void MeshWriter::commit() {
+  impl_->commit();
+}
+
+std::uint64_t MeshWriter::triangles_written() const {
+  return impl_->triangles;
+}
+std::uint64_t MeshWriter::vertices_written() const {
+  return impl_->vertices;
+}
+
+void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup) {
+  MeshWriter writer(path);
+  if (soup.part_count() <= 1) {
+    writer.add_part(soup.vertices, soup.triangles);
+    writer.commit();
+    return;
+  }
+  if (soup.part_of.size() != soup.triangles.size()) {
+    throw InputError("writing '" + path.string() + "': the soup has " +
+                     std::to_string(soup.triangles.size()) + " triangles but " +
+                     std::to_string(soup.part_of.size()) + " part ids");
+  }
+  // Group the triangles by part (a counting sort keeps their order within a part).
+  std::vector<std::size_t> first(soup.part_count() + 1, 0);
+  for (const auto part : soup.part_of) {
+    if (part >= soup.part_count()) {
+      throw InputError("writing '" + path.string() + "': part id " + std::to_string(part) +
+                       " but the soup has " + std::to_string(soup.part_count()) + " parts");
+    }
+    ++first[part + 1];
+  }
+  for (std::size_t p = 0; p < soup.part_count(); ++p) first[p + 1] += first[p];
+  std::vector<std::size_t> by_part(soup.triangles.size());
+  {
+    std::vector<std::size_t> next(first.begin(), first.end() - 1);
+    for (std::size_t t = 0; t < soup.triangles.size(); ++t) by_part[next[soup.part_of[t]]++] = t;
+  }
+  // Each part with the vertices its triangles use, in first-use order.
+  constexpr std::uint32_t unused = std::numeric_limits<std::uint32_t>::max();
+  std::vector<std::uint32_t> local(soup.vertices.size(), unused);
+  std::vector<std::uint32_t> used;
+  std::vector<Vec3> part_vertices;
+  std::vector<TriangleIndices> part_triangles;
+  for (std::size_t part = 0; part < soup.part_count(); ++part) {
+    part_vertices.clear();
+    part_triangles.clear();
+    used.clear();
+    for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
+      TriangleIndices triangle{};
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t global = soup.triangles[by_part[i]][k];
+        if (global >= soup.vertices.size()) {
+          throw InputError("writing '" + path.string() + "': triangle " +
+                           std::to_string(by_part[i]) + " uses vertex " + std::to_string(global) +
+                           " but the soup has " + std::to_string(soup.vertices.size()));
+        }
+        if (local[global] == unused) {
+          local[global] = static_cast<std::uint32_t>(part_vertices.size());
+          part_vertices.push_back(soup.vertices[global]);
+          used.push_back(global);
+        }
+        triangle[k] = local[global];
+      }
+      part_triangles.push_back(triangle);
+    }
+    for (const auto global : used) local[global] = unused;
+    writer.add_part(part_vertices, part_triangles);
+  }
+  writer.commit();
+}
+
+}  // namespace tetrapage

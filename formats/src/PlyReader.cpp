@@ -1,0 +1,514 @@
+// PLY (ascii, binary_little_endian, binary_big_endian). From the "vertex" element we keep the
+// scalar properties x, y, z (any PLY scalar type); from the "face" element the list property
+// "vertex_indices" (or "vertex_index"), with any count and index types. Every other element
+// and property is skipped by walking its declared layout, so it cannot desynchronise the read.
+
+#include <vector>
+
+#include "ReaderSupport.h"
+
+namespace tetrapage::detail {
+namespace {
+
+enum class PlyType { int8, uint8, int16, uint16, int32, uint32, float32, float64 };
+
+std::size_t size_of(PlyType type) {
+  switch (type) {
+    case PlyType::int8:
+    case PlyType::uint8:
+      return 1;
+    case PlyType::int16:
+    case PlyType::uint16:
+      return 2;
+    case PlyType::int32:
+    case PlyType::uint32:
+    case PlyType::float32:
+      return 4;
+    case PlyType::float64:
+      return 8;
+  }
+  return 0;
+}
+
+bool is_integer(PlyType type) {
+  return type != PlyType::float32 && type != PlyType::float64;
+}
+
+bool parse_type(std::string_view name, PlyType& type) {
+  struct Named {
+    std::string_view name;
+    PlyType type;
+  };
+  static constexpr Named names[] = {
+      {"char", PlyType::int8},      {"int8", PlyType::int8},       {"uchar", PlyType::uint8},
+      {"uint8", PlyType::uint8},    {"short", PlyType::int16},     {"int16", PlyType::int16},
+      {"ushort", PlyType::uint16},  {"uint16", PlyType::uint16},   {"int", PlyType::int32},
+      {"int32", PlyType::int32},    {"uint", PlyType::uint32},     {"uint32", PlyType::uint32},
+      {"float", PlyType::float32},  {"float32", PlyType::float32}, {"double", PlyType::float64},
+      {"float64", PlyType::float64}};
+  for (const auto& named : names) {
+    if (named.name == name) {
+      type = named.type;
+      return true;
+    }
+  }
+  return false;
+}
+
+double load_double(PlyType type, const char* bytes, bool big_endian) {
+  switch (type) {
+    case PlyType::int8:
+      return load_scalar<std::int8_t>(bytes, big_endian);
+    case PlyType::uint8:
+      return load_scalar<std::uint8_t>(bytes, big_endian);
+    case PlyType::int16:
+      return load_scalar<std::int16_t>(bytes, big_endian);
+    case PlyType::uint16:
+      return load_scalar<std::uint16_t>(bytes, big_endian);
+    case PlyType::int32:
+      return load_scalar<std::int32_t>(bytes, big_endian);
+    case PlyType::uint32:
+      return load_scalar<std::uint32_t>(bytes, big_endian);
+    case PlyType::float32:
+      return load_scalar<float>(bytes, big_endian);
+    case PlyType::float64:
+      return load_scalar<double>(bytes, big_endian);
+  }
+  return 0;
+}
+
+/// Integer types only (the header check guarantees it for counts and indices).
+std::int64_t load_integer(PlyType type, const char* bytes, bool big_endian) {
+  switch (type) {
+    case PlyType::int8:
+      return load_scalar<std::int8_t>(bytes, big_endian);
+    case PlyType::uint8:
+      return load_scalar<std::uint8_t>(bytes, big_endian);
+    case PlyType::int16:
+      return load_scalar<std::int16_t>(bytes, big_endian);
+    case PlyType::uint16:
+      return load_scalar<std::uint16_t>(bytes, big_endian);
+    case PlyType::int32:
+      return load_scalar<std::int32_t>(bytes, big_endian);
+    case PlyType::uint32:
+      return load_scalar<std::uint32_t>(bytes, big_endian);
+    default:
+      return 0;
+  }
+}
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::float32;  ///< the item type for a list
+  bool is_list = false;
+  PlyType count_type = PlyType::uint8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+  /// Bytes per record when no property is a list, else 0.
+  std::size_t fixed_size() const {
+    std::size_t size = 0;
+    for (const auto& property : properties) {
+      if (property.is_list) return 0;
+      size += size_of(property.type);
+    }
+    return size;
+  }
+};
+
+enum class PlyEncoding { ascii, binary_little_endian, binary_big_endian };
+
+struct PlyHeader {
+  PlyEncoding encoding = PlyEncoding::ascii;
+  std::vector<PlyElement> elements;
+};
+
+PlyHeader read_header(InputFile& file) {
+  std::string_view line;
+  if (!file.next_line(line) || line != "ply") {
+    throw FormatError(file.name() + ": not a PLY file (the first line is not 'ply')");
+  }
+  PlyHeader header;
+  bool have_format = false;
+  for (;;) {
+    if (!file.next_line(line)) throw FormatError(file.name() + ": the header has no 'end_header'");
+    std::string_view rest = line;
+    const std::string_view keyword = next_token(rest);
+    if (keyword == "end_header") break;
+    if (keyword.empty() || keyword == "comment" || keyword == "obj_info") continue;
+    if (keyword == "format") {
+      const std::string_view encoding = next_token(rest);
+      if (encoding == "ascii") {
+        header.encoding = PlyEncoding::ascii;
+      } else if (encoding == "binary_little_endian") {
+        header.encoding = PlyEncoding::binary_little_endian;
+      } else if (encoding == "binary_big_endian") {
+        header.encoding = PlyEncoding::binary_big_endian;
+      } else {
+        throw FormatError(where_line(file) + "unknown PLY format " + quote_token(encoding));
+      }
+      have_format = true;
+    } else if (keyword == "element") {
+      PlyElement element;
+      element.name = std::string(next_token(rest));
+      const std::string_view count = next_token(rest);
+      if (element.name.empty() || !parse_unsigned(count, element.count)) {
+        throw FormatError(where_line(file) + "malformed element line " + quote_token(line));
+      }
+      header.elements.push_back(std::move(element));
+    } else if (keyword == "property") {
+      if (header.elements.empty()) {
+        throw FormatError(where_line(file) + "property before any element");
+      }
+      PlyProperty property;
+      std::string_view type = next_token(rest);
+      if (type == "list") {
+        property.is_list = true;
+        const std::string_view count_type = next_token(rest);
+        if (!parse_type(count_type, property.count_type) || !is_integer(property.count_type)) {
+          throw FormatError(where_line(file) + "bad list count type " + quote_token(count_type));
+        }
+        type = next_token(rest);
+      }
+      if (!parse_type(type, property.type)) {
+        throw FormatError(where_line(file) + "unknown property type " + quote_token(type));
+      }
+      property.name = std::string(next_token(rest));
+      if (property.name.empty()) {
+        throw FormatError(where_line(file) + "malformed property line " + quote_token(line));
+      }
+      header.elements.back().properties.push_back(std::move(property));
+    } else {
+      throw FormatError(where_line(file) + "unknown header keyword " + quote_token(keyword));
+    }
+  }
+  if (!have_format) throw FormatError(file.name() + ": the header has no 'format' line");
+  return header;
+}
+
+/// Where x, y, z and the face corners sit in their elements.
+struct PlyLayout {
+  const PlyElement* vertex = nullptr;
+  int coordinate[3] = {-1, -1, -1};  ///< property index of x, y, z
+  const PlyElement* face = nullptr;
+  int corners = -1;  ///< property index of vertex_indices
+};
+
+PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
+  PlyLayout layout;
+  for (const auto& element : header.elements) {
+    if (element.name == "vertex" && layout.vertex == nullptr) layout.vertex = &element;
+    if (element.name == "face" && layout.face == nullptr) layout.face = &element;
+  }
+  if (layout.vertex == nullptr) throw FormatError(file.name() + ": no 'vertex' element");
+  for (std::size_t p = 0; p < layout.vertex->properties.size(); ++p) {
+    const auto& property = layout.vertex->properties[p];
+    static constexpr std::string_view axis_names[3] = {"x", "y", "z"};
+    for (int axis = 0; axis < 3; ++axis) {
+      if (property.name == axis_names[axis] && layout.coordinate[axis] < 0) {
+        if (property.is_list) {
+          throw FormatError(file.name() + ": vertex property '" + property.name +
+                            "' is a list, expected a scalar");
+        }
+        layout.coordinate[axis] = static_cast<int>(p);
+      }
+    }
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    if (layout.coordinate[axis] < 0) {
+      throw FormatError(file.name() + ": the vertex element has no property '" +
+                        std::string(1, "xyz"[axis]) + "'");
+    }
+  }
+  if (layout.vertex->count > max_vertices) {
+    throw InputError(file.name() + ": " + std::to_string(layout.vertex->count) +
+                     " vertices are more than a soup can index");
+  }
+  if (layout.face != nullptr) {
+    for (std::size_t p = 0; p < layout.face->properties.size(); ++p) {
+      const auto& property = layout.face->properties[p];
+      if ((property.name == "vertex_indices" || property.name == "vertex_index") &&
+          layout.corners < 0) {
+        if (!property.is_list || !is_integer(property.type)) {
+          throw FormatError(file.name() + ": face property '" + property.name +
+                            "' must be a list of integers");
+        }
+        layout.corners = static_cast<int>(p);
+      }
+    }
+    if (layout.corners < 0) {
+      throw FormatError(file.name() + ": the face element has no list 'vertex_indices'");
+    }
+  }
+  return layout;
+}
+
+class BinaryPlyReader {
+ public:
+  BinaryPlyReader(InputFile& file, bool big_endian, SoupBuilder& soup, const PlyLayout& layout)
+      : file_(file), big_endian_(big_endian), soup_(soup), layout_(layout) {}
+
+  void read_element(const PlyElement& element) {
+    if (&element == layout_.vertex) {
+      read_vertices(element);
+    } else if (&element == layout_.face) {
+      read_faces(element);
+    } else {
+      skip(element);
+    }
+  }
+
+ private:
+  std::span<const char> take(std::size_t bytes, const PlyElement& element, std::uint64_t index) {
+    const auto data = file_.take(bytes);
+    if (data.size() < bytes) {
+      throw FormatError(where_element(file_, element.name, index) + "truncated: needs " +
+                        std::to_string(bytes) + " bytes at byte " +
+                        std::to_string(file_.offset() - data.size()) + ", the file has " +
+                        std::to_string(file_.size()) + " bytes (element '" + element.name +
+                        "' announces " + std::to_string(element.count) + " records)");
+    }
+    return data;
+  }
+
+  /// Reads one list's count and returns its items' bytes.
+  std::span<const char> take_list(const PlyProperty& property, const PlyElement& element,
+                                  std::uint64_t index, std::int64_t& count) {
+    count = load_integer(property.count_type,
+                         take(size_of(property.count_type), element, index).data(), big_endian_);
+    if (count < 0) {
+      throw FormatError(where_element(file_, element.name, index) + "negative list count " +
+                        std::to_string(count) + " for '" + property.name + "'");
+    }
+    return take(static_cast<std::size_t>(count) * size_of(property.type), element, index);
+  }
+
+  void read_vertices(const PlyElement& element) {
+    const std::size_t record_size = element.fixed_size();
+    std::size_t offset[3] = {0, 0, 0};
+    PlyType type[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      type[axis] = element.properties[layout_.coordinate[axis]].type;
+      for (int p = 0; p < layout_.coordinate[axis]; ++p)
+        offset[axis] += size_of(element.properties[p].type);
+    }
+    for (std::uint64_t v = 0; v < element.count; ++v) {
+      Vec3 point{};
+      if (record_size > 0) {
+        const char* record = take(record_size, element, v).data();
+        for (int axis = 0; axis < 3; ++axis)
+          point[axis] = load_double(type[axis], record + offset[axis], big_endian_);
+      } else {
+        for (std::size_t p = 0; p < element.properties.size(); ++p) {
+          const auto& property = element.properties[p];
+          std::int64_t count = 0;
+          if (property.is_list) {
+            take_list(property, element, v, count);
+            continue;
+          }
+          const char* bytes = take(size_of(property.type), element, v).data();
+          for (int axis = 0; axis < 3; ++axis) {
+            if (static_cast<int>(p) == layout_.coordinate[axis])
+              point[axis] = load_double(property.type, bytes, big_endian_);
+          }
+        }
+      }
+      if (!is_finite(point)) throw_not_finite(where_element(file_, "vertex", v), point);
+      soup_.add_vertex(point);
+    }
+  }
+
+  void read_faces(const PlyElement& element) {
+    const std::uint64_t vertex_count = layout_.vertex->count;
+    for (std::uint64_t f = 0; f < element.count; ++f) {
+      for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const auto& property = element.properties[p];
+        if (!property.is_list) {
+          take(size_of(property.type), element, f);
+          continue;
+        }
+        std::int64_t count = 0;
+        const char* items = take_list(property, element, f, count).data();
+        if (static_cast<int>(p) != layout_.corners) continue;
+        if (count < 3) {
+          throw FormatError(where_element(file_, "face", f) + "face has " + std::to_string(count) +
+                            " corners, a face needs at least 3");
+        }
+        corners_.clear();
+        const std::size_t item_size = size_of(property.type);
+        for (std::int64_t k = 0; k < count; ++k) {
+          const std::int64_t index =
+              load_integer(property.type, items + k * item_size, big_endian_);
+          if (index < 0 || static_cast<std::uint64_t>(index) >= vertex_count) {
+            throw InputError(where_element(file_, "face", f) + "vertex index " +
+                             std::to_string(index) + " out of range (" +
+                             std::to_string(vertex_count) + " vertices)");
+          }
+          corners_.push_back(static_cast<std::uint32_t>(index));
+        }
+        soup_.add_polygon(corners_);
+      }
+    }
+  }
+
+  void skip(const PlyElement& element) {
+    const std::size_t record_size = element.fixed_size();
+    if (record_size > 0) {
+      // Skip in blocks rather than record by record; report the first record that is missing.
+      std::uint64_t remaining = element.count;
+      std::uint64_t index = 0;
+      const std::uint64_t block = std::max<std::uint64_t>(1, (1u << 20) / record_size);
+      while (remaining > 0) {
+        const std::uint64_t records = std::min(remaining, block);
+        const auto data = file_.take(static_cast<std::size_t>(records * record_size));
+        if (data.size() < records * record_size) {
+          index += data.size() / record_size;
+          throw FormatError(where_element(file_, element.name, index) + "truncated: needs " +
+                            std::to_string(record_size * (element.count - index)) +
+                            " more bytes, the file has " + std::to_string(file_.size()) + " bytes");
+        }
+        remaining -= records;
+        index += records;
+      }
+      return;
+    }
+    for (std::uint64_t r = 0; r < element.count; ++r) {
+      for (const auto& property : element.properties) {
+        std::int64_t count = 0;
+        if (property.is_list) {
+          take_list(property, element, r, count);
+        } else {
+          take(size_of(property.type), element, r);
+        }
+      }
+    }
+  }
+
+  InputFile& file_;
+  bool big_endian_;
+  SoupBuilder& soup_;
+  const PlyLayout& layout_;
+  std::vector<std::uint32_t> corners_;
+};
+
+class AsciiPlyReader {
+ public:
+  AsciiPlyReader(InputFile& file, SoupBuilder& soup, const PlyLayout& layout)
+      : file_(file), tokens_(file), soup_(soup), layout_(layout) {}
+
+  void read_element(const PlyElement& element) {
+    const bool is_vertex = &element == layout_.vertex;
+    const bool is_face = &element == layout_.face;
+    for (std::uint64_t r = 0; r < element.count; ++r) {
+      Vec3 point{};
+      for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const auto& property = element.properties[p];
+        const int index = static_cast<int>(p);
+        if (property.is_list) {
+          const std::int64_t count = parse_count(property, element, r);
+          if (is_face && index == layout_.corners) {
+            read_corners(count, r);
+          } else {
+            for (std::int64_t k = 0; k < count; ++k) value_token(property, element, r);
+          }
+          continue;
+        }
+        const std::string_view token = value_token(property, element, r);
+        if (!is_vertex) continue;
+        for (int axis = 0; axis < 3; ++axis) {
+          if (index == layout_.coordinate[axis] && !parse_double(token, point[axis])) {
+            throw FormatError(where_line(file_) + "vertex " + std::to_string(r) +
+                              ": expected a number for '" + property.name + "', got " +
+                              quote_token(token));
+          }
+        }
+      }
+      if (is_vertex) {
+        if (!is_finite(point)) {
+          throw_not_finite(where_line(file_) + "vertex " + std::to_string(r) + ": ", point);
+        }
+        soup_.add_vertex(point);
+      }
+    }
+  }
+
+ private:
+  std::string_view value_token(const PlyProperty& property, const PlyElement& element,
+                               std::uint64_t r) {
+    const std::string_view token = tokens_.next();
+    if (token.empty()) {
+      throw FormatError(file_.name() + ": the file ends inside element '" + element.name + "' " +
+                        std::to_string(r) + " (property '" + property.name + "'; the header " +
+                        "announces " + std::to_string(element.count) + " records)");
+    }
+    return token;
+  }
+
+  std::int64_t parse_count(const PlyProperty& property, const PlyElement& element,
+                           std::uint64_t r) {
+    const std::string_view token = value_token(property, element, r);
+    std::int64_t count = 0;
+    if (!parse_integer(token, count) || count < 0) {
+      throw FormatError(where_line(file_) + element.name + " " + std::to_string(r) +
+                        ": bad list count " + quote_token(token) + " for '" + property.name + "'");
+    }
+    return count;
+  }
+
+  void read_corners(std::int64_t count, std::uint64_t r) {
+    const auto& property = layout_.face->properties[layout_.corners];
+    if (count < 3) {
+      throw FormatError(where_line(file_) + "face " + std::to_string(r) + ": face has " +
+                        std::to_string(count) + " corners, a face needs at least 3");
+    }
+    corners_.clear();
+    const std::uint64_t vertex_count = layout_.vertex->count;
+    for (std::int64_t k = 0; k < count; ++k) {
+      const std::string_view token = value_token(property, *layout_.face, r);
+      std::int64_t index = 0;
+      if (!parse_integer(token, index)) {
+        throw FormatError(where_line(file_) + "face " + std::to_string(r) +
+                          ": expected a vertex index, got " + quote_token(token));
+      }
+      if (index < 0 || static_cast<std::uint64_t>(index) >= vertex_count) {
+        throw InputError(where_line(file_) + "face " + std::to_string(r) + ": vertex index " +
+                         std::to_string(index) + " out of range (" + std::to_string(vertex_count) +
+                         " vertices)");
+      }
+      corners_.push_back(static_cast<std::uint32_t>(index));
+    }
+    soup_.add_polygon(corners_);
+  }
+
+  InputFile& file_;
+  TokenReader tokens_;
+  SoupBuilder& soup_;
+  const PlyLayout& layout_;
+  std::vector<std::uint32_t> corners_;
+};
+
+}  // namespace
+
+TriangleSoup read_ply(InputFile& file, ReadReport& report) {
+  const PlyHeader header = read_header(file);
+  const PlyLayout layout = find_layout(file, header);
+  SoupBuilder soup(file.name(), report);
+  soup.begin_part(file.path().stem().string());
+  soup.reserve(layout.vertex->count, layout.face != nullptr ? layout.face->count : 0, file.size());
+  if (header.encoding == PlyEncoding::ascii) {
+    report.encoding = "ascii";
+    AsciiPlyReader reader(file, soup, layout);
+    for (const auto& element : header.elements) reader.read_element(element);
+  } else {
+    const bool big_endian = header.encoding == PlyEncoding::binary_big_endian;
+    report.encoding = big_endian ? "binary_big_endian" : "binary_little_endian";
+    BinaryPlyReader reader(file, big_endian, soup, layout);
+    for (const auto& element : header.elements) reader.read_element(element);
+  }
+  return soup.finish();
+}
+
+}  // namespace tetrapage::detail

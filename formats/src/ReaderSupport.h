@@ -1,0 +1,149 @@
+#pragma once
+// Internal: what every mesh reader shares: the soup under construction (with the degenerate
+// filter), error messages that name the file and the line or element, and the readers.
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "InputFile.h"
+#include "TextNumbers.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/TriangleSoup.h"
+
+namespace tetrapage::detail {
+
+/// "file: line 12: " for text formats.
+inline std::string where_line(const InputFile& file) {
+  return file.name() + ": line " + std::to_string(file.line_number()) + ": ";
+}
+/// "file: vertex 12: " for binary formats (0-based element index, as the file stores them).
+inline std::string where_element(const InputFile& file, std::string_view element,
+                                 std::uint64_t index) {
+  return file.name() + ": " + std::string(element) + " " + std::to_string(index) + ": ";
+}
+
+inline std::string number_text(double value) {
+  std::string text;
+  append_double(text, value);
+  return text;
+}
+
+/// @throw InputError naming the place and the coordinate: NaN or infinite values are not data.
+[[noreturn]] inline void throw_not_finite(const std::string& where, const Vec3& p) {
+  throw InputError(where + "coordinate is not finite (" + number_text(p[0]) + ", " +
+                   number_text(p[1]) + ", " + number_text(p[2]) + ")");
+}
+inline bool is_finite(const Vec3& p) {
+  return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+}
+
+/// Builds the soup of one file: vertices, triangles (global indices), parts. finish() drops
+/// the degenerate triangles and counts them in the report.
+class SoupBuilder {
+ public:
+  SoupBuilder(std::string file_name, ReadReport& report)
+      : file_name_(std::move(file_name)), report_(report) {}
+
+  void begin_part(std::string name) {
+    part_ = static_cast<std::uint32_t>(soup_.part_names.size());
+    soup_.part_names.push_back(std::move(name));
+  }
+  /// Reserves for the counts a header announces. A header may lie: no format stores a vertex
+  /// in fewer than 3 bytes or a face in fewer than 4, so the file size caps the reservation.
+  void reserve(std::uint64_t vertices, std::uint64_t triangles, std::uint64_t file_bytes) {
+    soup_.vertices.reserve(static_cast<std::size_t>(std::min(vertices, file_bytes / 3)));
+    const auto faces = static_cast<std::size_t>(std::min(triangles, file_bytes / 4));
+    soup_.triangles.reserve(faces);
+    soup_.part_of.reserve(faces);
+  }
+
+  std::uint64_t vertex_count() const { return soup_.vertices.size(); }
+  void add_vertex(const Vec3& p) { soup_.vertices.push_back(p); }
+
+  /// Indices are global (into every vertex added so far) and already range-checked.
+  void add_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    soup_.triangles.push_back({a, b, c});
+    soup_.part_of.push_back(part_);
+    ++report_.triangles_read;
+  }
+  /// A face of any size, fan-triangulated around its first corner (fewer than 3 corners: the
+  /// caller rejects it first).
+  void add_polygon(std::span<const std::uint32_t> corners) {
+    if (corners.size() > 3) ++report_.polygons_triangulated;
+    for (std::size_t i = 1; i + 1 < corners.size(); ++i)
+      add_triangle(corners[0], corners[i], corners[i + 1]);
+  }
+
+  /// Drops degenerate triangles and returns the soup.
+  /// @throw InputError if no triangle is left.
+  TriangleSoup finish();
+
+ private:
+  std::string file_name_;
+  ReadReport& report_;
+  TriangleSoup soup_;
+  std::uint32_t part_ = 0;
+};
+
+/// Whitespace-separated tokens of a text file, with the line they came from; a token never
+/// spans lines. `comment` (if not '\0') starts a comment that runs to the end of the line.
+class TokenReader {
+ public:
+  explicit TokenReader(InputFile& file, char comment = '\0') : file_(file), comment_(comment) {}
+
+  /// The next token; empty at the end of the file.
+  std::string_view next() {
+    for (;;) {
+      const std::string_view token = next_token(rest_);
+      if (!token.empty() && token.front() != comment_) return token;
+      if (!file_.next_line(rest_)) return {};
+    }
+  }
+  /// The next token, which must be there. @throw FormatError naming `what` at the end of file.
+  std::string_view expect(std::string_view what) {
+    const std::string_view token = next();
+    if (token.empty()) {
+      throw FormatError(where_line(file_) + "the file ends where " + std::string(what) +
+                        " was expected");
+    }
+    return token;
+  }
+  /// Drops what is left of the current line.
+  void skip_line() { rest_ = {}; }
+  const InputFile& file() const { return file_; }
+
+ private:
+  InputFile& file_;
+  char comment_;
+  std::string_view rest_;
+};
+
+/// Little- or big-endian scalar at `bytes` (no alignment needed).
+template <class T>
+T load_scalar(const char* bytes, bool big_endian) {
+  unsigned char raw[sizeof(T)];
+  std::memcpy(raw, bytes, sizeof(T));
+  if (big_endian != (std::endian::native == std::endian::big)) std::reverse(raw, raw + sizeof(T));
+  T value;
+  std::memcpy(&value, raw, sizeof(T));
+  return value;
+}
+
+/// Largest vertex count a soup can index.
+constexpr std::uint64_t max_vertices = std::numeric_limits<std::uint32_t>::max();
+
+TriangleSoup read_obj(InputFile& file, ReadReport& report);
+TriangleSoup read_stl(InputFile& file, ReadReport& report);
+TriangleSoup read_ply(InputFile& file, ReadReport& report);
+TriangleSoup read_off(InputFile& file, ReadReport& report);
+/// Any format Assimp knows; one part per mesh node instance.
+TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report);
+
+}  // namespace tetrapage::detail
