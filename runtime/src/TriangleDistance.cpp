@@ -1,0 +1,184 @@
+#include "tetrapage/runtime/geometry/TriangleDistance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/geometry/TriangleTriangle.h"
+
+namespace tetrapage::geometry {
+namespace {
+
+constexpr double kUnit = 0x1p-53;  // u, the unit roundoff of double
+
+using Vector = std::array<double, 3>;
+
+Vector sub(const Vector& a, const Vector& b) {
+  return {a[0] - b[0], a[1] - b[1], a[2] - b[2]};
+}
+Vector add_scaled(const Vector& a, double s, const Vector& d) {
+  return {a[0] + s * d[0], a[1] + s * d[1], a[2] + s * d[2]};
+}
+double dot(const Vector& a, const Vector& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+double norm(const Vector& a) {
+  return std::sqrt(dot(a, a));
+}
+Vector cross(const Vector& a, const Vector& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+struct Candidate {
+  double squared = std::numeric_limits<double>::infinity();
+  Vector on_first{}, on_second{};
+  void offer(const Vector& x, const Vector& y) {
+    const Vector d = sub(y, x);
+    const double s = dot(d, d);
+    if (s < squared) {
+      squared = s;
+      on_first = x;
+      on_second = y;
+    }
+  }
+};
+
+// Every reported point is a + s (b - a) or a + s ab + t ac with parameters clamped to the
+// segment or triangle, so it lies within a few roundings of a true point of the shape.
+Vector closest_on_segment(const Vector& p, const Vector& a, const Vector& b) {
+  const Vector ab = sub(b, a);
+  const double length2 = dot(ab, ab);
+  if (!(length2 > 0)) return a;
+  const double s = std::clamp(dot(sub(p, a), ab) / length2, 0.0, 1.0);
+  return add_scaled(a, s, ab);
+}
+
+Vector closest_on_triangle(const Vector& p, const std::array<Vector, 3>& t) {
+  const Vector ab = sub(t[1], t[0]), ac = sub(t[2], t[0]), ap = sub(p, t[0]);
+  const double d00 = dot(ab, ab), d01 = dot(ab, ac), d11 = dot(ac, ac);
+  const double d20 = dot(ap, ab), d21 = dot(ap, ac);
+  const double denominator = d00 * d11 - d01 * d01;
+  if (denominator > 1e-12 * d00 * d11) {
+    const double beta = (d11 * d20 - d01 * d21) / denominator;
+    const double gamma = (d00 * d21 - d01 * d20) / denominator;
+    if (beta >= 0 && gamma >= 0 && beta + gamma <= 1)  // the projection is inside
+      return add_scaled(add_scaled(t[0], beta, ab), gamma, ac);
+  }
+  Vector best = closest_on_segment(p, t[0], t[1]);
+  double best_squared = dot(sub(p, best), sub(p, best));
+  for (int e = 1; e < 3; ++e) {
+    const Vector x = closest_on_segment(p, t[e], t[e == 2 ? 0 : e + 1]);
+    const double s = dot(sub(p, x), sub(p, x));
+    if (s < best_squared) {
+      best_squared = s;
+      best = x;
+    }
+  }
+  return best;
+}
+
+// The closest points of two segments when both lie strictly inside them (the other cases are
+// vertex/triangle cases). Skips near-parallel pairs, whose minimum is also at an endpoint.
+void offer_edge_pair(const Vector& p, const Vector& p2, const Vector& q, const Vector& q2,
+                     Candidate& best) {
+  const Vector d1 = sub(p2, p), d2 = sub(q2, q), r = sub(p, q);
+  const double a = dot(d1, d1), e = dot(d2, d2), b = dot(d1, d2);
+  const double c = dot(d1, r), f = dot(d2, r);
+  const double denominator = a * e - b * b;
+  if (!(denominator > 1e-12 * a * e)) return;
+  const double s = (b * f - c * e) / denominator;
+  const double t = (a * f - b * c) / denominator;
+  if (s < 0 || s > 1 || t < 0 || t > 1) return;
+  best.offer(add_scaled(p, s, d1), add_scaled(q, t, d2));
+}
+
+struct Translated {
+  std::array<Vector, 3> a, b;
+  double magnitude;  // M: bounds every translated coordinate and every |v - origin| coordinate
+};
+
+Translated translate(const Triangle& a, const Triangle& b) {
+  Translated out;
+  double m = 0;
+  for (int i = 0; i < 3; ++i) {
+    out.a[i] = sub(a[i], a[0]);
+    out.b[i] = sub(b[i], a[0]);
+    for (int k = 0; k < 3; ++k) m = std::max({m, std::fabs(out.a[i][k]), std::fabs(out.b[i][k])});
+  }
+  out.magnitude = m * (1 + 4 * kUnit);
+  return out;
+}
+
+// A rigorous lower bound on the true distance from the separation of the two triangles along
+// the direction n: min over b of n.v - max over a of n.v, divided by |n|. Each computed dot
+// product is within 7 u |n| M of the exact one on the untranslated vertices (translation and
+// dot rounding), so the computed gap is within 18 u |n| M; 24 u |n| M covers it with room.
+double separation_lower_bound(const Translated& t, const Vector& n) {
+  const double length = norm(n);
+  if (!(length > 0) || !std::isfinite(length)) return 0.0;
+  double max_a = -std::numeric_limits<double>::infinity();
+  double min_b = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i) {
+    max_a = std::max(max_a, dot(n, t.a[i]));
+    min_b = std::min(min_b, dot(n, t.b[i]));
+  }
+  const double padded_length = length * (1 + 4 * kUnit);
+  const double numerator = (min_b - max_a) - 24 * kUnit * padded_length * t.magnitude;
+  if (!(numerator > 0)) return 0.0;
+  return numerator / padded_length * (1 - 4 * kUnit);
+}
+
+double clearance_upper_bound(double distance, double magnitude) {
+  return distance * (1 + 4 * kUnit) + 128 * kUnit * magnitude;
+}
+
+}  // namespace
+
+TriangleDistance triangle_distance(const Triangle& a, const Triangle& b) {
+  TriangleDistance result;
+  if (triangles_intersect(a, b)) {
+    // Report a vertex of one triangle as both points only when exactness says "meet"; the
+    // points are not needed by any caller in that case.
+    result.on_first = result.on_second = a[0];
+    return result;
+  }
+  const Translated t = translate(a, b);
+  Candidate best;
+  for (int i = 0; i < 3; ++i) {
+    best.offer(t.a[i], closest_on_triangle(t.a[i], t.b));
+    best.offer(closest_on_triangle(t.b[i], t.a), t.b[i]);
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      offer_edge_pair(t.a[i], t.a[i == 2 ? 0 : i + 1], t.b[j], t.b[j == 2 ? 0 : j + 1], best);
+  result.distance = std::sqrt(best.squared);
+  result.upper_bound = clearance_upper_bound(result.distance, t.magnitude);
+  result.lower_bound =
+      std::min(separation_lower_bound(t, sub(best.on_second, best.on_first)), result.distance);
+  for (int k = 0; k < 3; ++k) {
+    result.on_first[k] = best.on_first[k] + a[0][k];
+    result.on_second[k] = best.on_second[k] + a[0][k];
+  }
+  return result;
+}
+
+bool within_distance(const Triangle& a, const Triangle& b, double d) {
+  // Separated boxes: fl(lo - hi) (1 - 2u) is below the true axis gap.
+  const Box box_a = box_of(a), box_b = box_of(b);
+  for (int k = 0; k < 3; ++k) {
+    if ((box_b.lo[k] - box_a.hi[k]) * (1 - 2 * kUnit) > d) return false;
+    if ((box_a.lo[k] - box_b.hi[k]) * (1 - 2 * kUnit) > d) return false;
+  }
+  const Translated t = translate(a, b);
+  // The triangles' own planes often separate by more than d: cheap and rigorous.
+  const Vector normal_a = cross(sub(t.a[1], t.a[0]), sub(t.a[2], t.a[0]));
+  const Vector normal_b = cross(sub(t.b[1], t.b[0]), sub(t.b[2], t.b[0]));
+  const Vector minus_a{-normal_a[0], -normal_a[1], -normal_a[2]};
+  const Vector minus_b{-normal_b[0], -normal_b[1], -normal_b[2]};
+  for (const Vector* n : {&normal_a, &minus_a, &normal_b, &minus_b})
+    if (separation_lower_bound(t, *n) > d) return false;
+  return triangle_distance(a, b).lower_bound <= d;
+}
+
+}  // namespace tetrapage::geometry
