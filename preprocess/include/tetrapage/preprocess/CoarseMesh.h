@@ -1,0 +1,36 @@
+#pragma once
+/// @file CoarseMesh.h
+/// Sampling sites where the geometry is, and the coarse Delaunay mesh of those sites.
+/// "Model only what a scene requires": dense sites where triangles crowd, none in empty
+/// space, so empty space becomes a few big tetrahedra.
+
+#include <span>
+#include <vector>
+
+#include "tetrapage/formats/TetMesh.h"
+#include "tetrapage/formats/TriangleSoup.h"
+
+namespace tetrapage {
+
+struct SamplingOptions {
+  /// A leaf of the adaptive split holds at most this many triangle centroids.
+  std::size_t leaf_triangles = 4096;
+  /// The mesh covers the model's box enlarged by this fraction of its largest side.
+  double margin = 0.05;
+};
+
+/// Sites for the coarse mesh: the mean centroid of each leaf of a median split of the
+/// centroids (split along the longest side until a leaf holds at most leaf_triangles), plus
+/// the eight corners of the enlarged bounding box.
+/// @throw InputError if there is no centroid or the bounds are not finite.
+std::vector<Vec3> sample_sites(std::span<const Vec3> centroids, const BoundingBox& bounds,
+                               const SamplingOptions& options);
+
+/// The enlarged box whose corners bound the coarse mesh.
+BoundingBox enlarged_bounds(const BoundingBox& bounds, double margin);
+
+/// The Delaunay tetrahedralisation of the sites (CGAL), as a TetMesh of its finite cells.
+/// @throw InputError if the sites span no volume.
+TetMesh build_coarse_mesh(std::span<const Vec3> sites);
+
+}  // namespace tetrapage

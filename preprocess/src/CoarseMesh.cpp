@@ -1,0 +1,121 @@
+#include "tetrapage/preprocess/CoarseMesh.h"
+
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Triangulation_cell_base_with_info_3.h>
+#include <CGAL/Triangulation_vertex_base_with_info_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<std::uint32_t, Kernel>;
+using CellBase = CGAL::Triangulation_cell_base_with_info_3<
+    std::uint32_t, Kernel, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
+using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
+
+// Median split along the longest side of the centroids' own box; appends one site per leaf.
+void split(std::vector<Vec3>& points, std::size_t begin, std::size_t end, std::size_t leaf,
+           std::vector<Vec3>& sites) {
+  if (end - begin <= leaf) {
+    Vec3 mean{0, 0, 0};
+    for (std::size_t i = begin; i < end; ++i)
+      for (int a = 0; a < 3; ++a) mean[a] += points[i][a];
+    for (auto& m : mean) m /= double(end - begin);
+    sites.push_back(mean);
+    return;
+  }
+  BoundingBox box;
+  for (std::size_t i = begin; i < end; ++i) box.extend(points[i]);
+  const Vec3 size = box.size();
+  const int axis = size[0] >= size[1] && size[0] >= size[2] ? 0 : (size[1] >= size[2] ? 1 : 2);
+  if (size[axis] == 0.0) {  // all centroids coincide: one site is all they need
+    sites.push_back(points[begin]);
+    return;
+  }
+  const std::size_t middle = begin + (end - begin) / 2;
+  std::nth_element(points.begin() + long(begin), points.begin() + long(middle),
+                   points.begin() + long(end),
+                   [axis](const Vec3& a, const Vec3& b) { return a[axis] < b[axis]; });
+  split(points, begin, middle, leaf, sites);
+  split(points, middle, end, leaf, sites);
+}
+
+}  // namespace
+
+BoundingBox enlarged_bounds(const BoundingBox& bounds, double margin) {
+  const Vec3 size = bounds.size();
+  const double largest = std::max({size[0], size[1], size[2]});
+  // A flat or point-like model still gets a box with volume.
+  const double pad = std::max(margin * largest, largest > 0 ? 1e-3 * largest : 1.0);
+  BoundingBox out;
+  for (int a = 0; a < 3; ++a) {
+    out.lo[a] = bounds.lo[a] - pad;
+    out.hi[a] = bounds.hi[a] + pad;
+  }
+  return out;
+}
+
+std::vector<Vec3> sample_sites(std::span<const Vec3> centroids, const BoundingBox& bounds,
+                               const SamplingOptions& options) {
+  if (centroids.empty()) throw InputError("sampling: the model has no triangle");
+  for (int a = 0; a < 3; ++a)
+    if (!std::isfinite(bounds.lo[a]) || !std::isfinite(bounds.hi[a]))
+      throw InputError("sampling: the model's bounds are not finite");
+  std::vector<Vec3> points(centroids.begin(), centroids.end());
+  std::vector<Vec3> sites;
+  split(points, 0, points.size(), std::max<std::size_t>(1, options.leaf_triangles), sites);
+  const BoundingBox box = enlarged_bounds(bounds, options.margin);
+  for (int i = 0; i < 8; ++i)
+    sites.push_back({(i & 1) ? box.hi[0] : box.lo[0], (i & 2) ? box.hi[1] : box.lo[1],
+                     (i & 4) ? box.hi[2] : box.lo[2]});
+  return sites;
+}
+
+TetMesh build_coarse_mesh(std::span<const Vec3> sites) {
+  std::vector<std::pair<Kernel::Point_3, std::uint32_t>> points;
+  points.reserve(sites.size());
+  for (std::size_t i = 0; i < sites.size(); ++i)
+    points.emplace_back(Kernel::Point_3(sites[i][0], sites[i][1], sites[i][2]),
+                        static_cast<std::uint32_t>(i));
+  Delaunay delaunay(points.begin(), points.end());
+  if (delaunay.dimension() < 3)
+    throw InputError("coarse mesh: the " + std::to_string(sites.size()) +
+                     " sites span no volume (dimension " + std::to_string(delaunay.dimension()) + ")");
+
+  TetMesh mesh;
+  // Renumber vertices densely (duplicate sites were merged by CGAL) in site order.
+  std::vector<std::uint32_t> vertex_index(sites.size(), TetMesh::no_neighbour);
+  std::vector<Delaunay::Vertex_handle> by_site(sites.size());
+  for (auto v = delaunay.finite_vertices_begin(); v != delaunay.finite_vertices_end(); ++v)
+    by_site[v->info()] = v;
+  for (std::size_t i = 0; i < sites.size(); ++i) {
+    if (by_site[i] == Delaunay::Vertex_handle()) continue;
+    vertex_index[i] = static_cast<std::uint32_t>(mesh.vertices.size());
+    mesh.vertices.push_back(sites[i]);
+  }
+  for (auto c = delaunay.finite_cells_begin(); c != delaunay.finite_cells_end(); ++c) {
+    c->info() = static_cast<std::uint32_t>(mesh.tets.size());
+    std::array<std::uint32_t, 4> corners;
+    for (int i = 0; i < 4; ++i) corners[i] = vertex_index[c->vertex(i)->info()];
+    mesh.tets.push_back(corners);
+  }
+  mesh.neighbours.resize(mesh.tets.size());
+  for (auto c = delaunay.finite_cells_begin(); c != delaunay.finite_cells_end(); ++c) {
+    auto& n = mesh.neighbours[c->info()];
+    for (int i = 0; i < 4; ++i) {
+      const auto neighbour = c->neighbor(i);
+      n[i] = delaunay.is_infinite(neighbour) ? TetMesh::no_neighbour : neighbour->info();
+    }
+  }
+  return mesh;
+}
+
+}  // namespace tetrapage
