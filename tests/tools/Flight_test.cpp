@@ -1,0 +1,264 @@
+// The reference oracle against brute force over every triangle pair (CGAL's exact
+// construction kernel, no tree), and the billiard flight's promises.
+
+#include <gtest/gtest.h>
+
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/tools/AnswerFile.h"
+#include "tetrapage/tools/FlightGenerator.h"
+#include "tetrapage/tools/Random.h"
+#include "tetrapage/tools/ReferenceCollider.h"
+
+namespace tetrapage {
+namespace {
+
+using Exact = CGAL::Exact_predicates_exact_constructions_kernel;
+
+// Closed, outward-oriented axis-aligned box as 12 triangles, appended as one part.
+void add_box(TriangleSoup& soup, const Vec3& lo, const Vec3& hi) {
+  const auto base = static_cast<std::uint32_t>(soup.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    soup.vertices.push_back({(i & 1) ? hi[0] : lo[0], (i & 2) ? hi[1] : lo[1], (i & 4) ? hi[2] : lo[2]});
+  const std::uint32_t faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  const auto part = static_cast<std::uint32_t>(soup.part_names.size());
+  soup.part_names.push_back("box" + std::to_string(part));
+  for (const auto& f : faces) {
+    soup.triangles.push_back({base + f[0], base + f[1], base + f[2]});
+    soup.part_of.push_back(part);
+  }
+}
+
+// A unit-cube workspace (its corners are two tiny boxes) holding a few box obstacles.
+TriangleSoup boxes_environment(std::uint64_t seed, int count) {
+  TriangleSoup soup;
+  add_box(soup, {0, 0, 0}, {0.001, 0.001, 0.001});
+  add_box(soup, {0.999, 0.999, 0.999}, {1, 1, 1});
+  Random random(seed);
+  for (int i = 0; i < count; ++i) {
+    Vec3 lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = random.uniform(0.05, 0.8);
+      hi[a] = lo[a] + random.uniform(0.03, 0.15);
+    }
+    add_box(soup, lo, hi);
+  }
+  return soup;
+}
+
+TriangleSoup tetra_object(double size) {
+  TriangleSoup soup;
+  soup.vertices = {{size, size, size}, {size, -size, -size}, {-size, size, -size}, {-size, -size, size}};
+  soup.triangles = {{0, 1, 2}, {0, 3, 1}, {0, 2, 3}, {1, 3, 2}};
+  soup.part_of = {0, 0, 0, 0};
+  soup.part_names = {"tetra"};
+  return soup;
+}
+
+Exact::Point_3 exact_point(const Vec3& v) { return {v[0], v[1], v[2]}; }
+
+bool brute_force_touch(const TriangleSoup& environment, const TriangleSoup& object, const Pose& pose) {
+  std::vector<Vec3> placed;
+  for (const auto& v : object.vertices) placed.push_back(apply_pose(pose, v));
+  for (std::size_t e = 0; e < environment.triangle_count(); ++e) {
+    const auto c = environment.corners(e);
+    const Exact::Triangle_3 obstacle(exact_point(c[0]), exact_point(c[1]), exact_point(c[2]));
+    for (const auto& t : object.triangles) {
+      const Exact::Triangle_3 moving(exact_point(placed[t[0]]), exact_point(placed[t[1]]),
+                                     exact_point(placed[t[2]]));
+      if (CGAL::do_intersect(obstacle, moving)) return true;
+    }
+  }
+  return false;
+}
+
+// Parity along a direction different from the oracle's, by brute force in exact arithmetic.
+bool brute_force_inside(const TriangleSoup& environment, const Vec3& p) {
+  const Exact::Ray_3 ray(exact_point(p), Exact::Vector_3(0.3141592653, -0.2718281828, -1.0));
+  int crossings = 0;
+  for (std::size_t e = 0; e < environment.triangle_count(); ++e) {
+    const auto c = environment.corners(e);
+    if (CGAL::do_intersect(ray, Exact::Triangle_3(exact_point(c[0]), exact_point(c[1]), exact_point(c[2]))))
+      ++crossings;
+  }
+  return crossings % 2 == 1;
+}
+
+Pose random_pose(Random& random) {
+  Pose pose;
+  for (auto& t : pose.translation) t = random.uniform(0.0, 1.0);
+  std::array<double, 4> q{random.normal(), random.normal(), random.normal(), random.normal()};
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  for (auto& c : q) c /= n;
+  pose.rotation = q;
+  return pose;
+}
+
+TEST(ReferenceCollider, AgreesWithBruteForceOnRandomPoses) {
+  const std::uint64_t seed = 7;
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const TriangleSoup environment = boxes_environment(seed, 12);
+  const TriangleSoup object = tetra_object(0.04);
+  const ReferenceCollider oracle(environment, object);
+  Random random(seed);
+  int touching = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Pose pose = random_pose(random);
+    const auto answer = oracle.query(pose);
+    ASSERT_EQ(answer.surfaces_touch, brute_force_touch(environment, object, pose)) << "pose " << i;
+    if (!answer.surfaces_touch) {
+      ASSERT_EQ(answer.object_inside, brute_force_inside(environment, apply_pose(pose, object.vertices[0])))
+          << "pose " << i;
+    }
+    touching += answer.surfaces_touch;
+  }
+  EXPECT_GT(touching, 30) << "the test poses should include contacts";
+}
+
+TEST(ReferenceCollider, TouchingAlongAnEdgeCounts) {
+  TriangleSoup environment;
+  add_box(environment, {0, 0, 0}, {1, 1, 1});
+  const TriangleSoup object = tetra_object(0.25);
+  const ReferenceCollider oracle(environment, object);
+  // Half a turn about z maps (x, y, z) to (-x, -y, z) exactly; with this translation the
+  // tetra's edge from vertex 0 to vertex 1 lies exactly on the box's face x = 1.
+  Pose touching;
+  touching.translation = {1.25, 0.5, 0.5};
+  touching.rotation = {0, 0, 0, 1};
+  ASSERT_EQ(apply_pose(touching, object.vertices[0]), (Vec3{1.0, 0.25, 0.75}));
+  EXPECT_TRUE(oracle.query(touching).surfaces_touch);
+  Pose apart = touching;
+  apart.translation[0] = 1.25 + 1.0 / 1024;
+  EXPECT_FALSE(oracle.query(apart).surfaces_touch);
+}
+
+TEST(ReferenceCollider, ObjectInsideAClosedObstacleCollides) {
+  TriangleSoup environment;
+  add_box(environment, {0, 0, 0}, {1, 1, 1});
+  const ReferenceCollider oracle(environment, tetra_object(0.01));
+  Pose inside;
+  inside.translation = {0.5, 0.5, 0.5};
+  const auto answer = oracle.query(inside);
+  EXPECT_FALSE(answer.surfaces_touch);
+  EXPECT_TRUE(answer.object_inside);
+  EXPECT_TRUE(answer.collides);
+  Pose outside;
+  outside.translation = {1.5, 0.5, 0.5};
+  EXPECT_FALSE(oracle.query(outside).collides);
+}
+
+TEST(ReferenceCollider, RejectsEmptyInput) {
+  EXPECT_THROW(ReferenceCollider(TriangleSoup{}, tetra_object(0.01)), InputError);
+  EXPECT_THROW(ReferenceCollider(boxes_environment(1, 1), TriangleSoup{}), InputError);
+}
+
+class BilliardFlight : public ::testing::TestWithParam<std::uint64_t> {};
+
+TEST_P(BilliardFlight, KeepsItsPromises) {
+  const std::uint64_t seed = GetParam();
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const TriangleSoup environment = boxes_environment(seed, 25);
+  const TriangleSoup object = tetra_object(0.02);
+  const ReferenceCollider oracle(environment, object);
+  FlightOptions options;
+  options.steps = 1500;
+  options.seed = seed;
+  const Flight flight = generate_billiard_flight(oracle, options);
+  ASSERT_EQ(flight.poses.size(), options.steps);
+  ASSERT_EQ(flight.collides.size(), options.steps);
+
+  // Deterministic: the same seed gives the same poses, bit for bit.
+  const Flight again = generate_billiard_flight(oracle, options);
+  for (std::size_t i = 0; i < options.steps; ++i) {
+    ASSERT_EQ(flight.poses[i].translation, again.poses[i].translation) << "pose " << i;
+    ASSERT_EQ(flight.poses[i].rotation, again.poses[i].rotation) << "pose " << i;
+  }
+
+  const BoundingBox& workspace = environment.bounds();
+  std::uint64_t collisions = 0;
+  double travelled = 0;
+  for (std::size_t i = 0; i < options.steps; ++i) {
+    const Pose& pose = flight.poses[i];
+    const bool touch = brute_force_touch(environment, object, pose);
+    ASSERT_EQ(bool(flight.collides[i]), touch) << "pose " << i << ": recorded answer is wrong";
+    // Never inside an obstacle: a pose is either touching or outside every obstacle.
+    if (!touch) {
+      ASSERT_FALSE(brute_force_inside(environment, apply_pose(pose, object.vertices[0]))) << "pose " << i;
+    }
+    // Inside the workspace.
+    for (const auto& v : object.vertices) {
+      const Vec3 w = apply_pose(pose, v);
+      for (int a = 0; a < 3; ++a) {
+        ASSERT_GE(w[a], workspace.lo[a]);
+        ASSERT_LE(w[a], workspace.hi[a]);
+      }
+    }
+    // A collision is followed by the reverse move back to free space.
+    if (i > 0 && flight.collides[i - 1]) {
+      ASSERT_FALSE(flight.collides[i]) << "pose " << i;
+    }
+    if (i > 0) {
+      double d2 = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double d = pose.translation[a] - flight.poses[i - 1].translation[a];
+        d2 += d * d;
+      }
+      travelled += std::sqrt(d2);
+    }
+    collisions += flight.collides[i];
+  }
+  EXPECT_FALSE(flight.collides.front());
+  EXPECT_FALSE(flight.collides.back());
+  EXPECT_EQ(collisions, flight.collisions);
+  EXPECT_GT(collisions, 0u) << "a cluttered scene should produce bounces";
+  EXPECT_NEAR(travelled / double(options.steps - 1), options.displacement, 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(Seeds, BilliardFlight, ::testing::Values(1, 2, 3));
+
+TEST(BilliardFlight, DifferentSeedsDiffer) {
+  const TriangleSoup environment = boxes_environment(5, 10);
+  const ReferenceCollider oracle(environment, tetra_object(0.02));
+  FlightOptions a, b;
+  a.steps = b.steps = 50;
+  a.seed = 1;
+  b.seed = 2;
+  EXPECT_NE(generate_billiard_flight(oracle, a).poses.back().translation,
+            generate_billiard_flight(oracle, b).poses.back().translation);
+}
+
+TEST(BilliardFlight, RefusesAnObjectLargerThanTheWorkspace) {
+  const TriangleSoup environment = boxes_environment(5, 1);
+  const ReferenceCollider oracle(environment, tetra_object(2.0));
+  EXPECT_THROW(generate_billiard_flight(oracle, FlightOptions{}), InputError);
+}
+
+TEST(AnswerFile, RoundTripsAndRejectsBadRows) {
+  const std::filesystem::path folder = std::filesystem::path(TETRAPAGE_TEST_TMP) / "answers";
+  std::filesystem::create_directories(folder);
+  const std::vector<std::uint8_t> answers{0, 1, 1, 0, 0};
+  write_answers(folder / "a.csv", answers);
+  EXPECT_EQ(read_answers(folder / "a.csv"), answers);
+  EXPECT_FALSE(std::filesystem::exists(folder / "a.csv.tmp"));
+
+  std::ofstream(folder / "bad.csv") << "step,collides\n0,1\n1,2\n";
+  try {
+    read_answers(folder / "bad.csv");
+    FAIL() << "expected FormatError";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.csv"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+  std::ofstream(folder / "header.csv") << "collides\n0\n";
+  EXPECT_THROW(read_answers(folder / "header.csv"), FormatError);
+  EXPECT_THROW(read_answers(folder / "missing.csv"), IoError);
+}
+
+}  // namespace
+}  // namespace tetrapage

@@ -1,0 +1,35 @@
+#pragma once
+// Each subcommand group registers itself on the app; main() only dispatches.
+// A registration returns nothing; the callback it installs runs the command and throws
+// tetrapage::Error (or CLI11 errors) on failure, which main() turns into one stderr line.
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace tetrapage::cli {
+
+/// `generate scene|tetras|terrain|object` (tools/cli/GenerateEnvironment.cpp)
+void add_generate_environment_commands(CLI::App& generate);
+/// `generate flight` (tools/cli/GenerateFlight.cpp)
+void add_generate_flight_command(CLI::App& generate);
+/// `replay` (tools/cli/ReplayCommand.cpp)
+void add_replay_command(CLI::App& app);
+/// `mesh info|convert` (tools/cli/MeshCommands.cpp)
+void add_mesh_commands(CLI::App& app);
+
+/// Writes a JSON report under a temporary name and renames it (never half-written).
+/// @throw IoError on failure.
+void write_report(const std::filesystem::path& path, const nlohmann::json& report);
+
+/// Fails early, before long work, when an output could not be written: creates and
+/// removes `path`.tmp. Empty paths (optional outputs not asked for) are skipped.
+/// @throw IoError naming the path and the reason.
+void check_writable(const std::filesystem::path& path);
+
+/// Peak resident set size of this process in bytes (VmHWM), 0 if unknown.
+std::uint64_t peak_rss_bytes();
+
+}  // namespace tetrapage::cli

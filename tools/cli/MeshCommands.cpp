@@ -1,0 +1,193 @@
+// `tetrapage mesh info|convert`: look at mesh files and convert between formats.
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "Commands.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/MeshWriter.h"
+
+namespace tetrapage::cli {
+namespace {
+
+struct InfoArguments {
+  std::vector<std::filesystem::path> files;
+  std::filesystem::path report;
+};
+
+struct ConvertArguments {
+  std::filesystem::path input;
+  std::filesystem::path output;
+  std::filesystem::path report;
+};
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double megabytes_per_second(std::uint64_t bytes, double seconds) {
+  return seconds > 0 ? double(bytes) / 1e6 / seconds : 0.0;
+}
+
+nlohmann::json bounds_json(const BoundingBox& box) {
+  if (box.empty()) return nullptr;
+  return {{"lo", box.lo}, {"hi", box.hi}};
+}
+
+nlohmann::json report_json(const ReadReport& report) {
+  return {{"path", report.path},
+          {"format", report.format},
+          {"encoding", report.encoding},
+          {"bytes", report.bytes},
+          {"triangles_read", report.triangles_read},
+          {"degenerate_dropped", report.degenerate_dropped},
+          {"polygons_triangulated", report.polygons_triangulated},
+          {"seconds", report.seconds},
+          {"megabytes_per_second", megabytes_per_second(report.bytes, report.seconds)}};
+}
+
+void print_bounds(const BoundingBox& box) {
+  if (box.empty()) return;
+  std::printf("  bounds [%.9g, %.9g, %.9g] .. [%.9g, %.9g, %.9g]\n", box.lo[0], box.lo[1],
+              box.lo[2], box.hi[0], box.hi[1], box.hi[2]);
+}
+
+void run_info(const InfoArguments& args) {
+  nlohmann::json files = nlohmann::json::array();
+  for (const auto& path : args.files) {
+    std::vector<ReadReport> reports;
+    const auto start = std::chrono::steady_clock::now();
+    const bool is_manifest = path.extension() == ".json" || path.extension() == ".JSON";
+    const TriangleSoup soup = load_inputs({path}, &reports);
+    const double seconds = seconds_since(start);
+    std::uint64_t bytes = 0, degenerate = 0, polygons = 0;
+    for (const auto& report : reports) {
+      bytes += report.bytes;
+      degenerate += report.degenerate_dropped;
+      polygons += report.polygons_triangulated;
+    }
+    const BoundingBox box = soup.bounds();
+    const std::string format =
+        is_manifest
+            ? "manifest"
+            : reports.front().format +
+                  (reports.front().encoding.empty() ? "" : " (" + reports.front().encoding + ")");
+    std::printf(
+        "%s: %s, %zu triangles, %zu vertices, %zu parts, %llu degenerate dropped, "
+        "%llu polygons triangulated\n",
+        path.c_str(), format.c_str(), soup.triangle_count(), soup.vertices.size(),
+        soup.part_count(), static_cast<unsigned long long>(degenerate),
+        static_cast<unsigned long long>(polygons));
+    print_bounds(box);
+    std::printf("  read %.3f s, %.1f MB/s (%llu bytes%s)\n", seconds,
+                megabytes_per_second(bytes, seconds), static_cast<unsigned long long>(bytes),
+                is_manifest ? (", " + std::to_string(reports.size()) + " files").c_str() : "");
+    nlohmann::json entry = {
+        {"path", path.string()},
+        {"format", is_manifest ? "manifest" : reports.front().format},
+        {"encoding", is_manifest ? "" : reports.front().encoding},
+        {"triangles", soup.triangle_count()},
+        {"vertices", soup.vertices.size()},
+        {"parts", soup.part_count()},
+        {"degenerate_dropped", degenerate},
+        {"polygons_triangulated", polygons},
+        {"bounds", bounds_json(box)},
+        {"bytes", bytes},
+        {"read_seconds", seconds},
+        {"megabytes_per_second", megabytes_per_second(bytes, seconds)},
+        {"triangles_per_second", seconds > 0 ? double(soup.triangle_count()) / seconds : 0.0}};
+    if (is_manifest) {
+      entry["files"] = nlohmann::json::array();
+      for (const auto& report : reports) entry["files"].push_back(report_json(report));
+    }
+    files.push_back(std::move(entry));
+  }
+  if (!args.report.empty()) {
+    write_report(
+        args.report,
+        {{"command", "mesh info"}, {"files", files}, {"peak_rss_bytes", peak_rss_bytes()}});
+  }
+}
+
+void run_convert(const ConvertArguments& args) {
+  if (!can_write_mesh(args.output)) {
+    throw InputError("'" + args.output.string() + "': cannot write meshes with the extension '" +
+                     args.output.extension().string() +
+                     "' (writable: .obj, .stl, .ply, .off, .gltf, .glb)");
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<ReadReport> reports;
+  Progress reading("reading", 0);
+  const TriangleSoup soup = load_inputs({args.input}, &reports, reading);
+  reading.finish();
+  const double read_seconds = seconds_since(start);
+  const auto write_start = std::chrono::steady_clock::now();
+  write_mesh(args.output, soup);
+  const double write_seconds = seconds_since(write_start);
+  std::uint64_t degenerate = 0;
+  for (const auto& report : reports) degenerate += report.degenerate_dropped;
+  std::printf(
+      "wrote %s: %zu triangles, %zu vertices, %zu parts (%llu degenerate dropped); "
+      "read %.3f s, write %.3f s\n",
+      args.output.c_str(), soup.triangle_count(), soup.vertices.size(), soup.part_count(),
+      static_cast<unsigned long long>(degenerate), read_seconds, write_seconds);
+  if (!args.report.empty()) {
+    nlohmann::json inputs = nlohmann::json::array();
+    for (const auto& report : reports) inputs.push_back(report_json(report));
+    std::error_code error;
+    const auto output_bytes = std::filesystem::file_size(args.output, error);
+    write_report(args.report, {{"command", "mesh convert"},
+                               {"input", args.input.string()},
+                               {"output", args.output.string()},
+                               {"triangles", soup.triangle_count()},
+                               {"vertices", soup.vertices.size()},
+                               {"parts", soup.part_count()},
+                               {"degenerate_dropped", degenerate},
+                               {"read_seconds", read_seconds},
+                               {"write_seconds", write_seconds},
+                               {"output_bytes", error ? 0 : output_bytes},
+                               {"files", inputs},
+                               {"peak_rss_bytes", peak_rss_bytes()}});
+  }
+}
+
+}  // namespace
+
+void add_mesh_commands(CLI::App& app) {
+  auto* mesh = app.add_subcommand("mesh", "Inspect and convert mesh files and assembly manifests");
+  mesh->require_subcommand(1);
+
+  auto info_args = std::make_shared<InfoArguments>();
+  auto* info = mesh->add_subcommand(
+      "info",
+      "Read mesh files and print, per file: format, triangles, vertices, parts, degenerate\n"
+      "triangles dropped, polygons triangulated, bounds, read time and throughput (MB/s).\n"
+      "Readable: .obj, .stl (ASCII or binary), .ply (ASCII or binary), .off (our own readers,\n"
+      "double precision), .gltf, .glb and the other formats Assimp imports (single precision),\n"
+      "and assembly manifests (.json).");
+  info->add_option("files", info_args->files, "Mesh files or manifests (.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  info->add_option("--report", info_args->report, "Also write the figures as JSON");
+  info->callback([info_args] { run_info(*info_args); });
+
+  auto convert_args = std::make_shared<ConvertArguments>();
+  auto* convert = mesh->add_subcommand(
+      "convert",
+      "Read a mesh file (or an assembly manifest, .json) and write it in the format named by\n"
+      "the output's extension: .obj, .ply (binary, double), .off (exact doubles), .stl\n"
+      "(binary, float), .gltf/.glb (float; one node per part). The output appears only when\n"
+      "complete.");
+  convert->add_option("input", convert_args->input, "Mesh file or manifest (.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  convert->add_option("-o,--output", convert_args->output, "Mesh file to write")->required();
+  convert->add_option("--report", convert_args->report, "Also write the figures as JSON");
+  convert->callback([convert_args] { run_convert(*convert_args); });
+}
+
+}  // namespace tetrapage::cli

@@ -1,0 +1,87 @@
+// The `tetrapage` command: thin subcommands over the libraries. Results go to stdout,
+// logs and progress to stderr; every failure is one line on stderr and a non-zero exit.
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <fstream>
+
+#include "Commands.h"
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage::cli {
+
+void write_report(const std::filesystem::path& path, const nlohmann::json& report) {
+  const auto temporary = std::filesystem::path(path.string() + ".tmp");
+  {
+    std::ofstream out(temporary);
+    if (!out) throw IoError("cannot write report '" + temporary.string() + "'");
+    out << report.dump(2) << '\n';
+    if (!out.flush()) throw IoError("cannot write report '" + temporary.string() + "'");
+  }
+  std::error_code ec;
+  std::filesystem::rename(temporary, path, ec);
+  if (ec) {
+    std::filesystem::remove(temporary, ec);
+    throw IoError("cannot rename report to '" + path.string() + "': " + ec.message());
+  }
+}
+
+void check_writable(const std::filesystem::path& path) {
+  if (path.empty()) return;
+  const auto temporary = std::filesystem::path(path.string() + ".tmp");
+  {
+    std::ofstream probe(temporary);
+    if (!probe)
+      throw IoError("cannot write '" + path.string() + "': " + std::strerror(errno));
+  }
+  std::error_code ec;
+  std::filesystem::remove(temporary, ec);
+}
+
+std::uint64_t peak_rss_bytes() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
+  }
+  return 0;
+}
+
+}  // namespace tetrapage::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "tetrapage: out-of-core collision detection for huge CAD models.\n"
+      "Generates the study's environments, objects and billiard flights, reads meshes,\n"
+      "and (as the pipeline grows) preprocesses assemblies into an index and flies through it."};
+  app.require_subcommand(1);
+  app.set_help_all_flag("--help-all", "Show help for every subcommand");
+
+  auto* generate = app.add_subcommand(
+      "generate", "Generate the study's environments, flying objects and billiard flights");
+  generate->require_subcommand(1);
+  tetrapage::cli::add_generate_environment_commands(*generate);
+  tetrapage::cli::add_generate_flight_command(*generate);
+  tetrapage::cli::add_replay_command(app);
+  tetrapage::cli::add_mesh_commands(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "tetrapage: %s (see --help)\n", e.what());
+    return 2;
+  } catch (const tetrapage::Error& e) {
+    std::fprintf(stderr, "tetrapage: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "tetrapage: unexpected error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,43 @@
+#pragma once
+/// @file FlightGenerator.h
+/// The study's billiard flights (section 4.1): the object moves by a displacement and a
+/// rotation that are randomly perturbed each step; when a pose collides, the motion is
+/// reversed; the path starts from a collision-free placement and stays inside the
+/// environment's bounding box (the workspace).
+
+#include <cstdint>
+#include <vector>
+
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/tools/ReferenceCollider.h"
+
+namespace tetrapage {
+
+struct FlightOptions {
+  std::size_t steps = 10000;
+  std::uint64_t seed = 1;
+  double displacement = 0.005;    ///< distance moved per step (the study's mean displacement)
+  double max_rotation = 0.05;     ///< radians per step at most
+  double perturbation = 0.3;      ///< relative random change of the motion per step
+  std::size_t start_attempts = 100000;  ///< random placements tried for a free start
+};
+
+struct Flight {
+  std::vector<Pose> poses;
+  std::vector<std::uint8_t> collides;  ///< the oracle's answer for each pose
+  std::uint64_t collisions = 0;
+  std::uint64_t boundary_reversals = 0;  ///< moves refused because they left the workspace
+  std::uint64_t start_attempts = 0;
+  std::vector<double> query_seconds;     ///< oracle time per emitted pose
+};
+
+/// Generates a billiard flight with the reference oracle deciding collisions.
+/// A colliding pose is followed by the exact reverse of the move that led into it, so the
+/// object is back at a free placement the step after; the last pose is collision-free.
+/// @throw InputError if no collision-free start is found within options.start_attempts, or if
+///        the object does not fit inside the workspace.
+Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOptions& options,
+                                Progress& progress = Progress::silent());
+
+}  // namespace tetrapage

@@ -1,0 +1,175 @@
+#include "tetrapage/tools/FlightGenerator.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/tools/Random.h"
+
+namespace tetrapage {
+namespace {
+
+using Quaternion = std::array<double, 4>;
+
+Quaternion multiply(const Quaternion& a, const Quaternion& b) {
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+          a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+          a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+}
+
+Quaternion normalized(const Quaternion& q) {
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
+}
+
+// Rotation by the axis-angle vector w (angle = |w|).
+Quaternion exp_map(const Vec3& w) {
+  const double angle = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+  if (angle == 0.0) return {1.0, 0.0, 0.0, 0.0};
+  const double s = std::sin(0.5 * angle) / angle;
+  return {std::cos(0.5 * angle), w[0] * s, w[1] * s, w[2] * s};
+}
+
+double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+Vec3 random_direction(Random& random) {
+  for (;;) {
+    Vec3 v{random.normal(), random.normal(), random.normal()};
+    const double n = norm(v);
+    if (n > 1e-9) return {v[0] / n, v[1] / n, v[2] / n};
+  }
+}
+
+Quaternion random_rotation(Random& random) {
+  for (;;) {
+    Quaternion q{random.normal(), random.normal(), random.normal(), random.normal()};
+    const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (n > 1e-9) return {q[0] / n, q[1] / n, q[2] / n, q[3] / n};
+  }
+}
+
+bool inside_workspace(const BoundingBox& object, const BoundingBox& workspace) {
+  for (int a = 0; a < 3; ++a)
+    if (object.lo[a] < workspace.lo[a] || object.hi[a] > workspace.hi[a]) return false;
+  return true;
+}
+
+Pose moved(const Pose& pose, const Vec3& velocity, const Vec3& spin) {
+  Pose next;
+  for (int a = 0; a < 3; ++a) next.translation[a] = pose.translation[a] + velocity[a];
+  next.rotation = normalized(multiply(exp_map(spin), pose.rotation));
+  return next;
+}
+
+}  // namespace
+
+Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOptions& options,
+                                Progress& progress) {
+  if (options.steps == 0) throw InputError("flight: --steps must be at least 1");
+  if (!(options.displacement > 0.0) || !(options.max_rotation >= 0.0))
+    throw InputError("flight: displacement must be positive and rotation non-negative");
+  Random random(options.seed);
+  const BoundingBox& workspace = oracle.environment_bounds();
+  const double radius = oracle.object_radius();
+  for (int a = 0; a < 3; ++a) {
+    if (workspace.hi[a] - workspace.lo[a] <= 2.0 * radius)
+      throw InputError("flight: the object (radius " + std::to_string(radius) +
+                       ") does not fit inside the environment's bounding box along axis " +
+                       std::to_string(a));
+  }
+
+  Flight flight;
+  flight.poses.reserve(options.steps);
+  flight.collides.reserve(options.steps);
+  flight.query_seconds.reserve(options.steps);
+
+  // A free start: random placements (centre at least the object's radius from the walls).
+  Pose pose;
+  bool found = false;
+  while (!found && flight.start_attempts < options.start_attempts) {
+    ++flight.start_attempts;
+    for (int a = 0; a < 3; ++a)
+      pose.translation[a] = random.uniform(workspace.lo[a] + radius, workspace.hi[a] - radius);
+    pose.rotation = random_rotation(random);
+    found = inside_workspace(oracle.object_bounds(pose), workspace) && !oracle.query(pose).collides;
+  }
+  if (!found)
+    throw InputError("flight: no collision-free start placement found in " +
+                     std::to_string(options.start_attempts) + " random attempts (seed " +
+                     std::to_string(options.seed) + ")");
+
+  const auto record = [&](const Pose& p, bool collides, double seconds) {
+    flight.poses.push_back(p);
+    flight.collides.push_back(collides ? 1 : 0);
+    flight.query_seconds.push_back(seconds);
+    if (collides) ++flight.collisions;
+    progress.advance();
+  };
+  record(pose, false, 0.0);
+
+  Vec3 direction = random_direction(random);
+  Vec3 velocity{direction[0] * options.displacement, direction[1] * options.displacement,
+                direction[2] * options.displacement};
+  Vec3 spin = random_direction(random);
+  const double initial_spin = random.uniform(0.0, options.max_rotation);
+  for (auto& s : spin) s *= initial_spin;
+  bool replay_reverse = false;  // after a collision the next move is the exact reverse
+
+  std::size_t boundary_streak = 0;
+  std::size_t final_attempts = 0;
+  while (flight.poses.size() < options.steps) {
+    if (!replay_reverse) {
+      // Perturb the motion: direction and spin random-walk; speed stays `displacement`.
+      Vec3 v;
+      for (int a = 0; a < 3; ++a)
+        v[a] = velocity[a] + options.perturbation * options.displacement * random.normal();
+      const double n = norm(v);
+      if (n > 0.0)
+        for (int a = 0; a < 3; ++a) velocity[a] = v[a] / n * options.displacement;
+      for (int a = 0; a < 3; ++a)
+        spin[a] += options.perturbation * options.max_rotation * random.normal();
+      const double s = norm(spin);
+      if (s > options.max_rotation)
+        for (auto& c : spin) c *= options.max_rotation / s;
+    }
+    replay_reverse = false;
+    const Pose candidate = moved(pose, velocity, spin);
+    if (!inside_workspace(oracle.object_bounds(candidate), workspace)) {
+      // Bounce off the workspace walls without emitting the outside pose.
+      ++flight.boundary_reversals;
+      for (auto& c : velocity) c = -c;
+      for (auto& c : spin) c = -c;
+      if (++boundary_streak > 1000)
+        throw InputError("flight: the object cannot move inside the workspace (seed " +
+                         std::to_string(options.seed) + ")");
+      continue;
+    }
+    boundary_streak = 0;
+    const auto start = std::chrono::steady_clock::now();
+    const bool collides = oracle.query(candidate).collides;
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const bool last = flight.poses.size() + 1 == options.steps;
+    if (collides) {
+      for (auto& c : velocity) c = -c;
+      for (auto& c : spin) c = -c;
+      replay_reverse = true;
+      if (last) {
+        // The path ends on a free placement: try other (perturbed) moves from the last one.
+        replay_reverse = false;
+        if (++final_attempts > 100000)
+          throw InputError("flight: no free final move found (seed " +
+                           std::to_string(options.seed) + ")");
+        continue;
+      }
+    }
+    record(candidate, collides, seconds);
+    pose = candidate;
+  }
+  progress.finish();
+  return flight;
+}
+
+}  // namespace tetrapage
