@@ -92,6 +92,23 @@ void write_ascii_ply(const std::filesystem::path& path, const TriangleSoup& soup
   if (std::fclose(file) != 0) throw std::runtime_error("cannot write " + path.string());
 }
 
+/// ASCII STL, which MeshWriter does not write (it writes binary STL).
+void write_ascii_stl(const std::filesystem::path& path, const TriangleSoup& soup) {
+  std::FILE* file = std::fopen(path.c_str(), "wb");
+  if (file == nullptr) throw std::runtime_error("cannot write " + path.string());
+  std::fprintf(file, "solid grid\n");
+  for (const TriangleIndices& t : soup.triangles) {
+    std::fprintf(file, "facet normal 0 0 1\nouter loop\n");
+    for (int k = 0; k < 3; ++k) {
+      const Vec3& p = soup.vertices[t[k]];
+      std::fprintf(file, "vertex %.6f %.6f %.6f\n", p[0], p[1], p[2]);
+    }
+    std::fprintf(file, "endloop\nendfacet\n");
+  }
+  std::fprintf(file, "endsolid grid\n");
+  if (std::fclose(file) != 0) throw std::runtime_error("cannot write " + path.string());
+}
+
 void read_benchmark(benchmark::State& state, const std::filesystem::path& path, bool assimp) {
   std::uint64_t triangles = 0;
   std::uint64_t bytes = 0;
@@ -145,6 +162,7 @@ int main(int argc, char** argv) {
     for (const char* name : {"grid.obj", "grid.stl", "grid.ply", "grid.off", "grid.glb"})
       tetrapage::write_mesh(folder / name, grid);
     write_ascii_ply(folder / "grid_ascii.ply", grid);
+    write_ascii_stl(folder / "grid_ascii.stl", grid);
     std::fprintf(stderr, "generated a %zu x %zu grid (%zu triangles) in %s in %.1f s\n", n, n,
                  grid.triangle_count(), folder.c_str(),
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
@@ -158,11 +176,13 @@ int main(int argc, char** argv) {
   const Case cases[] = {
       {"read/ours/obj", "grid.obj", false},
       {"read/ours/stl_binary", "grid.stl", false},
+      {"read/ours/stl_ascii", "grid_ascii.stl", false},
       {"read/ours/ply_binary", "grid.ply", false},
       {"read/ours/ply_ascii", "grid_ascii.ply", false},
       {"read/ours/off", "grid.off", false},
       {"read/assimp/obj", "grid.obj", true},
       {"read/assimp/stl_binary", "grid.stl", true},
+      {"read/assimp/stl_ascii", "grid_ascii.stl", true},
       {"read/assimp/ply_binary", "grid.ply", true},
       {"read/assimp/ply_ascii", "grid_ascii.ply", true},
       {"read/assimp/off", "grid.off", true},

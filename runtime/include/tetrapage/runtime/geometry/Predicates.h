@@ -57,9 +57,20 @@ namespace detail {
 inline constexpr double kOrient3dRelativeBound = 0x1p-50;
 inline constexpr double kOrient2dRelativeBound = 0x1p-51;
 // Gradual underflow adds an absolute error below 2^-1075 per product; a product of a minor
-// with a coordinate difference w magnifies it by |w| (hence the |w| term in orient3d).
-inline constexpr double kUnderflowPerUnit = 0x1p-1072;
-inline constexpr double kUnderflowAbsolute = 0x1p-1071;
+// with a coordinate difference w magnifies it by |w| (hence the |w| term in orient3d). That
+// bound, 2^-1072 (|w|_1 + 2), is subnormal: arithmetic on subnormals takes a slow microcode
+// path on x86 (about 100 cycles), so the filter never computes it. It accepts a sign when
+// |det| exceeds twice each of the two terms (hence their sum), testing the underflow term
+// scaled by 2^1000, where every operand is normal.
+inline constexpr double kUnderflowScale = 0x1p+1000;
+inline constexpr double kUnderflowScaledPerUnit = 0x1p-71;  // 2 * 2^-1072 * 2^1000
+
+// |det| is certainly larger than the rounding error of the filter.
+inline bool filter_accepts(double det_magnitude, double relative_bound, double permanent,
+                           double underflow_units) {
+  return det_magnitude > 2 * relative_bound * permanent &&
+         det_magnitude * kUnderflowScale > kUnderflowScaledPerUnit * underflow_units;
+}
 
 }  // namespace detail
 
@@ -76,10 +87,9 @@ inline Sign orient3d(const Point& a, const Point& b, const Point& c, const Point
   const double permanent = awx * (std::fabs(p1) + std::fabs(p2)) +
                            awy * (std::fabs(p3) + std::fabs(p4)) +
                            awz * (std::fabs(p5) + std::fabs(p6));
-  const double bound = detail::kOrient3dRelativeBound * permanent +
-                       detail::kUnderflowPerUnit * (awx + awy + awz) + detail::kUnderflowAbsolute;
-  if (det > bound) return Sign::positive;
-  if (-det > bound) return Sign::negative;
+  if (detail::filter_accepts(std::fabs(det), detail::kOrient3dRelativeBound, permanent,
+                             awx + awy + awz + 2))
+    return sign_of(det);
   return orient3d_cgal(a, b, c, d);  // also reached on overflow (bound = inf) or NaN
 }
 
@@ -88,10 +98,9 @@ inline Sign orient2d(double ax, double ay, double bx, double by, double cx, doub
   const double ux = bx - ax, uy = by - ay, vx = cx - ax, vy = cy - ay;
   const double left = ux * vy, right = uy * vx;
   const double det = left - right;
-  const double bound = detail::kOrient2dRelativeBound * (std::fabs(left) + std::fabs(right)) +
-                       detail::kUnderflowAbsolute;
-  if (det > bound) return Sign::positive;
-  if (-det > bound) return Sign::negative;
+  if (detail::filter_accepts(std::fabs(det), detail::kOrient2dRelativeBound,
+                             std::fabs(left) + std::fabs(right), 2))
+    return sign_of(det);
   return orient2d_cgal(ax, ay, bx, by, cx, cy);
 }
 
@@ -135,10 +144,9 @@ class OrientedPlane {
     const double det = wx * normal_[0] + wy * normal_[1] + wz * normal_[2];
     const double awx = std::fabs(wx), awy = std::fabs(wy), awz = std::fabs(wz);
     const double permanent = awx * magnitude_[0] + awy * magnitude_[1] + awz * magnitude_[2];
-    const double bound = detail::kOrient3dRelativeBound * permanent +
-                         detail::kUnderflowPerUnit * (awx + awy + awz) + detail::kUnderflowAbsolute;
-    if (det > bound) return Sign::positive;
-    if (-det > bound) return Sign::negative;
+    if (detail::filter_accepts(std::fabs(det), detail::kOrient3dRelativeBound, permanent,
+                               awx + awy + awz + 2))
+      return sign_of(det);
     return orient3d_cgal(a_, b_, c_, d);
   }
 
