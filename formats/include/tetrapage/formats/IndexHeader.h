@@ -1,0 +1,39 @@
+#pragma once
+/// @file IndexHeader.h
+/// What the root attributes of an index file say about it (docs/FORMAT.md lists them).
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "tetrapage/formats/TriangleSoup.h"
+
+namespace tetrapage {
+
+/// Value of the root attribute "format" of every tetrapage index.
+inline constexpr std::string_view kIndexFormatName = "tetrapage-index";
+/// The only layout version this build writes and reads; any change to the layout bumps it.
+inline constexpr std::uint32_t kIndexVersion = 1;
+
+struct IndexHeader {
+  std::uint32_t version = kIndexVersion;
+  /// Precision of the stored shard coordinates: "float" or "double".
+  std::string precision = "double";
+  std::uint64_t input_triangles = 0;
+  /// Triangles over all shards, duplicates (a triangle binned into several tets) included.
+  std::uint64_t stored_triangles = 0;
+  std::uint64_t region_count = 0;
+  /// Number of shards; the writer fills it in (a non-zero value must match).
+  std::uint64_t shard_count = 0;
+  /// Largest distance between an input vertex and its stored (rounded) position.
+  double max_rounding_distance = 0;
+  BoundingBox bounds;
+  /// What the index was built from (file names, a hash: free text).
+  std::string source;
+  /// The preprocess report, a JSON document (any length).
+  std::string build_report_json;
+  /// Program that wrote the file; the writer fills it in, the reader reports it.
+  std::string created_by;
+};
+
+}  // namespace tetrapage

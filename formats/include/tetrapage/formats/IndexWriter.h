@@ -1,0 +1,83 @@
+#pragma once
+/// @file IndexWriter.h
+/// Writes a tetrapage index (one HDF5 file, layout in docs/FORMAT.md) under a temporary name
+/// and renames it into place on commit, so a reader never sees a half-written index.
+/// Shards are streamed: memory holds one chunk and 16 bytes per shard, never the file.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string_view>
+
+#include "tetrapage/formats/IndexHeader.h"
+#include "tetrapage/formats/TetMesh.h"
+
+namespace tetrapage {
+
+struct IndexWriterOptions {
+  /// Chunk size of /shards/data in bytes (every shard starts on a chunk boundary, so small
+  /// chunks waste less padding and large ones need fewer reads). 1 KiB .. 64 MiB.
+  std::uint32_t chunk_bytes = 65536;
+  /// zlib level of every compressed dataset, 0 (store) .. 9.
+  int deflate_level = 4;
+};
+
+class IndexWriter {
+ public:
+  /// Creates "<path>.tmp-<pid>" next to `path`; `path` itself is untouched until commit().
+  /// @throw InputError if an option is out of range.
+  /// @throw IoError if the temporary file cannot be created.
+  explicit IndexWriter(std::filesystem::path path, IndexWriterOptions options = {});
+  /// Removes the temporary file unless commit() succeeded.
+  ~IndexWriter();
+  IndexWriter(IndexWriter&&) noexcept;
+  IndexWriter& operator=(IndexWriter&&) noexcept;
+  IndexWriter(const IndexWriter&) = delete;
+  IndexWriter& operator=(const IndexWriter&) = delete;
+
+  /// Stores the coarse mesh under /mesh (at most once; an empty mesh is written at commit
+  /// if this is never called).
+  /// @throw InputError if called twice, after commit, or if a corner or neighbour index is
+  ///        out of range or the neighbour and tet counts differ.
+  /// @throw IoError if HDF5 fails to write.
+  void write_mesh(const TetMesh& mesh);
+
+  /// Stores a 1-D table as /tables/<name> (e.g. "tet_shard" per tet, "shard_kind" per shard).
+  /// @throw InputError if the name is empty, holds '/' or '.', or is already used; or after
+  ///        commit.
+  /// @throw IoError if HDF5 fails to write.
+  void write_table(std::string_view name, std::span<const std::uint8_t> values);
+  void write_table(std::string_view name, std::span<const std::uint32_t> values);
+  void write_table(std::string_view name, std::span<const std::uint64_t> values);
+  void write_table(std::string_view name, std::span<const double> values);
+
+  /// Compresses and writes the shard's chunks now; returns its number (0, 1, 2, ...).
+  /// An empty payload is a valid shard of size 0.
+  /// @throw InputError after commit, or past 2^32 - 1 shards.
+  /// @throw IoError if HDF5 fails to write.
+  std::uint32_t append_shard(std::span<const std::byte> payload);
+
+  /// Shards appended so far.
+  std::uint32_t shard_count() const;
+  /// Bytes of shard chunks written so far, as stored (compressed, with checksums).
+  std::uint64_t stored_shard_bytes() const;
+  const std::filesystem::path& path() const;
+  const std::filesystem::path& temporary_path() const;
+
+  /// Writes the shard extents and the header attributes, closes and flushes the file, and
+  /// renames it to path(). Returns the size of the index in bytes.
+  /// @throw InputError if called twice, if header.precision is neither "float" nor "double",
+  ///        if header.version is not kIndexVersion, or if a non-zero header.shard_count
+  ///        differs from shard_count().
+  /// @throw IoError if HDF5, fsync or the rename fails (the temporary file is then removed
+  ///        by the destructor).
+  std::uint64_t commit(const IndexHeader& header);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace tetrapage

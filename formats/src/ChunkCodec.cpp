@@ -1,0 +1,119 @@
+#include "ChunkCodec.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage::detail {
+
+namespace {
+
+std::uint32_t fold(std::uint32_t sum) { return (sum & 0xffffu) + (sum >> 16); }
+
+void store_le32(std::byte* out, std::uint32_t value) {
+  for (int i = 0; i < 4; ++i) out[i] = std::byte((value >> (8 * i)) & 0xffu);
+}
+
+std::uint32_t load_le32(const std::byte* in) {
+  std::uint32_t value = 0;
+  for (int i = 0; i < 4; ++i) value |= std::uint32_t(in[i]) << (8 * i);
+  return value;
+}
+
+}  // namespace
+
+std::uint32_t fletcher32(std::span<const std::byte> data) {
+  // uint32_t on purpose: the sums wrap exactly as HDF5's do, so even pathological inputs
+  // give HDF5's value.
+  std::uint32_t sum1 = 0;
+  std::uint32_t sum2 = 0;
+  const std::byte* word = data.data();
+  std::size_t words_left = data.size() / 2;
+  while (words_left > 0) {
+    const std::size_t block = std::min<std::size_t>(words_left, 360);
+    words_left -= block;
+    for (std::size_t i = 0; i < block; ++i, word += 2) {
+      sum1 += (std::uint32_t(word[0]) << 8) | std::uint32_t(word[1]);
+      sum2 += sum1;
+    }
+    sum1 = fold(sum1);
+    sum2 = fold(sum2);
+  }
+  if (data.size() % 2 != 0) {
+    sum1 += std::uint32_t(*word) << 8;
+    sum2 += sum1;
+    sum1 = fold(sum1);
+    sum2 = fold(sum2);
+  }
+  sum1 = fold(sum1);
+  sum2 = fold(sum2);
+  return (sum2 << 16) | sum1;
+}
+
+void encode_chunk(std::span<const std::byte> chunk, int level, EncodedChunk& out) {
+  uLongf compressed_bytes = compressBound(static_cast<uLong>(chunk.size()));
+  out.bytes.resize(std::max<std::size_t>(compressed_bytes, chunk.size()) + kChecksumBytes);
+  const int status = compress2(reinterpret_cast<Bytef*>(out.bytes.data()), &compressed_bytes,
+                               reinterpret_cast<const Bytef*>(chunk.data()),
+                               static_cast<uLong>(chunk.size()), level);
+  if (status != Z_OK)
+    throw InputError("zlib cannot deflate a chunk at level " + std::to_string(level) +
+                     " (zlib status " + std::to_string(status) + ")");
+  std::size_t filtered_bytes = compressed_bytes;
+  out.filter_mask = 0;
+  if (compressed_bytes >= chunk.size()) {
+    // Deflate is optional in the pipeline: HDF5 readers honour the mask bit.
+    std::memcpy(out.bytes.data(), chunk.data(), chunk.size());
+    filtered_bytes = chunk.size();
+    out.filter_mask = kDeflateSkipped;
+  }
+  const std::uint32_t checksum = fletcher32({out.bytes.data(), filtered_bytes});
+  store_le32(out.bytes.data() + filtered_bytes, checksum);
+  out.bytes.resize(filtered_bytes + kChecksumBytes);
+}
+
+std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter_mask,
+                         std::span<std::byte> out) {
+  if ((filter_mask & kChecksumSkipped) != 0)
+    return "stored without its Fletcher-32 checksum (filter mask " +
+           std::to_string(filter_mask) + ")";
+  if (stored.size() < kChecksumBytes)
+    return "stored chunk of " + std::to_string(stored.size()) +
+           " bytes is too short to hold a checksum";
+  const auto filtered = stored.first(stored.size() - kChecksumBytes);
+  const std::uint32_t expected = load_le32(stored.data() + filtered.size());
+  const std::uint32_t actual = fletcher32(filtered);
+  if (expected != actual) {
+    char text[64];
+    std::snprintf(text, sizeof text, "Fletcher-32 mismatch (stored %08x, computed %08x)",
+                  expected, actual);
+    return text;
+  }
+  if ((filter_mask & kDeflateSkipped) != 0) {
+    if (filtered.size() != out.size())
+      return "uncompressed chunk holds " + std::to_string(filtered.size()) + " bytes, expected " +
+             std::to_string(out.size());
+    std::memcpy(out.data(), filtered.data(), out.size());
+    return {};
+  }
+  uLongf inflated_bytes = static_cast<uLongf>(out.size());
+  const int status = uncompress(reinterpret_cast<Bytef*>(out.data()), &inflated_bytes,
+                                reinterpret_cast<const Bytef*>(filtered.data()),
+                                static_cast<uLong>(filtered.size()));
+  if (status == Z_BUF_ERROR)
+    return "chunk inflates to more than " + std::to_string(out.size()) +
+           " bytes, or its zlib stream is incomplete";
+  if (status != Z_OK)
+    return std::string("zlib cannot inflate the chunk (") +
+           (status == Z_DATA_ERROR ? "corrupt data" : "status " + std::to_string(status)) + ")";
+  if (inflated_bytes != out.size())
+    return "chunk inflates to " + std::to_string(inflated_bytes) + " bytes, expected " +
+           std::to_string(out.size());
+  return {};
+}
+
+}  // namespace tetrapage::detail

@@ -1,0 +1,65 @@
+#pragma once
+// Internal: RAII for HDF5 identifiers and the translation of HDF5's error stack into
+// tetrapage exceptions. Nothing here appears in a public header.
+
+#include <hdf5.h>
+
+#include <string>
+#include <utility>
+
+namespace tetrapage::detail {
+
+/// Turns off HDF5's automatic printing of its error stack for the calling thread. HDF5's
+/// thread-safe build keeps one error stack per thread, so every entry point that calls HDF5
+/// must call this first (it is cheap after the first call on a thread).
+void silence_hdf5_errors();
+
+/// The innermost message of the calling thread's HDF5 error stack ("" when empty), then
+/// clears the stack.
+std::string take_hdf5_error();
+
+/// An owned HDF5 identifier closed by `Close` (H5Fclose, H5Dclose, ...).
+template <herr_t (*Close)(hid_t)>
+class Hdf5Handle {
+ public:
+  Hdf5Handle() = default;
+  explicit Hdf5Handle(hid_t id) : id_(id) {}
+  ~Hdf5Handle() { reset(); }
+  Hdf5Handle(Hdf5Handle&& other) noexcept : id_(std::exchange(other.id_, H5I_INVALID_HID)) {}
+  Hdf5Handle& operator=(Hdf5Handle&& other) noexcept {
+    if (this != &other) {
+      reset();
+      id_ = std::exchange(other.id_, H5I_INVALID_HID);
+    }
+    return *this;
+  }
+  Hdf5Handle(const Hdf5Handle&) = delete;
+  Hdf5Handle& operator=(const Hdf5Handle&) = delete;
+
+  hid_t get() const { return id_; }
+  bool valid() const { return id_ >= 0; }
+  explicit operator bool() const { return valid(); }
+
+  /// Closes now and reports whether HDF5 succeeded (destruction ignores the result).
+  bool close() {
+    if (!valid()) return true;
+    const herr_t status = Close(std::exchange(id_, H5I_INVALID_HID));
+    return status >= 0;
+  }
+  void reset() {
+    if (valid()) Close(std::exchange(id_, H5I_INVALID_HID));
+  }
+
+ private:
+  hid_t id_ = H5I_INVALID_HID;
+};
+
+using FileHandle = Hdf5Handle<H5Fclose>;
+using GroupHandle = Hdf5Handle<H5Gclose>;
+using DatasetHandle = Hdf5Handle<H5Dclose>;
+using DataspaceHandle = Hdf5Handle<H5Sclose>;
+using DatatypeHandle = Hdf5Handle<H5Tclose>;
+using AttributeHandle = Hdf5Handle<H5Aclose>;
+using PropertyListHandle = Hdf5Handle<H5Pclose>;
+
+}  // namespace tetrapage::detail

@@ -1,0 +1,516 @@
+// The HDF5 index: round trips of mesh, tables and shards (both read paths, several threads),
+// the temporary-file protocol, and files that are missing, foreign, of another version,
+// truncated or corrupted. The chunk codec is checked against HDF5's own filters.
+
+#include <hdf5.h>
+
+#include <thread>
+
+#include "ChunkCodec.h"
+#include "TestSupport.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/IndexWriter.h"
+
+namespace tetrapage {
+namespace {
+
+using test::expect_error;
+using test::scratch_folder;
+
+std::vector<std::byte> random_bytes(Random& random, std::size_t size, bool compressible) {
+  std::vector<std::byte> bytes(size);
+  for (std::size_t i = 0; i < size; ++i)
+    bytes[i] = std::byte(compressible ? (random.below(16) == 0 ? random.below(256) : (i / 7) % 5)
+                                      : random.below(256));
+  return bytes;
+}
+
+TetMesh random_mesh(Random& random, std::size_t vertices, std::size_t tets) {
+  TetMesh mesh;
+  for (std::size_t v = 0; v < vertices; ++v)
+    mesh.vertices.push_back({random.uniform(-1e9, 1e9), random.uniform(-1, 1), random.normal()});
+  for (std::size_t t = 0; t < tets; ++t) {
+    std::array<std::uint32_t, 4> corners{}, neighbours{};
+    for (int i = 0; i < 4; ++i) {
+      corners[i] = static_cast<std::uint32_t>(random.below(vertices));
+      neighbours[i] = random.below(5) == 0 ? TetMesh::no_neighbour
+                                           : static_cast<std::uint32_t>(random.below(tets));
+    }
+    mesh.tets.push_back(corners);
+    mesh.neighbours.push_back(neighbours);
+  }
+  return mesh;
+}
+
+IndexHeader sample_header() {
+  IndexHeader header;
+  header.precision = "float";
+  header.input_triangles = 123456789012ULL;
+  header.stored_triangles = 234567890123ULL;
+  header.region_count = 77;
+  header.max_rounding_distance = 1.5e-7;
+  header.bounds.extend(Vec3{-1.25, 2.5, -3e9});
+  header.bounds.extend(Vec3{4.0, 5e-9, 6.0});
+  header.source = "scene.glb sha256:0123abcd é";
+  // Larger than HDF5's 64 KiB limit for compact attributes.
+  header.build_report_json = "{\"pad\":\"" + std::string(200000, 'x') + "\"}";
+  return header;
+}
+
+constexpr std::uint32_t kChunk = 4096;
+
+/// Payload sizes covering the edges: empty, one byte, exactly a chunk, one past, several.
+std::vector<std::size_t> edge_sizes() {
+  return {0, 1, kChunk, kChunk + 1, 3 * kChunk + 17, 2 * kChunk, 0, 100, 5 * kChunk - 1};
+}
+
+struct WrittenIndex {
+  std::filesystem::path path;
+  TetMesh mesh;
+  std::vector<std::vector<std::byte>> shards;
+  std::vector<std::uint32_t> tet_shard;
+  std::vector<std::uint8_t> shard_kind;
+  std::vector<std::uint64_t> ids;
+  std::vector<double> weights;
+  std::uint64_t file_bytes = 0;
+};
+
+WrittenIndex write_sample(const std::filesystem::path& folder, std::uint64_t seed) {
+  WrittenIndex written;
+  written.path = folder / "model.tpi";
+  Random random(seed);
+  written.mesh = random_mesh(random, 50, 120);
+  for (std::size_t size : edge_sizes()) written.shards.push_back(random_bytes(random, size, true));
+  written.shards.push_back(random_bytes(random, 2 * kChunk + 5, false));  // incompressible
+  for (std::size_t t = 0; t < written.mesh.tet_count(); ++t)
+    written.tet_shard.push_back(static_cast<std::uint32_t>(random.below(written.shards.size())));
+  for (std::size_t s = 0; s < written.shards.size(); ++s)
+    written.shard_kind.push_back(static_cast<std::uint8_t>(s % 2));
+  for (int i = 0; i < 70000; ++i) written.ids.push_back(random.next_u64());
+  for (int i = 0; i < 33; ++i) written.weights.push_back(random.normal());
+
+  IndexWriter writer(written.path, {.chunk_bytes = kChunk, .deflate_level = 4});
+  writer.write_mesh(written.mesh);
+  writer.write_table("tet_shard", std::span<const std::uint32_t>(written.tet_shard));
+  writer.write_table("shard_kind", std::span<const std::uint8_t>(written.shard_kind));
+  writer.write_table("ids", std::span<const std::uint64_t>(written.ids));
+  writer.write_table("weights", std::span<const double>(written.weights));
+  writer.write_table("empty", std::span<const double>());
+  for (std::size_t s = 0; s < written.shards.size(); ++s)
+    EXPECT_EQ(writer.append_shard(written.shards[s]), s);
+  written.file_bytes = writer.commit(sample_header());
+  return written;
+}
+
+TEST(IndexFile, RoundTripOfMeshTablesAndShards) {
+  const std::uint64_t seed = 20240511;
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const auto folder = scratch_folder("round_trip");
+  const WrittenIndex written = write_sample(folder, seed);
+  EXPECT_EQ(test::folder_listing(folder), std::vector<std::string>{"model.tpi"});
+  EXPECT_EQ(written.file_bytes, std::filesystem::file_size(written.path));
+
+  const IndexReader reader(written.path);
+  const IndexHeader expected = sample_header();
+  const IndexHeader& header = reader.header();
+  EXPECT_EQ(header.version, kIndexVersion);
+  EXPECT_EQ(header.precision, expected.precision);
+  EXPECT_EQ(header.input_triangles, expected.input_triangles);
+  EXPECT_EQ(header.stored_triangles, expected.stored_triangles);
+  EXPECT_EQ(header.region_count, expected.region_count);
+  EXPECT_EQ(header.shard_count, written.shards.size());
+  EXPECT_EQ(header.max_rounding_distance, expected.max_rounding_distance);
+  EXPECT_EQ(header.bounds.lo, expected.bounds.lo);
+  EXPECT_EQ(header.bounds.hi, expected.bounds.hi);
+  EXPECT_EQ(header.source, expected.source);
+  EXPECT_EQ(header.build_report_json, expected.build_report_json);
+  EXPECT_NE(header.created_by.find("tetrapage"), std::string::npos);
+  EXPECT_EQ(reader.file_bytes(), written.file_bytes);
+
+  const TetMesh mesh = reader.read_mesh();
+  EXPECT_EQ(mesh.vertices, written.mesh.vertices);
+  EXPECT_EQ(mesh.tets, written.mesh.tets);
+  EXPECT_EQ(mesh.neighbours, written.mesh.neighbours);
+
+  EXPECT_EQ(reader.table_names(),
+            (std::vector<std::string>{"empty", "ids", "shard_kind", "tet_shard", "weights"}));
+  EXPECT_TRUE(reader.has_table("tet_shard"));
+  EXPECT_FALSE(reader.has_table("nothing"));
+  EXPECT_EQ(reader.read_table_uint32("tet_shard"), written.tet_shard);
+  EXPECT_EQ(reader.read_table_uint8("shard_kind"), written.shard_kind);
+  EXPECT_EQ(reader.read_table_uint64("ids"), written.ids);
+  EXPECT_EQ(reader.read_table_double("weights"), written.weights);
+  EXPECT_TRUE(reader.read_table_double("empty").empty());
+  expect_error<FormatError>([&] { reader.read_table_double("tet_shard"); },
+                            {"model.tpi", "/tables/tet_shard", "uint32", "float64"});
+  expect_error<FormatError>([&] { reader.read_table_uint8("nothing"); },
+                            {"model.tpi", "/tables/nothing", "missing"});
+
+  ASSERT_EQ(reader.shard_count(), written.shards.size());
+  EXPECT_EQ(reader.chunk_bytes(), kChunk);
+  std::uint64_t expected_offset = 0;
+  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    SCOPED_TRACE("shard " + std::to_string(s));
+    const auto& payload = written.shards[s];
+    EXPECT_EQ(reader.shard_size(s), payload.size());
+    EXPECT_EQ(reader.read_shard(s), payload);
+    EXPECT_EQ(reader.read_shard_through_hdf5(s), payload);
+    const auto chunks = reader.shard_chunks(s);
+    ASSERT_EQ(chunks.size(), (payload.size() + kChunk - 1) / kChunk);
+    std::uint64_t stored = 0;
+    for (std::size_t k = 0; k < chunks.size(); ++k) {
+      EXPECT_EQ(chunks[k].chunk, expected_offset / kChunk + k);  // shards are consecutive runs
+      stored += chunks[k].stored_bytes;
+    }
+    EXPECT_EQ(reader.stored_shard_size(s), stored);
+    expected_offset += chunks.size() * kChunk;
+  }
+  // The incompressible shard's full chunks are stored with deflate skipped; its last chunk,
+  // mostly zero padding, and the other shards are compressed.
+  const auto mixed = reader.shard_chunks(reader.shard_count() - 1);
+  ASSERT_EQ(mixed.size(), 3u);
+  EXPECT_FALSE(mixed[0].compressed);
+  EXPECT_FALSE(mixed[1].compressed);
+  EXPECT_TRUE(mixed[2].compressed);
+  for (const auto& chunk : reader.shard_chunks(4)) EXPECT_TRUE(chunk.compressed);
+  expect_error<InputError>([&] { reader.read_shard(reader.shard_count()); }, {"shard"});
+  EXPECT_EQ(reader.validate(), std::vector<std::string>{});
+}
+
+TEST(IndexFile, ShardsReadConcurrentlyFromSeveralThreads) {
+  const std::uint64_t seed = 77;
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const auto folder = scratch_folder("threads");
+  const WrittenIndex written = write_sample(folder, seed);
+  const IndexReader reader(written.path);
+  for (int threads : {2, 4}) {
+    std::vector<int> mismatches(static_cast<std::size_t>(threads), 0);
+    std::vector<std::thread> workers;
+    for (int w = 0; w < threads; ++w)
+      workers.emplace_back([&, w] {
+        for (int round = 0; round < 20; ++round)
+          for (std::uint32_t i = 0; i < reader.shard_count(); ++i) {
+            // Different threads walk the shards in different orders.
+            const auto s = static_cast<std::uint32_t>((i * (2 * w + 1) + round) %
+                                                      reader.shard_count());
+            const bool through_hdf5 = (round + w) % 2 == 1;
+            const auto payload =
+                through_hdf5 ? reader.read_shard_through_hdf5(s) : reader.read_shard(s);
+            if (payload != written.shards[s]) ++mismatches[static_cast<std::size_t>(w)];
+          }
+      });
+    for (auto& worker : workers) worker.join();
+    for (int w = 0; w < threads; ++w)
+      EXPECT_EQ(mismatches[static_cast<std::size_t>(w)], 0) << threads << " threads, thread " << w;
+  }
+}
+
+TEST(IndexFile, WriterWithoutCommitLeavesNothing) {
+  const auto folder = scratch_folder("no_commit");
+  const auto target = folder / "model.tpi";
+  std::filesystem::path temporary;
+  {
+    IndexWriter writer(target, {.chunk_bytes = kChunk});
+    temporary = writer.temporary_path();
+    EXPECT_EQ(temporary.parent_path(), folder);
+    EXPECT_NE(temporary.filename().string().find("model.tpi.tmp-"), std::string::npos);
+    std::vector<std::byte> payload(3 * kChunk, std::byte{7});
+    writer.append_shard(payload);
+    EXPECT_TRUE(std::filesystem::exists(temporary));
+    EXPECT_FALSE(std::filesystem::exists(target));
+  }
+  EXPECT_FALSE(std::filesystem::exists(temporary));
+  EXPECT_FALSE(std::filesystem::exists(target));
+  EXPECT_TRUE(test::folder_listing(folder).empty());
+
+  // The same when an exception unwinds the writer.
+  try {
+    IndexWriter writer(target);
+    temporary = writer.temporary_path();
+    throw InputError("interrupted");
+  } catch (const InputError&) {
+  }
+  EXPECT_TRUE(test::folder_listing(folder).empty());
+}
+
+TEST(IndexFile, WriterRejectsBadInput) {
+  const auto folder = scratch_folder("bad_input");
+  expect_error<InputError>([&] { IndexWriter(folder / "a.tpi", {.chunk_bytes = 10}); },
+                           {"a.tpi", "chunk size 10"});
+  expect_error<InputError>([&] { IndexWriter(folder / "a.tpi", {.deflate_level = 11}); },
+                           {"a.tpi", "deflate level 11"});
+  expect_error<IoError>([&] { IndexWriter(folder / "missing_folder" / "a.tpi"); },
+                        {"a.tpi", "cannot create"});
+
+  IndexWriter writer(folder / "a.tpi");
+  const std::vector<std::uint32_t> values{1, 2, 3};
+  expect_error<InputError>([&] { writer.write_table("a/b", std::span(values)); }, {"a/b"});
+  expect_error<InputError>([&] { writer.write_table("", std::span(values)); }, {"table name"});
+  writer.write_table("t", std::span(values));
+  expect_error<InputError>([&] { writer.write_table("t", std::span(values)); },
+                           {"'t'", "twice"});
+  TetMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  mesh.tets = {{0, 1, 2, 4}};
+  mesh.neighbours = {{TetMesh::no_neighbour, TetMesh::no_neighbour, TetMesh::no_neighbour,
+                      TetMesh::no_neighbour}};
+  expect_error<InputError>([&] { writer.write_mesh(mesh); }, {"tet 0", "corner 3", "vertex 4"});
+  mesh.tets = {{0, 1, 2, 3}};
+  mesh.neighbours[0][2] = 1;
+  expect_error<InputError>([&] { writer.write_mesh(mesh); }, {"tet 0", "neighbour 2", "tet 1"});
+  IndexHeader header;
+  header.shard_count = 3;
+  expect_error<InputError>([&] { writer.commit(header); }, {"3 shards", "0 were appended"});
+  header.shard_count = 0;
+  header.precision = "half";
+  expect_error<InputError>([&] { writer.commit(header); }, {"'half'"});
+  header.precision = "double";
+  EXPECT_GT(writer.commit(header), 0u);
+  expect_error<InputError>([&] { writer.commit(header); }, {"already committed"});
+  expect_error<InputError>([&] { writer.append_shard({}); }, {"already committed"});
+
+  // Nothing but a header: a valid, empty index.
+  const IndexReader reader(folder / "a.tpi");
+  EXPECT_EQ(reader.shard_count(), 0u);
+  EXPECT_EQ(reader.read_mesh().tet_count(), 0u);
+  EXPECT_EQ(reader.read_table_uint32("t"), values);
+  EXPECT_EQ(reader.validate(), std::vector<std::string>{});
+}
+
+// ---- the chunk codec against HDF5's own filters -----------------------------------------
+
+/// Writes `data` as one chunk through HDF5's pipeline and returns the stored chunk.
+std::vector<std::byte> stored_by_hdf5(const std::filesystem::path& path,
+                                      const std::vector<std::byte>& data, bool deflate,
+                                      std::uint32_t& filter_mask) {
+  const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  const hsize_t size = data.size();
+  const hid_t space = H5Screate_simple(1, &size, nullptr);
+  const hid_t creation = H5Pcreate(H5P_DATASET_CREATE);
+  H5Pset_chunk(creation, 1, &size);
+  if (deflate) H5Pset_deflate(creation, 6);
+  H5Pset_fletcher32(creation);
+  const hid_t dataset =
+      H5Dcreate2(file, "d", H5T_STD_U8LE, space, H5P_DEFAULT, creation, H5P_DEFAULT);
+  EXPECT_GE(H5Dwrite(dataset, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), 0);
+  hsize_t origin = 0, stored_bytes = 0;
+  EXPECT_GE(H5Dget_chunk_storage_size(dataset, &origin, &stored_bytes), 0);
+  std::vector<std::byte> stored(stored_bytes);
+  EXPECT_GE(H5Dread_chunk(dataset, H5P_DEFAULT, &origin, &filter_mask, stored.data()), 0);
+  H5Dclose(dataset);
+  H5Pclose(creation);
+  H5Sclose(space);
+  H5Fclose(file);
+  return stored;
+}
+
+TEST(IndexFile, ChunkCodecAgreesWithHdf5Filters) {
+  const std::uint64_t seed = 4242;
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const auto folder = scratch_folder("codec");
+  Random random(seed);
+  for (std::size_t size : {1, 2, 3, 719, 720, 721, 1441, 4096, 65535, 100001}) {
+    for (bool compressible : {false, true}) {
+      SCOPED_TRACE("size " + std::to_string(size) + (compressible ? " compressible" : ""));
+      const auto data = random_bytes(random, size, compressible);
+      // Fletcher-32 only: the stored chunk is the data and HDF5's checksum.
+      std::uint32_t mask = 0;
+      const auto plain = stored_by_hdf5(folder / "plain.h5", data, false, mask);
+      ASSERT_EQ(plain.size(), size + 4);
+      std::uint32_t stored_checksum = 0;
+      for (int i = 0; i < 4; ++i) stored_checksum |= std::uint32_t(plain[size + i]) << (8 * i);
+      EXPECT_EQ(detail::fletcher32(std::span(plain).first(size)), stored_checksum);
+
+      // Deflate then Fletcher-32, as /shards/data: our decoder recovers HDF5's chunk.
+      const auto deflated = stored_by_hdf5(folder / "deflated.h5", data, true, mask);
+      std::vector<std::byte> decoded(size);
+      EXPECT_EQ(detail::decode_chunk(deflated, mask, decoded), "");
+      EXPECT_EQ(decoded, data);
+
+      // And a chunk we encode decodes back (HDF5 reading our chunks is the round-trip test).
+      detail::EncodedChunk encoded;
+      detail::encode_chunk(data, 4, encoded);
+      EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, decoded), "");
+      EXPECT_EQ(decoded, data);
+      // Any single flipped byte is caught.
+      auto corrupted = encoded.bytes;
+      corrupted[random.below(corrupted.size())] ^= std::byte{0x20};
+      EXPECT_NE(detail::decode_chunk(corrupted, encoded.filter_mask, decoded), "");
+    }
+  }
+}
+
+// ---- broken files -------------------------------------------------------------------------
+
+void set_root_attribute(const std::filesystem::path& path, const char* name,
+                        const std::function<void(hid_t root)>& create) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
+  if (H5Aexists(root, name) > 0) H5Adelete(root, name);
+  create(root);
+  H5Gclose(root);
+  H5Fclose(file);
+}
+
+TEST(IndexFile, MissingForeignAndWrongVersionFilesAreRejected) {
+  const auto folder = scratch_folder("rejected");
+  expect_error<IoError>([&] { IndexReader reader(folder / "absent.tpi"); },
+                        {"absent.tpi", "No such file"});
+  test::write_file(folder / "text.tpi", "solid cube\nendsolid cube\n");
+  expect_error<FormatError>([&] { IndexReader reader(folder / "text.tpi"); },
+                            {"text.tpi", "not an HDF5 file"});
+  test::write_file(folder / "empty.tpi", "");
+  expect_error<FormatError>([&] { IndexReader reader(folder / "empty.tpi"); },
+                            {"empty.tpi", "not an HDF5 file"});
+
+  // An HDF5 file that is not an index.
+  const auto foreign = folder / "foreign.h5";
+  H5Fclose(H5Fcreate(foreign.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+  expect_error<FormatError>([&] { IndexReader reader(foreign); },
+                            {"foreign.h5", "'format'", "not a tetrapage index"});
+
+  const auto write_string = [](hid_t root, const char* name, const char* value) {
+    const hid_t type = H5Tcopy(H5T_C_S1);
+    H5Tset_size(type, std::strlen(value));
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t attribute = H5Acreate2(root, name, type, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(attribute, type, value);
+    H5Aclose(attribute);
+    H5Sclose(space);
+    H5Tclose(type);
+  };
+  const WrittenIndex written = write_sample(folder, 5);
+  // A fixed-length string, as other tools write it, is read too.
+  set_root_attribute(written.path, "format",
+                     [&](hid_t root) { write_string(root, "format", "tetrapage-index"); });
+  EXPECT_EQ(IndexReader(written.path).read_shard(4), written.shards[4]);
+  set_root_attribute(written.path, "format",
+                     [&](hid_t root) { write_string(root, "format", "vdb-grid"); });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "'vdb-grid'", "tetrapage-index"});
+  set_root_attribute(written.path, "format",
+                     [&](hid_t root) { write_string(root, "format", "tetrapage-index"); });
+  set_root_attribute(written.path, "version", [](hid_t root) {
+    const std::uint32_t version = 2;
+    const hid_t space = H5Screate(H5S_SCALAR);
+    const hid_t attribute =
+        H5Acreate2(root, "version", H5T_STD_U32LE, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(attribute, H5T_NATIVE_UINT32, &version);
+    H5Aclose(attribute);
+    H5Sclose(space);
+  });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "version 2", "rebuild"});
+  set_root_attribute(written.path, "version", [&](hid_t root) {
+    write_string(root, "version", "1");
+  });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "'version'", "string"});
+}
+
+TEST(IndexFile, MissingOrMisshapedDatasetsAreRejected) {
+  const auto folder = scratch_folder("datasets");
+  const WrittenIndex written = write_sample(folder, 6);
+  const std::string original = test::read_file(written.path);
+  const auto edit = [&](const std::function<void(hid_t file)>& change) {
+    test::write_file(written.path, original);
+    const hid_t file = H5Fopen(written.path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    change(file);
+    H5Fclose(file);
+  };
+  edit([](hid_t file) { H5Ldelete(file, "/shards/sizes", H5P_DEFAULT); });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "'/shards/sizes' is missing"});
+  edit([](hid_t file) { H5Ldelete(file, "/mesh", H5P_DEFAULT); });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "'/mesh' is missing"});
+  edit([](hid_t file) {
+    H5Ldelete(file, "/mesh/tets", H5P_DEFAULT);
+    const std::array<hsize_t, 2> dims{2, 3};
+    const hid_t space = H5Screate_simple(2, dims.data(), nullptr);
+    H5Dclose(H5Dcreate2(file, "/mesh/tets", H5T_STD_U32LE, space, H5P_DEFAULT, H5P_DEFAULT,
+                        H5P_DEFAULT));
+    H5Sclose(space);
+  });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "'/mesh/tets'", "3 columns", "expected 4"});
+  // An extent past the end of /shards/data, and one off a chunk boundary.
+  for (std::uint64_t bad_offset : {std::uint64_t{1} << 40, std::uint64_t{kChunk / 2}}) {
+    edit([&](hid_t file) {
+      const hid_t dataset = H5Dopen2(file, "/shards/offsets", H5P_DEFAULT);
+      const hid_t space = H5Dget_space(dataset);
+      const hsize_t start = 3, count = 1;
+      H5Sselect_hyperslab(space, H5S_SELECT_SET, &start, nullptr, &count, nullptr);
+      const hid_t memory = H5Screate_simple(1, &count, nullptr);
+      H5Dwrite(dataset, H5T_NATIVE_UINT64, memory, space, H5P_DEFAULT, &bad_offset);
+      H5Sclose(memory);
+      H5Sclose(space);
+      H5Dclose(dataset);
+    });
+    expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                              {"model.tpi", "shard 3", std::to_string(bad_offset)});
+  }
+}
+
+TEST(IndexFile, TruncatedFilesThrowNeverCrash) {
+  const auto folder = scratch_folder("truncated");
+  const WrittenIndex written = write_sample(folder, 8);
+  const std::string whole = test::read_file(written.path);
+  const auto truncated = folder / "truncated.tpi";
+  for (std::size_t length : {std::size_t{0}, std::size_t{7}, std::size_t{100}, std::size_t{2048},
+                             whole.size() / 3, whole.size() / 2, whole.size() - 4096,
+                             whole.size() - 1}) {
+    SCOPED_TRACE("truncated to " + std::to_string(length) + " of " + std::to_string(whole.size()));
+    test::write_file(truncated, std::string_view(whole).substr(0, length));
+    expect_error<FormatError>([&] { IndexReader reader(truncated); }, {"truncated.tpi"});
+  }
+}
+
+TEST(IndexFile, FlippedByteInShardDataIsCaught) {
+  const auto folder = scratch_folder("flipped");
+  const WrittenIndex written = write_sample(folder, 9);
+  const std::uint32_t victim = 4;  // 3 chunks + 17 bytes
+  std::uint64_t offset = 0;
+  for (std::uint32_t s = 0; s < victim; ++s)
+    offset += (written.shards[s].size() + kChunk - 1) / kChunk * kChunk;
+  // Locate the shard's second chunk through HDF5 itself, not through the reader.
+  haddr_t address = HADDR_UNDEF;
+  hsize_t stored = 0;
+  {
+    const hid_t file = H5Fopen(written.path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+    const hid_t dataset = H5Dopen2(file, "/shards/data", H5P_DEFAULT);
+    hsize_t coordinate = offset + kChunk;
+    unsigned mask = 0;
+    ASSERT_GE(H5Dget_chunk_info_by_coord(dataset, &coordinate, &mask, &address, &stored), 0);
+    H5Dclose(dataset);
+    H5Fclose(file);
+  }
+  ASSERT_NE(address, HADDR_UNDEF);
+  {
+    const IndexReader reader(written.path);
+    const auto chunks = reader.shard_chunks(victim);
+    ASSERT_EQ(chunks.size(), 4u);
+    EXPECT_EQ(chunks[1].file_offset, address);
+    EXPECT_EQ(chunks[1].stored_bytes, stored);
+  }
+  std::string bytes = test::read_file(written.path);
+  bytes[address + stored / 2] ^= 0x01;
+  test::write_file(written.path, bytes);
+
+  const IndexReader reader(written.path);  // opening does not read shard data
+  expect_error<FormatError>([&] { reader.read_shard(victim); },
+                            {"model.tpi", "shard 4", "chunk 1 of 4", "Fletcher-32"});
+  expect_error<FormatError>([&] { reader.read_shard_through_hdf5(victim); },
+                            {"model.tpi", "shard 4"});
+  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    if (s == victim) continue;
+    EXPECT_EQ(reader.read_shard(s), written.shards[s]) << "shard " << s;
+  }
+  const auto problems = reader.validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_NE(problems[0].find("shard 4, chunk 1 of 4"), std::string::npos) << problems[0];
+}
+
+}  // namespace
+}  // namespace tetrapage
