@@ -1,0 +1,543 @@
+#include "tetrapage/preprocess/ShardBuilder.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <string>
+#include <unordered_map>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/geometry/TriangleBox.h"
+
+namespace tetrapage {
+namespace {
+
+using geometry::Box;
+using geometry::Point;
+using geometry::Triangle;
+
+/// 2^ceil(log2(x)) for x > 0.
+double power_of_two_above(double x) {
+  int e = std::ilogb(x);
+  if (std::ldexp(1.0, e) < x) ++e;
+  return std::ldexp(1.0, e);
+}
+
+/// Where the stored vertices are relative to, and the fixed-point step of float coordinates.
+struct Frame {
+  Point origin{};
+  double step = 0;  ///< float32: relative coordinates are multiples of step; float64: unused
+};
+
+// float32: relative coordinates are integers q (|q| < 2^24, exact in float) times a power of
+// two `step`, and the origin is a multiple of step, so origin + q * step is an integer times
+// step below 2^53 * step: exact in double. The step is the finer of the float's resolution
+// over the region and the double's resolution at the region's magnitude.
+Frame float_frame(const Box& box) {
+  double half_extent = 0, magnitude = 0;
+  for (int k = 0; k < 3; ++k) {
+    half_extent = std::max(half_extent, 0.5 * (box.hi[k] - box.lo[k]));
+    magnitude = std::max({magnitude, std::fabs(box.lo[k]), std::fabs(box.hi[k])});
+  }
+  const double grid = half_extent > 0 ? power_of_two_above(half_extent) : 0;
+  double step = std::max({std::ldexp(grid, -23),
+                          magnitude > 0 ? std::ldexp(power_of_two_above(magnitude), -51) : 0.0,
+                          std::ldexp(1.0, -120)});
+  if (step > std::ldexp(1.0, 100))
+    throw InputError("shard region of half extent " + std::to_string(half_extent) +
+                     " at magnitude " + std::to_string(magnitude) +
+                     " is beyond float32's range; store it as float64");
+  const double spacing = std::max(grid, step);  // a power of two, a multiple of step
+  Frame frame;
+  frame.step = step;
+  const Point centre = box.center();
+  for (int k = 0; k < 3; ++k) frame.origin[k] = std::nearbyint(centre[k] / spacing) * spacing;
+  return frame;
+}
+
+// float64: an origin on a coarse power-of-two grid near the centre, kept only if every vertex
+// survives the trip origin + (v - origin) unchanged; else the origin 0, which always does.
+Frame double_frame(const Box& box, std::span<const Triangle> triangles) {
+  double half_extent = 0;
+  for (int k = 0; k < 3; ++k) half_extent = std::max(half_extent, 0.5 * (box.hi[k] - box.lo[k]));
+  Frame frame;
+  if (half_extent == 0) return frame;
+  const double spacing = power_of_two_above(half_extent);
+  const Point centre = box.center();
+  for (int k = 0; k < 3; ++k) frame.origin[k] = std::nearbyint(centre[k] / spacing) * spacing;
+  for (const Triangle& t : triangles)
+    for (const Point& v : t)
+      for (int k = 0; k < 3; ++k)
+        if (frame.origin[k] + (v[k] - frame.origin[k]) != v[k]) return Frame{};
+  return frame;
+}
+
+struct VertexKey {
+  std::array<std::uint64_t, 3> bits;
+  bool operator==(const VertexKey&) const = default;
+};
+struct VertexKeyHash {
+  std::size_t operator()(const VertexKey& key) const {
+    std::uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (const std::uint64_t b : key.bits) h = (h ^ b) * 0xbf58476d1ce4e5b9ull + (h >> 29);
+    return std::size_t(h ^ (h >> 31));
+  }
+};
+
+/// The triangles as stored: relative coordinates (exactly representable in the stored type),
+/// deduplicated vertices, and the absolute stored triangles.
+struct StoredGeometry {
+  Frame frame;
+  std::vector<Point> relative;                      ///< per distinct vertex, first-seen order
+  std::vector<std::array<std::uint32_t, 3>> corners;  ///< per triangle
+  std::vector<Triangle> triangles;                  ///< absolute stored coordinates
+  double max_rounding_distance = 0;
+};
+
+StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision) {
+  Box box;
+  for (const Triangle& t : input)
+    for (const Point& v : t) box.extend(v);
+  StoredGeometry g;
+  g.frame = precision == StoredPrecision::float32 ? float_frame(box) : double_frame(box, input);
+  const Point& o = g.frame.origin;
+  std::unordered_map<VertexKey, std::uint32_t, VertexKeyHash> index;
+  index.reserve(input.size() * 2);
+  g.corners.resize(input.size());
+  g.triangles.resize(input.size());
+  for (std::size_t t = 0; t < input.size(); ++t)
+    for (int c = 0; c < 3; ++c) {
+      const Point& v = input[t][c];
+      Point r;
+      for (int k = 0; k < 3; ++k) {
+        r[k] = v[k] - o[k];
+        if (precision == StoredPrecision::float32)
+          r[k] = double(float(std::nearbyint(r[k] / g.frame.step) * g.frame.step));
+        r[k] += 0.0;  // one key for 0 and -0
+      }
+      Point stored;
+      double squared = 0;
+      for (int k = 0; k < 3; ++k) {
+        stored[k] = o[k] + r[k];
+        squared += (stored[k] - v[k]) * (stored[k] - v[k]);
+      }
+      g.max_rounding_distance = std::max(g.max_rounding_distance, std::sqrt(squared));
+      g.triangles[t][c] = stored;
+      const VertexKey key{{std::bit_cast<std::uint64_t>(r[0]), std::bit_cast<std::uint64_t>(r[1]),
+                           std::bit_cast<std::uint64_t>(r[2])}};
+      const auto [it, inserted] = index.try_emplace(key, std::uint32_t(g.relative.size()));
+      if (inserted) g.relative.push_back(r);
+      g.corners[t][c] = it->second;
+    }
+  return g;
+}
+
+// ---------------------------------------------------------------------------------------
+// Grid
+
+std::array<std::uint32_t, 3> grid_cells_for(const Box& bounds, std::size_t triangles,
+                                           double cells_per_triangle) {
+  const double target = std::max(1.0, cells_per_triangle * double(triangles));
+  const Point size = bounds.size();
+  std::array<bool, 3> active{};
+  for (int k = 0; k < 3; ++k) active[k] = size[k] > 0;
+  double side = 0;
+  for (bool changed = true; changed;) {  // drop the axes thinner than a cell
+    changed = false;
+    int dimensions = 0;
+    double measure = 1;
+    for (int k = 0; k < 3; ++k)
+      if (active[k]) {
+        ++dimensions;
+        measure *= size[k];
+      }
+    if (dimensions == 0) return {1, 1, 1};
+    side = std::pow(measure / target, 1.0 / dimensions);
+    for (int k = 0; k < 3; ++k)
+      if (active[k] && size[k] < side) {
+        active[k] = false;
+        changed = true;
+      }
+  }
+  std::array<std::uint32_t, 3> cells{1, 1, 1};
+  for (int k = 0; k < 3; ++k)
+    if (active[k]) cells[k] = std::uint32_t(std::clamp(std::round(size[k] / side), 1.0, 65536.0));
+  return cells;
+}
+
+struct GridShape {
+  std::array<std::uint32_t, 3> cells{};
+  Point lo{}, cell_size{};
+};
+
+GridShape grid_shape(const Box& bounds, std::array<std::uint32_t, 3> cells) {
+  GridShape shape;
+  shape.cells = cells;
+  shape.lo = bounds.lo;
+  for (int k = 0; k < 3; ++k) {
+    const double extent = bounds.hi[k] - bounds.lo[k];
+    double h = extent > 0 ? extent / cells[k]
+                          : std::max(std::fabs(bounds.lo[k]) * 0x1p-40, 0x1p-900);
+    // Grow the cell until the last boundary, rounded as queries round it, holds every vertex.
+    for (int i = 0; shard_format::grid_boundary(shape.lo[k], h, cells[k]) < bounds.hi[k]; ++i) {
+      if (i > 200) throw std::logic_error("grid extent does not converge");
+      h = h * (1 + 0x1p-30) + std::numeric_limits<double>::denorm_min();
+    }
+    shape.cell_size[k] = h;
+  }
+  return shape;
+}
+
+struct GridIndex {
+  GridShape shape;
+  std::vector<std::uint32_t> cell_offsets;
+  std::vector<std::uint32_t> references;
+};
+
+GridIndex build_grid(const std::vector<Triangle>& triangles, const Box& bounds,
+                     std::array<std::uint32_t, 3> cells) {
+  GridIndex grid;
+  grid.shape = grid_shape(bounds, cells);
+  const GridShape& s = grid.shape;
+  const std::uint64_t cell_count = std::uint64_t(cells[0]) * cells[1] * cells[2];
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;  // (cell, triangle)
+  pairs.reserve(triangles.size() * 2);
+  auto boundary = [&](int k, std::uint32_t i) {
+    return shard_format::grid_boundary(s.lo[k], s.cell_size[k], i);
+  };
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+    const Box box = geometry::box_of(triangles[t]);
+    std::array<std::uint32_t, 3> first{}, last{};
+    for (int k = 0; k < 3; ++k)
+      if (!shard_format::grid_cell_range(s.lo[k], s.cell_size[k], cells[k], box.lo[k],
+                                         box.hi[k], first[k], last[k]))
+        throw std::logic_error("a stored triangle lies outside its grid");
+    const bool single = first == last;
+    for (std::uint32_t z = first[2]; z <= last[2]; ++z)
+      for (std::uint32_t y = first[1]; y <= last[1]; ++y)
+        for (std::uint32_t x = first[0]; x <= last[0]; ++x) {
+          Box cell;
+          cell.lo = {boundary(0, x), boundary(1, y), boundary(2, z)};
+          cell.hi = {boundary(0, x + 1), boundary(1, y + 1), boundary(2, z + 1)};
+          if (single || geometry::triangle_intersects_box(triangles[t], cell))
+            pairs.emplace_back(std::uint32_t((std::uint64_t(z) * cells[1] + y) * cells[0] + x),
+                               t);
+        }
+  }
+  if (pairs.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw InputError("shard grid of " + std::to_string(cell_count) + " cells would hold " +
+                     std::to_string(pairs.size()) + " references, beyond 2^32");
+  grid.cell_offsets.assign(cell_count + 1, 0);
+  for (const auto& [cell, t] : pairs) ++grid.cell_offsets[cell + 1];
+  std::partial_sum(grid.cell_offsets.begin(), grid.cell_offsets.end(), grid.cell_offsets.begin());
+  grid.references.resize(pairs.size());
+  std::vector<std::uint32_t> fill(grid.cell_offsets.begin(), grid.cell_offsets.end() - 1);
+  for (const auto& [cell, t] : pairs) grid.references[fill[cell]++] = t;
+  return grid;
+}
+
+// ---------------------------------------------------------------------------------------
+// R-tree: bulk loaded top-down; a node's triangles are cut at medians along the longest side
+// of their centres into groups of full subtrees, so every leaf but the last of a parent is
+// full and triangles end up in tree order.
+
+struct RtreeNode {
+  Box box;  ///< relative coordinates (stored values)
+  std::uint32_t first = 0;
+  std::uint32_t count = 0;  ///< with kLeafFlag for a leaf
+};
+
+class RtreeBuilder {
+ public:
+  RtreeBuilder(const std::vector<Box>& relative_boxes, std::uint32_t leaf_size,
+               std::uint32_t fanout)
+      : boxes_(relative_boxes), leaf_size_(leaf_size), fanout_(fanout) {
+    order_.resize(boxes_.size());
+    std::iota(order_.begin(), order_.end(), 0u);
+    centres_.reserve(boxes_.size());
+    for (const Box& b : boxes_) centres_.push_back(b.center());
+  }
+
+  void build() {
+    const std::uint64_t n = order_.size();
+    std::uint32_t height = 0;
+    for (std::uint64_t capacity = leaf_size_; capacity < n; capacity *= fanout_) ++height;
+    nodes_.resize(1);
+    build_node(0, 0, std::uint32_t(n), height);
+  }
+
+  const std::vector<std::uint32_t>& order() const { return order_; }
+  std::vector<RtreeNode>& nodes() { return nodes_; }
+
+ private:
+  void build_node(std::uint32_t index, std::uint32_t begin, std::uint32_t end,
+                  std::uint32_t height) {
+    Box box;
+    if (height == 0) {
+      for (std::uint32_t i = begin; i < end; ++i) box.extend(boxes_[order_[i]]);
+      nodes_[index] = {box, begin, (end - begin) | shard_format::kLeafFlag};
+      return;
+    }
+    std::uint64_t capacity = leaf_size_;
+    for (std::uint32_t h = 1; h < height; ++h) capacity *= fanout_;
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> groups;
+    const auto count = std::uint32_t((end - begin + capacity - 1) / capacity);
+    split(begin, end, count, capacity, groups);
+    const auto first = std::uint32_t(nodes_.size());
+    nodes_.resize(nodes_.size() + groups.size());
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      build_node(first + std::uint32_t(g), groups[g].first, groups[g].second, height - 1);
+      box.extend(nodes_[first + g].box);
+    }
+    nodes_[index] = {box, first, std::uint32_t(groups.size())};
+  }
+
+  void split(std::uint32_t begin, std::uint32_t end, std::uint32_t groups, std::uint64_t capacity,
+             std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
+    if (groups == 1) {
+      out.emplace_back(begin, end);
+      return;
+    }
+    const std::uint32_t left = groups / 2;
+    const auto middle = std::uint32_t(begin + left * capacity);
+    Box spread;
+    for (std::uint32_t i = begin; i < end; ++i) spread.extend(centres_[order_[i]]);
+    const Point size = spread.size();
+    const int axis = size[0] >= size[1] ? (size[0] >= size[2] ? 0 : 2) : (size[1] >= size[2] ? 1 : 2);
+    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
+                     [&](std::uint32_t a, std::uint32_t b) {
+                       const double ca = centres_[a][axis], cb = centres_[b][axis];
+                       return ca < cb || (ca == cb && a < b);
+                     });
+    split(begin, middle, left, capacity, out);
+    split(middle, end, groups - left, capacity, out);
+  }
+
+  const std::vector<Box>& boxes_;
+  std::uint32_t leaf_size_, fanout_;
+  std::vector<std::uint32_t> order_;
+  std::vector<Point> centres_;
+  std::vector<RtreeNode> nodes_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Serialisation
+
+class PayloadWriter {
+ public:
+  explicit PayloadWriter(std::vector<std::byte>& out) : out_(out) {}
+  template <class T>
+  void put(std::size_t offset, T value) {
+    std::memcpy(out_.data() + offset, &value, sizeof(T));
+  }
+  template <class T>
+  void append(T value) {
+    const std::size_t at = out_.size();
+    out_.resize(at + sizeof(T));
+    put(at, value);
+  }
+  void align() { out_.resize((out_.size() + 7) & ~std::size_t(7)); }
+  std::size_t size() const { return out_.size(); }
+
+ private:
+  std::vector<std::byte>& out_;
+};
+
+void check_input(const ShardTriangles& region, const ShardLayout& layout) {
+  const std::size_t n = region.triangles.size();
+  if (n == 0) throw InputError("shard region has no triangles");
+  if (region.ids.size() != n || region.parts.size() != n)
+    throw InputError("shard region has " + std::to_string(n) + " triangles but " +
+                     std::to_string(region.ids.size()) + " ids and " +
+                     std::to_string(region.parts.size()) + " part ids");
+  if (n >= std::numeric_limits<std::uint32_t>::max())
+    throw InputError("shard region has " + std::to_string(n) + " triangles, beyond 2^32 - 1");
+  for (std::size_t t = 0; t < n; ++t)
+    if (!geometry::is_finite(region.triangles[t]))
+      throw InputError("shard region triangle " + std::to_string(t) + " (id " +
+                       std::to_string(region.ids[t]) + ") has a non-finite coordinate");
+  if (layout.rtree_fanout < 2 || layout.rtree_fanout > shard_format::kMaxFanout)
+    throw InputError("R-tree fanout " + std::to_string(layout.rtree_fanout) + " is not in 2.." +
+                     std::to_string(shard_format::kMaxFanout));
+  if (layout.rtree_leaf_size > 65536)
+    throw InputError("R-tree leaf size " + std::to_string(layout.rtree_leaf_size) +
+                     " is above 65536");
+  const auto& c = layout.grid_cells;
+  const bool chosen = c[0] == 0 && c[1] == 0 && c[2] == 0;
+  if (!chosen && (c[0] == 0 || c[1] == 0 || c[2] == 0 ||
+                  std::uint64_t(c[0]) * c[1] * c[2] > (std::uint64_t(1) << 26)))
+    throw InputError("grid cells " + std::to_string(c[0]) + "x" + std::to_string(c[1]) + "x" +
+                     std::to_string(c[2]) + " must all be positive, at most 2^26 in all");
+  if (chosen && !(layout.grid_cells_per_triangle > 0 && layout.grid_cells_per_triangle <= 64))
+    throw InputError("grid cells per triangle " + std::to_string(layout.grid_cells_per_triangle) +
+                     " is not in (0, 64]");
+}
+
+}  // namespace
+
+BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPrecision precision,
+                       const ShardLayout& layout) {
+  namespace sf = shard_format;
+  check_input(region, layout);
+  const auto n = std::uint32_t(region.triangles.size());
+  const StoredGeometry g = store(region.triangles, precision);
+  Box bounds;
+  for (const Triangle& t : g.triangles) bounds.extend(geometry::box_of(t));
+
+  BuiltShard built;
+  built.kind = kind;
+  built.precision = precision;
+  built.max_rounding_distance = g.max_rounding_distance;
+  built.origin = g.frame.origin;
+  built.triangle_count = n;
+
+  // Triangle order: the R-tree's, or the input's.
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::vector<RtreeNode> nodes;
+  GridIndex grid;
+  if (kind == ShardKind::rtree) {
+    std::vector<Box> boxes(n);
+    for (std::uint32_t t = 0; t < n; ++t)
+      for (const std::uint32_t v : g.corners[t]) boxes[t].extend(g.relative[v]);
+    const std::uint32_t leaf = layout.rtree_leaf_size == 0 ? 8 : layout.rtree_leaf_size;
+    RtreeBuilder tree(boxes, leaf, layout.rtree_fanout);
+    tree.build();
+    order = tree.order();
+    nodes = std::move(tree.nodes());
+    built.rtree_leaf_size = leaf;
+    built.rtree_nodes = std::uint32_t(nodes.size());
+  } else {
+    const auto& c = layout.grid_cells;
+    const std::array<std::uint32_t, 3> cells =
+        c[0] == 0 && c[1] == 0 && c[2] == 0
+            ? grid_cells_for(bounds, n, layout.grid_cells_per_triangle)
+            : c;
+    grid = build_grid(g.triangles, bounds, cells);
+    built.grid_cells = cells;
+    built.grid_references = grid.references.size();
+  }
+
+  // Vertices renumbered in order of first use, for locality.
+  std::vector<std::uint32_t> renumber(g.relative.size(), std::numeric_limits<std::uint32_t>::max());
+  std::vector<std::uint32_t> vertex_order;
+  vertex_order.reserve(g.relative.size());
+  for (const std::uint32_t t : order)
+    for (const std::uint32_t v : g.corners[t])
+      if (renumber[v] == std::numeric_limits<std::uint32_t>::max()) {
+        renumber[v] = std::uint32_t(vertex_order.size());
+        vertex_order.push_back(v);
+      }
+  const auto vertex_count = std::uint32_t(vertex_order.size());
+  built.vertex_count = vertex_count;
+
+  std::vector<std::uint32_t> palette(region.parts.begin(), region.parts.end());
+  std::sort(palette.begin(), palette.end());
+  palette.erase(std::unique(palette.begin(), palette.end()), palette.end());
+  const auto [id_min, id_max] = std::minmax_element(region.ids.begin(), region.ids.end());
+  const std::uint64_t id_base = *id_min;
+  const std::uint8_t id_bytes = *id_max - id_base <= 0xffff'ffffu ? 4 : 8;
+  const std::uint8_t index_bytes = vertex_count <= 65536 ? 2 : 4;
+  const std::uint8_t part_bytes =
+      palette.size() == 1 ? 0 : (palette.size() <= 256 ? 1 : (palette.size() <= 65536 ? 2 : 4));
+  const std::uint8_t reference_bytes = kind == ShardKind::grid ? (n <= 65536 ? 2 : 4) : 0;
+
+  std::vector<std::byte>& out = built.payload;
+  out.assign(sf::kHeaderBytes, std::byte{0});
+  PayloadWriter w(out);
+  std::memcpy(out.data(), sf::kMagic.data(), 4);
+  w.put<std::uint16_t>(4, sf::kVersion);
+  w.put<std::uint8_t>(6, std::uint8_t(kind));
+  w.put<std::uint8_t>(7, std::uint8_t(precision));
+  w.put<std::uint8_t>(8, index_bytes);
+  w.put<std::uint8_t>(9, id_bytes);
+  w.put<std::uint8_t>(10, part_bytes);
+  w.put<std::uint8_t>(11, reference_bytes);
+  w.put<std::uint32_t>(12, vertex_count);
+  w.put<std::uint32_t>(16, n);
+  w.put<std::uint32_t>(20, std::uint32_t(palette.size()));
+  w.put<std::uint32_t>(24, kind == ShardKind::grid
+                               ? std::uint32_t(grid.cell_offsets.size() - 1)
+                               : std::uint32_t(nodes.size()));
+  w.put<std::uint32_t>(28, std::uint32_t(grid.references.size()));
+  w.put<std::uint64_t>(32, id_base);
+  for (int k = 0; k < 3; ++k) {
+    w.put<double>(40 + 8 * k, g.frame.origin[k]);
+    if (kind == ShardKind::grid) {
+      w.put<std::uint32_t>(64 + 4 * k, grid.shape.cells[k]);
+      w.put<double>(80 + 8 * k, grid.shape.lo[k]);
+      w.put<double>(104 + 8 * k, grid.shape.cell_size[k]);
+    }
+  }
+  std::size_t section = 0;
+  auto begin_section = [&] {
+    w.align();
+    w.put<std::uint64_t>(128 + 8 * section++, w.size());
+  };
+  auto put_real = [&](double value) {
+    if (precision == StoredPrecision::float32)
+      w.append<float>(float(value));  // exact: the value is a stored float
+    else
+      w.append<double>(value);
+  };
+
+  begin_section();  // vertices
+  for (const std::uint32_t v : vertex_order)
+    for (int k = 0; k < 3; ++k) put_real(g.relative[v][k]);
+  begin_section();  // triangles
+  for (const std::uint32_t t : order)
+    for (const std::uint32_t v : g.corners[t]) {
+      if (index_bytes == 2)
+        w.append<std::uint16_t>(std::uint16_t(renumber[v]));
+      else
+        w.append<std::uint32_t>(renumber[v]);
+    }
+  begin_section();  // ids
+  for (const std::uint32_t t : order) {
+    if (id_bytes == 4)
+      w.append<std::uint32_t>(std::uint32_t(region.ids[t] - id_base));
+    else
+      w.append<std::uint64_t>(region.ids[t] - id_base);
+  }
+  begin_section();  // part palette
+  for (const std::uint32_t p : palette) w.append<std::uint32_t>(p);
+  begin_section();  // part indices
+  if (part_bytes > 0)
+    for (const std::uint32_t t : order) {
+      const auto i = std::uint32_t(
+          std::lower_bound(palette.begin(), palette.end(), region.parts[t]) - palette.begin());
+      if (part_bytes == 1)
+        w.append<std::uint8_t>(std::uint8_t(i));
+      else if (part_bytes == 2)
+        w.append<std::uint16_t>(std::uint16_t(i));
+      else
+        w.append<std::uint32_t>(i);
+    }
+  begin_section();  // structure
+  if (kind == ShardKind::grid) {
+    for (const std::uint32_t o : grid.cell_offsets) w.append<std::uint32_t>(o);
+  } else {
+    for (const RtreeNode& node : nodes) {
+      for (int k = 0; k < 3; ++k) put_real(node.box.lo[k]);
+      for (int k = 0; k < 3; ++k) put_real(node.box.hi[k]);
+      w.append<std::uint32_t>(node.first);
+      w.append<std::uint32_t>(node.count);
+    }
+  }
+  begin_section();  // references
+  for (const std::uint32_t t : grid.references) {
+    if (reference_bytes == 2)
+      w.append<std::uint16_t>(std::uint16_t(t));
+    else
+      w.append<std::uint32_t>(t);
+  }
+  begin_section();  // end
+  return built;
+}
+
+}  // namespace tetrapage

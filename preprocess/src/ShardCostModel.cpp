@@ -1,0 +1,111 @@
+#include "tetrapage/preprocess/ShardCostModel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/runtime/Shard.h"
+
+namespace tetrapage {
+
+// Measured by bench/runtime/ShardBench.cpp on the build machine (2 x 2.6 GHz shared cores,
+// load ~6), CPU time, three runs each:
+//  BM_CostFit (non-negative least squares over 45 workloads per kind: 3 regions x 5 query
+//  extents x 3 layouts, median of 5 x 512 queries each):
+//    grid:  407, 371, 407 ns per query; 20.8, 21.2, 20.6 ns per reference; per cell and per
+//           candidate indistinguishable from 0 (fitted 0; a cell visit is an empty-list read)
+//    rtree: 0 ns per query; 31.4, 32.0, 31.7 ns per node; 14.9, 14.4, 14.4 ns per reference
+//  BM_PageIn (zlib inflate of the level-4 deflated payload + Shard::decode, per decoded
+//  byte): 4.1 to 6.7 ns (median 5.7).
+// The cell cost is set to 1 ns (not the fitted 0) so that finer grids are never free.
+ShardCostModel::ShardCostModel()
+    : seconds_per_grid_query(400e-9),
+      seconds_per_cell(1e-9),
+      seconds_per_grid_reference(21e-9),
+      seconds_per_rtree_query(0),
+      seconds_per_node(32e-9),
+      seconds_per_rtree_reference(14.5e-9),
+      seconds_per_byte(5.7e-9) {}
+
+namespace {
+
+ShardCostEstimate estimate(const ShardTriangles& region, ShardKind kind,
+                           StoredPrecision precision, const ShardLayout& layout,
+                           const std::vector<geometry::Box>& queries,
+                           const ShardCostModel& model) {
+  const BuiltShard built = build_shard(region, kind, precision, layout);
+  const Shard shard = Shard::decode(built.payload);
+  ShardQueryCounters counters;
+  for (const geometry::Box& box : queries) shard.for_each_candidate(box, [](std::uint32_t) {}, counters);
+  ShardCostEstimate e;
+  e.kind = kind;
+  e.layout = layout;
+  const double q = double(std::max<std::size_t>(queries.size(), 1));
+  e.visited_per_query = double(counters.visited) / q;
+  e.references_per_query = double(counters.references) / q;
+  e.candidates_per_query = double(counters.candidates) / q;
+  e.payload_bytes = built.payload.size();
+  e.query_seconds =
+      kind == ShardKind::grid
+          ? model.seconds_per_grid_query + model.seconds_per_cell * e.visited_per_query +
+                model.seconds_per_grid_reference * e.references_per_query
+          : model.seconds_per_rtree_query + model.seconds_per_node * e.visited_per_query +
+                model.seconds_per_rtree_reference * e.references_per_query;
+  e.paging_seconds = model.seconds_per_byte * double(e.payload_bytes) /
+                     std::max(model.queries_per_page_in, 1e-9);
+  return e;
+}
+
+}  // namespace
+
+ShardCostReport estimate_shard_costs(const ShardTriangles& region, double query_extent,
+                                     StoredPrecision precision, const ShardCostModel& model) {
+  if (!(query_extent >= 0) || !std::isfinite(query_extent))
+    throw InputError("query extent " + std::to_string(query_extent) +
+                     " is not a finite non-negative length");
+  // Cubes of side query_extent centred on triangles spread over the region (every
+  // (n / samples)-th): queries come where the geometry is, as a flying object near contact.
+  std::vector<geometry::Box> queries;
+  const std::size_t n = region.triangles.size();
+  const std::size_t samples = std::min<std::size_t>(n, std::max<std::uint32_t>(model.sample_queries, 1));
+  for (std::size_t i = 0; i < samples; ++i) {
+    const geometry::Triangle& t = region.triangles[i * n / std::max<std::size_t>(samples, 1)];
+    geometry::Point centre;
+    for (int k = 0; k < 3; ++k) centre[k] = (t[0][k] + t[1][k] + t[2][k]) / 3;
+    geometry::Box box;
+    for (int k = 0; k < 3; ++k) {
+      box.lo[k] = centre[k] - 0.5 * query_extent;
+      box.hi[k] = centre[k] + 0.5 * query_extent;
+    }
+    queries.push_back(box);
+  }
+  ShardCostReport report;
+  bool first = true;
+  for (const double cells_per_triangle : {0.25, 1.0, 4.0}) {
+    ShardLayout layout;
+    layout.grid_cells_per_triangle = cells_per_triangle;
+    const ShardCostEstimate e = estimate(region, ShardKind::grid, precision, layout, queries, model);
+    if (first || e.total_seconds() < report.grid.total_seconds()) report.grid = e;
+    first = false;
+  }
+  first = true;
+  for (const std::uint32_t leaf : {4u, 8u, 16u}) {
+    ShardLayout layout;
+    layout.rtree_leaf_size = leaf;
+    const ShardCostEstimate e =
+        estimate(region, ShardKind::rtree, precision, layout, queries, model);
+    if (first || e.total_seconds() < report.rtree.total_seconds()) report.rtree = e;
+    first = false;
+  }
+  report.chosen = report.rtree.total_seconds() < report.grid.total_seconds() ? ShardKind::rtree
+                                                                             : ShardKind::grid;
+  return report;
+}
+
+ShardKind choose_shard_kind(const ShardTriangles& region, double query_extent,
+                            const ShardCostModel& model) {
+  return estimate_shard_costs(region, query_extent, StoredPrecision::float32, model).chosen;
+}
+
+}  // namespace tetrapage

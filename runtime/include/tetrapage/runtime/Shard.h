@@ -1,0 +1,287 @@
+#pragma once
+/// @file Shard.h
+/// One region's triangles and their spatial index (a uniform grid or an R-tree), decoded from a
+/// shard payload (docs/SHARD-FORMAT.md) and immutable afterwards: any number of threads may
+/// query one shard at once.
+///
+/// Stored coordinates: vertex v is stored relative to the shard origin o as float or double r;
+/// the stored vertex is, by definition, o + double(r) computed in double. Every answer here is
+/// exact on those stored vertices.
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "tetrapage/runtime/ShardKind.h"
+#include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/geometry/Shapes.h"
+#include "tetrapage/runtime/geometry/TriangleBox.h"
+
+namespace tetrapage {
+
+/// Constants of the payload layout, shared by the builder and the decoder.
+namespace shard_format {
+inline constexpr std::array<std::byte, 4> kMagic{std::byte{'T'}, std::byte{'P'}, std::byte{'S'},
+                                                 std::byte{'H'}};
+inline constexpr std::uint16_t kVersion = 1;
+inline constexpr std::size_t kHeaderBytes = 192;
+/// The sections, in payload order; the header holds the byte offset of each and of the end.
+enum Section : std::size_t {
+  vertices,
+  triangles,
+  ids,
+  part_palette,
+  part_indices,
+  structure,
+  references,
+  section_count
+};
+/// R-tree limits the decoder enforces (so that a query's stack is bounded).
+inline constexpr std::uint32_t kMaxFanout = 16;
+inline constexpr std::uint32_t kMaxDepth = 48;
+/// Bit 31 of an R-tree node's count marks a leaf.
+inline constexpr std::uint32_t kLeafFlag = 0x8000'0000u;
+/// Bytes of one R-tree node record: a box (6 stored coordinates), first, count.
+constexpr std::size_t node_record_bytes(StoredPrecision precision) {
+  return (precision == StoredPrecision::float32 ? 4 : 8) * 6 + 8;
+}
+/// Boundary i (0..cells) of a grid axis: lo + i * cell_size rounded as written, the one
+/// formula the builder and the queries share, monotone in i.
+inline double grid_boundary(double lo, double cell_size, std::uint32_t i) {
+  return lo + double(i) * cell_size;
+}
+/// The cells [first, last] of a grid axis (cells >= 1) whose closed extent meets [low, high];
+/// false when none does. Exact with respect to grid_boundary.
+bool grid_cell_range(double lo, double cell_size, std::uint32_t cells, double low, double high,
+                     std::uint32_t& first, std::uint32_t& last);
+}  // namespace shard_format
+
+/// What one query did, for counters and the cost model.
+struct ShardQueryCounters {
+  std::uint64_t visited = 0;     ///< grid cells or R-tree nodes visited
+  std::uint64_t references = 0;  ///< triangle references examined (with a grid's repeats)
+  std::uint64_t candidates = 0;  ///< triangles passed to visit
+};
+
+class Shard {
+ public:
+  /// Decodes and validates a payload: every count, offset, index and box is checked, so a
+  /// corrupted payload throws instead of crashing or looping.
+  /// @param context names the payload in error messages (e.g. "model.tpi shard 17").
+  /// @throw FormatError naming the field at fault and its value.
+  static Shard decode(std::span<const std::byte> payload, std::string_view context = "shard");
+
+  ShardKind kind() const { return kind_; }
+  StoredPrecision precision() const { return precision_; }
+  std::uint32_t triangle_count() const { return triangle_count_; }
+  std::uint32_t vertex_count() const { return vertex_count_; }
+  /// Bytes held by this object (its arrays and itself).
+  std::size_t memory_bytes() const;
+  const geometry::Point& origin() const { return origin_; }
+
+  /// The stored triangle `local` (< triangle_count(), unchecked) in double.
+  geometry::Triangle triangle(std::uint32_t local) const {
+    return precision_ == StoredPrecision::float32 ? stored_triangle<float>(local)
+                                                  : stored_triangle<double>(local);
+  }
+  /// The model-wide triangle id of `local` (< triangle_count(), unchecked).
+  std::uint64_t triangle_id(std::uint32_t local) const {
+    return id_base_ + (id_offsets32_.empty() ? id_offsets64_[local] : id_offsets32_[local]);
+  }
+  /// The part id of `local` (< triangle_count(), unchecked).
+  std::uint32_t part_id(std::uint32_t local) const;
+  /// The box of all stored triangles.
+  const geometry::Box& bounds() const { return bounds_; }
+
+  /// Calls visit(local) exactly once for each stored triangle that meets the closed box (the
+  /// kernel's exact triangle_intersects_box), in no particular order. Every such triangle
+  /// also has a stored box overlapping `box`; a triangle whose box overlaps `box` but that
+  /// does not itself meet `box` is not visited. An empty box (or one with a NaN) visits
+  /// nothing. No state is shared between concurrent queries.
+  /// @return the grid cells or R-tree nodes visited.
+  /// @throw whatever visit throws.
+  template <class Visit>
+  std::size_t for_each_candidate(const geometry::Box& box, Visit&& visit) const {
+    ShardQueryCounters counters;
+    query(box, visit, counters);
+    return counters.visited;
+  }
+  /// The same, adding what the query did to `counters`.
+  template <class Visit>
+  std::size_t for_each_candidate(const geometry::Box& box, Visit&& visit,
+                                 ShardQueryCounters& counters) const {
+    const std::uint64_t before = counters.visited;
+    query(box, visit, counters);
+    return counters.visited - before;
+  }
+
+  // Read-only views of the decoded structure, for inspection, tests and the builder's checks.
+  std::array<std::uint32_t, 3> grid_cells() const { return grid_cells_; }
+  const geometry::Point& grid_lo() const { return grid_lo_; }
+  const geometry::Point& grid_cell_size() const { return grid_cell_size_; }
+  std::size_t grid_reference_count() const {
+    return references16_.empty() ? references32_.size() : references16_.size();
+  }
+  std::size_t rtree_node_count() const { return nodes_.size(); }
+  std::uint32_t part_count() const { return std::uint32_t(part_palette_.size()); }
+
+  /// Lower boundary of grid cell i along axis (the same rounding at build and query time).
+  double grid_boundary(int axis, std::uint32_t i) const {
+    return shard_format::grid_boundary(grid_lo_[axis], grid_cell_size_[axis], i);
+  }
+
+ private:
+  /// An R-tree node with its box converted to stored (absolute) coordinates at decode.
+  struct Node {
+    geometry::Box box;
+    std::uint32_t first = 0;  ///< first child node, or first triangle of a leaf
+    std::uint32_t count = 0;  ///< children, or triangles (with kLeafFlag for a leaf)
+  };
+
+  /// Per-thread marks that report a grid triangle once per query (defined in Shard.cpp).
+  class Marks {
+   public:
+    explicit Marks(std::uint32_t triangle_count);
+    ~Marks();
+    Marks(const Marks&) = delete;
+    Marks& operator=(const Marks&) = delete;
+    /// True the first time t is seen during this query.
+    bool first_visit(std::uint32_t t) {
+      if (stamps_[t] == epoch_) return false;
+      stamps_[t] = epoch_;
+      return true;
+    }
+
+   private:
+    std::uint32_t* stamps_ = nullptr;
+    std::uint32_t epoch_ = 0;
+    std::vector<std::uint32_t> own_;  ///< used when a query runs inside another's visit
+    bool borrowed_ = false;
+  };
+
+  template <class Real>
+  geometry::Point stored_vertex(std::uint32_t v) const {
+    const Real* r;
+    if constexpr (sizeof(Real) == 4)
+      r = vertices32_.data() + 3 * std::size_t(v);
+    else
+      r = vertices64_.data() + 3 * std::size_t(v);
+    return {origin_[0] + double(r[0]), origin_[1] + double(r[1]), origin_[2] + double(r[2])};
+  }
+  std::uint32_t corner(std::uint32_t local, int k) const {
+    const std::size_t i = 3 * std::size_t(local) + std::size_t(k);
+    return indices16_.empty() ? indices32_[i] : indices16_[i];
+  }
+  template <class Real>
+  geometry::Triangle stored_triangle(std::uint32_t local) const {
+    return {stored_vertex<Real>(corner(local, 0)), stored_vertex<Real>(corner(local, 1)),
+            stored_vertex<Real>(corner(local, 2))};
+  }
+  bool meets(std::uint32_t local, const geometry::Box& box) const {
+    const geometry::Triangle t = triangle(local);
+    return geometry::boxes_overlap(geometry::box_of(t), box) &&
+           geometry::triangle_intersects_box(t, box);
+  }
+
+
+  template <class Visit>
+  void query(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
+    for (int k = 0; k < 3; ++k)
+      if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
+    if (!geometry::boxes_overlap(box, bounds_)) return;
+    // A triangle meets the box iff it meets the box clipped to the shard's bounds, which is
+    // finite even when the query is not.
+    geometry::Box clipped;
+    for (int k = 0; k < 3; ++k) {
+      clipped.lo[k] = std::max(box.lo[k], bounds_.lo[k]);
+      clipped.hi[k] = std::min(box.hi[k], bounds_.hi[k]);
+    }
+    if (kind_ == ShardKind::grid)
+      query_grid(clipped, visit, counters);
+    else
+      query_rtree(clipped, visit, counters);
+  }
+
+  template <class Visit>
+  void query_grid(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
+    std::array<std::uint32_t, 3> first{}, last{};
+    for (int k = 0; k < 3; ++k)
+      if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k],
+                                         box.lo[k], box.hi[k], first[k], last[k]))
+        return;
+    Marks marks(triangle_count_);
+    const std::uint32_t nx = grid_cells_[0], ny = grid_cells_[1];
+    for (std::uint32_t z = first[2]; z <= last[2]; ++z)
+      for (std::uint32_t y = first[1]; y <= last[1]; ++y)
+        for (std::uint32_t x = first[0]; x <= last[0]; ++x) {
+          const std::size_t cell = (std::size_t(z) * ny + y) * nx + x;
+          ++counters.visited;
+          const std::uint32_t begin = cell_offsets_[cell], end = cell_offsets_[cell + 1];
+          counters.references += end - begin;
+          for (std::uint32_t r = begin; r < end; ++r) {
+            const std::uint32_t t = references16_.empty() ? references32_[r] : references16_[r];
+            if (!marks.first_visit(t) || !meets(t, box)) continue;
+            ++counters.candidates;
+            visit(t);
+          }
+        }
+  }
+
+  template <class Visit>
+  void query_rtree(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
+    // Depth is at most kMaxDepth and each level leaves at most kMaxFanout - 1 siblings
+    // pending, which the decoder checked.
+    std::array<std::uint32_t, shard_format::kMaxDepth * shard_format::kMaxFanout + 1> stack;
+    std::size_t size = 0;
+    stack[size++] = 0;
+    while (size > 0) {
+      const Node& node = nodes_[stack[--size]];
+      ++counters.visited;
+      if (!geometry::boxes_overlap(node.box, box)) continue;
+      if (node.count & shard_format::kLeafFlag) {
+        const std::uint32_t count = node.count & ~shard_format::kLeafFlag;
+        counters.references += count;
+        for (std::uint32_t t = node.first; t < node.first + count; ++t) {
+          if (!meets(t, box)) continue;
+          ++counters.candidates;
+          visit(t);
+        }
+      } else {
+        for (std::uint32_t c = node.count; c-- > 0;) stack[size++] = node.first + c;
+      }
+    }
+  }
+
+  ShardKind kind_ = ShardKind::grid;
+  StoredPrecision precision_ = StoredPrecision::float32;
+  std::uint32_t triangle_count_ = 0;
+  std::uint32_t vertex_count_ = 0;
+  geometry::Point origin_{};
+  geometry::Box bounds_;
+
+  std::vector<float> vertices32_;  ///< relative xyz, when stored as float
+  std::vector<double> vertices64_;
+  std::vector<std::uint16_t> indices16_;  ///< three corners per triangle
+  std::vector<std::uint32_t> indices32_;
+  std::uint64_t id_base_ = 0;
+  std::vector<std::uint32_t> id_offsets32_;
+  std::vector<std::uint64_t> id_offsets64_;
+  std::vector<std::uint32_t> part_palette_;
+  std::vector<std::uint8_t> part_indices_;  ///< part_index_bytes_ per triangle, little-endian
+  std::uint8_t part_index_bytes_ = 0;
+
+  std::array<std::uint32_t, 3> grid_cells_{};
+  geometry::Point grid_lo_{};
+  geometry::Point grid_cell_size_{};
+  std::vector<std::uint32_t> cell_offsets_;
+  std::vector<std::uint16_t> references16_;
+  std::vector<std::uint32_t> references32_;
+
+  std::vector<Node> nodes_;
+};
+
+}  // namespace tetrapage
