@@ -19,6 +19,8 @@ void add_generate_flight_command(CLI::App& generate);
 void add_replay_command(CLI::App& app);
 /// `mesh info|convert` (tools/cli/MeshCommands.cpp)
 void add_mesh_commands(CLI::App& app);
+/// `preprocess`, `inspect`, `validate` (tools/cli/IndexCommands.cpp)
+void add_index_commands(CLI::App& app);
 
 /// Writes a JSON report under a temporary name and renames it (never half-written).
 /// @throw IoError on failure.

@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   tetrapage::cli::add_generate_flight_command(*generate);
   tetrapage::cli::add_replay_command(app);
   tetrapage::cli::add_mesh_commands(app);
+  tetrapage::cli::add_index_commands(app);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,90 @@
+#pragma once
+/// @file Preprocess.h
+/// The preprocess pipeline (DESIGN.md): ingest the parts, sample sites where the triangles
+/// are, build the coarse Delaunay mesh, bin every triangle into the tets it meets (exactly),
+/// build a grid or R-tree shard per non-empty tet, and write one HDF5 index under a temporary
+/// name, renamed only when complete.
+///
+/// Memory: the ingest holds one part file at a time plus a bounded sample of centroids; the
+/// stages after sampling stream over spill files in blocks and process the tets in buckets
+/// sized from --memory, so the working memory follows the budget, not the model.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tetrapage/runtime/ShardKind.h"
+
+namespace tetrapage {
+
+enum class ShardChoice : std::uint8_t { automatic, grid, rtree };
+
+/// @throw InputError for anything but "auto", "grid", "rtree".
+ShardChoice parse_shard_choice(const std::string& text);
+
+struct PreprocessOptions {
+  /// Target triangles per region (the leaf size of the adaptive split of centroids).
+  std::size_t region_triangles = 2048;
+  /// Working-memory budget in bytes (the ingest's largest part file comes on top).
+  std::uint64_t memory_bytes = std::uint64_t(1) << 30;
+  /// Worker threads; 0: all cores.
+  unsigned threads = 0;
+  ShardChoice shard = ShardChoice::automatic;
+  StoredPrecision precision = StoredPrecision::float32;
+  /// The side of the query boxes the cost model plans for; 0: 5 % of the model's largest side
+  /// (the study's flying objects fit a cube of 0.05 in a unit-cube scene).
+  double query_extent = 0;
+  /// Progress bars (or lines) on stderr.
+  bool progress = false;
+  /// Where spill files go; empty: next to the output.
+  std::filesystem::path spill_folder;
+};
+
+/// Time and peak resident memory of one stage.
+struct StageFigures {
+  std::string name;
+  double seconds = 0;
+  std::uint64_t peak_resident_bytes = 0;
+};
+
+struct PreprocessSummary {
+  std::filesystem::path output;
+  std::uint64_t files_read = 0;
+  std::uint64_t parts = 0;
+  std::uint64_t triangles_read = 0;        ///< kept triangles, as read and placed
+  std::uint64_t degenerate_dropped = 0;    ///< by the readers and the placement
+  std::uint64_t sites = 0;
+  std::uint64_t regions = 0;               ///< tets of the coarse mesh
+  std::uint64_t empty_regions = 0;         ///< tets without triangles (no shard)
+  std::uint64_t grid_shards = 0;
+  std::uint64_t rtree_shards = 0;
+  std::uint64_t stored_triangles = 0;      ///< triangle references over all shards
+  double duplication_factor = 0;           ///< stored_triangles / triangles_read
+  std::uint64_t exact_tet_tests = 0;
+  std::uint64_t shard_payload_bytes = 0;   ///< decoded, the bytes a resident cache holds
+  std::uint64_t bytes_written = 0;         ///< the index file
+  double max_rounding_distance = 0;
+  std::string precision;
+  double query_extent = 0;
+  std::uint64_t memory_budget_bytes = 0;
+  std::uint64_t buckets = 0;               ///< tet buckets processed one at a time
+  bool spilled = false;                    ///< whether the stages used spill files
+  std::uint64_t peak_resident_bytes = 0;   ///< the whole run
+  double seconds = 0;
+  std::vector<StageFigures> stages;
+
+  /// The summary as JSON text (the --report file).
+  std::string to_json() const;
+  /// A few human lines (stdout).
+  std::string to_text() const;
+};
+
+/// Runs the pipeline over mesh files and manifests (.json) into `output`.
+/// @throw IoError, FormatError, InputError (from the readers, naming the file), InputError for
+///        an empty model or bad options; nothing is left at `output` on failure.
+PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
+                             const std::filesystem::path& output,
+                             const PreprocessOptions& options);
+
+}  // namespace tetrapage

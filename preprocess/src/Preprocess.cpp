@@ -1,0 +1,490 @@
+#include "tetrapage/preprocess/Preprocess.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <random>
+#include <sstream>
+
+#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/MemoryUsage.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/preprocess/CoarseMesh.h"
+#include "tetrapage/preprocess/RecordSpill.h"
+#include "tetrapage/preprocess/ShardBuilder.h"
+#include "tetrapage/preprocess/ShardCostModel.h"
+#include "tetrapage/preprocess/TriangleBinning.h"
+#include "tetrapage/runtime/MeshWalk.h"
+
+namespace tetrapage {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// One triangle on its way through the pipeline (88 bytes).
+struct TriangleRecord {
+  geometry::Triangle triangle;
+  std::uint64_t id;    // position in the input order, over all parts
+  std::uint32_t part;  // part id over all inputs
+  std::uint32_t tet;   // after binning: the tet this copy belongs to
+};
+
+// Runs one stage, recording its time and peak resident memory.
+class StageClock {
+ public:
+  StageClock(PreprocessSummary& summary, std::string name) : summary_(summary), name_(std::move(name)) {
+    reset_peak_resident();
+    start_ = Clock::now();
+  }
+  void stop() {
+    const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    summary_.stages.push_back({name_, seconds, peak_resident_bytes()});
+  }
+
+ private:
+  PreprocessSummary& summary_;
+  std::string name_;
+  Clock::time_point start_;
+};
+
+// Spreads a 21-bit integer's bits three apart (for Morton codes).
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+std::uint64_t morton_code(const Vec3& p, const BoundingBox& box) {
+  std::uint64_t code = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double side = box.hi[axis] - box.lo[axis];
+    const double t = side > 0 ? (p[axis] - box.lo[axis]) / side : 0.0;
+    const auto cell = std::uint64_t(std::clamp(t, 0.0, 1.0) * double((1 << 21) - 1));
+    code |= spread_bits(cell) << axis;
+  }
+  return code;
+}
+
+Vec3 centroid(const geometry::Triangle& t) {
+  return {(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
+          (t[0][2] + t[1][2] + t[2][2]) / 3};
+}
+
+std::filesystem::path spill_path(const std::filesystem::path& folder, const std::string& what) {
+  return folder / (".tetrapage-spill-" + std::to_string(::getpid()) + "-" + what);
+}
+
+// Ingest: every part file read once, instances placed, triangles appended as records; a
+// reservoir sample of centroids (Algorithm R, fixed seed) bounded by the memory budget.
+struct Ingest {
+  RecordSpill<TriangleRecord> records;
+  std::vector<Vec3> sample;
+  std::uint64_t seen = 0;
+  BoundingBox bounds;
+  std::vector<std::string> part_names;
+};
+
+void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
+            const std::filesystem::path& spill_folder, Ingest& in, PreprocessSummary& summary) {
+  const std::uint64_t held_limit = options.memory_bytes / 4;
+  const std::size_t sample_capacity = std::size_t(
+      std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 22));
+  in.sample.reserve(std::min<std::size_t>(sample_capacity, 1 << 16));
+  std::mt19937_64 random(0x7e7a9a9e);
+  std::vector<TriangleRecord> block;
+
+  auto add_soup = [&](const TriangleSoup& soup) {
+    const auto part_offset = std::uint32_t(in.part_names.size());
+    for (const auto& name : soup.part_names) in.part_names.push_back(name);
+    if (soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
+    block.clear();
+    block.reserve(soup.triangle_count());
+    for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+      TriangleRecord record{};
+      record.triangle = soup.corners(t);
+      record.id = in.seen;
+      record.part = part_offset + (soup.part_of.empty() ? 0 : soup.part_of[t]);
+      for (const auto& p : record.triangle) in.bounds.extend(p);
+      const Vec3 c = centroid(record.triangle);
+      if (in.sample.size() < sample_capacity) {
+        in.sample.push_back(c);
+      } else {
+        const std::uint64_t slot = std::uniform_int_distribution<std::uint64_t>(0, in.seen)(random);
+        if (slot < sample_capacity) in.sample[slot] = c;
+      }
+      ++in.seen;
+      block.push_back(record);
+    }
+    in.records.append(block);
+    if (!in.records.spilled() && in.records.size() * sizeof(TriangleRecord) > held_limit)
+      in.records.spill_to(spill_path(spill_folder, "triangles"));
+  };
+
+  Progress progress("reading parts", inputs.size(), options.progress);
+  for (const auto& input : inputs) {
+    if (input.extension() == ".json") {
+      const Manifest manifest = read_manifest(input);
+      for (const auto& part : manifest.parts) {
+        // One part at a time: the ingest holds one part file, never the assembly.
+        Manifest single = manifest;
+        single.parts = {part};
+        std::vector<ReadReport> reports;
+        const TriangleSoup soup = load_assembly(single, &reports);
+        for (const auto& report : reports) {
+          summary.degenerate_dropped += report.degenerate_dropped;
+          ++summary.files_read;
+        }
+        add_soup(soup);
+      }
+    } else {
+      ReadReport report;
+      const TriangleSoup soup = read_mesh(input, &report);
+      summary.degenerate_dropped += report.degenerate_dropped;
+      ++summary.files_read;
+      add_soup(soup);
+    }
+    progress.advance();
+  }
+  progress.finish();
+  summary.triangles_read = in.seen;
+  summary.parts = in.part_names.size();
+  if (in.seen == 0) throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
+}
+
+}  // namespace
+
+ShardChoice parse_shard_choice(const std::string& text) {
+  if (text == "auto") return ShardChoice::automatic;
+  if (text == "grid") return ShardChoice::grid;
+  if (text == "rtree") return ShardChoice::rtree;
+  throw InputError("unknown shard kind '" + text + "' (use auto, grid or rtree)");
+}
+
+PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
+                             const std::filesystem::path& output,
+                             const PreprocessOptions& options) {
+  if (inputs.empty()) throw InputError("no input given");
+  if (options.region_triangles == 0) throw InputError("--region-triangles must be at least 1");
+  if (options.memory_bytes < (std::uint64_t(16) << 20))
+    throw InputError("--memory " + format_byte_size(options.memory_bytes) +
+                     " is below the 16 MiB the pipeline needs to work");
+  const auto start = Clock::now();
+  const unsigned threads = options.threads == 0 ? unsigned(tbb::info::default_concurrency()) : options.threads;
+  tbb::global_control thread_limit(tbb::global_control::max_allowed_parallelism, threads);
+
+  PreprocessSummary summary;
+  summary.output = output;
+  summary.memory_budget_bytes = options.memory_bytes;
+  summary.precision = std::string(to_string(options.precision));
+  const std::filesystem::path spill_folder =
+      !options.spill_folder.empty() ? options.spill_folder
+                                    : std::filesystem::absolute(output).parent_path();
+
+  // The writer's temporary file is removed if anything below throws.
+  IndexWriter writer(output);
+
+  // 1. Ingest.
+  Ingest in;
+  {
+    StageClock clock(summary, "ingest");
+    ingest(inputs, options, spill_folder, in, summary);
+    clock.stop();
+  }
+  const std::uint64_t triangle_count = in.seen;
+
+  // 2. Sample and 3. coarse mesh.
+  TetMesh mesh;
+  {
+    StageClock clock(summary, "coarse mesh");
+    SamplingOptions sampling;
+    // The sample stands for all triangles: scale the leaf size to its share.
+    const double share = double(in.sample.size()) / double(triangle_count);
+    sampling.leaf_triangles = std::max<std::size_t>(1, std::size_t(std::llround(double(options.region_triangles) * share)));
+    const std::vector<Vec3> sites = sample_sites(in.sample, in.bounds, sampling);
+    summary.sites = sites.size();
+    mesh = build_coarse_mesh(sites);
+    summary.regions = mesh.tet_count();
+    clock.stop();
+  }
+  const std::size_t tet_count = mesh.tet_count();
+
+  // Tets in Morton order of their centroids: neighbouring shards sit side by side on disk.
+  std::vector<std::uint32_t> order(tet_count), rank(tet_count);
+  {
+    const BoundingBox box = enlarged_bounds(in.bounds, SamplingOptions{}.margin);
+    std::vector<std::uint64_t> code(tet_count);
+    tbb::parallel_for(std::size_t(0), tet_count, [&](std::size_t t) {
+      const auto c = mesh.corners(t);
+      const Vec3 mid{(c[0][0] + c[1][0] + c[2][0] + c[3][0]) / 4, (c[0][1] + c[1][1] + c[2][1] + c[3][1]) / 4,
+                     (c[0][2] + c[1][2] + c[2][2] + c[3][2]) / 4};
+      code[t] = morton_code(mid, box);
+    });
+    for (std::size_t t = 0; t < tet_count; ++t) order[t] = std::uint32_t(t);
+    tbb::parallel_sort(order.begin(), order.end(),
+                       [&](std::uint32_t a, std::uint32_t b) { return code[a] < code[b]; });
+    for (std::size_t r = 0; r < tet_count; ++r) rank[order[r]] = std::uint32_t(r);
+  }
+
+  // Buckets of consecutive tets (in Morton order) whose estimated triangle copies fit in a
+  // third of the budget; the estimate locates the sampled centroids, with room for duplicates.
+  std::vector<std::uint32_t> bucket_of(tet_count, 0);
+  std::size_t bucket_count = 1;
+  {
+    const double copies_per_sample = 1.5 * double(triangle_count) / double(in.sample.size());
+    const double capacity = double(options.memory_bytes / 3) / double(sizeof(TriangleRecord));
+    if (copies_per_sample * double(in.sample.size()) > capacity) {
+      std::vector<double> estimate(tet_count, 0.0);
+      const BoundingBox box = enlarged_bounds(in.bounds, SamplingOptions{}.margin);
+      std::sort(in.sample.begin(), in.sample.end(), [&](const Vec3& a, const Vec3& b) {
+        return morton_code(a, box) < morton_code(b, box);
+      });
+      std::uint32_t hint = 0;
+      for (const Vec3& c : in.sample) {
+        const WalkResult located = locate_point(mesh, hint, c);
+        if (located.tet == TetMesh::no_neighbour) continue;
+        hint = located.tet;
+        estimate[located.tet] += copies_per_sample;
+      }
+      double load = 0;
+      std::uint32_t bucket = 0;
+      for (const std::uint32_t t : order) {
+        if (load > 0 && load + estimate[t] > capacity) ++bucket, load = 0;
+        load += estimate[t];
+        bucket_of[t] = bucket;
+      }
+      bucket_count = bucket + 1;
+    }
+  }
+  summary.buckets = bucket_count;
+  std::vector<Vec3>().swap(in.sample);
+
+  // 4. Bin: every triangle into every tet it meets, appended to its tets' bucket spills.
+  std::vector<RecordSpill<TriangleRecord>> buckets;
+  buckets.reserve(bucket_count);
+  for (std::size_t b = 0; b < bucket_count; ++b)
+    buckets.emplace_back(bucket_count == 1 && !in.records.spilled()
+                             ? std::filesystem::path()
+                             : spill_path(spill_folder, "bucket" + std::to_string(b)));
+  summary.spilled = in.records.spilled() || bucket_count > 1;
+  {
+    StageClock clock(summary, "binning");
+    struct ThreadState {
+      BinningScratch scratch;
+      std::vector<std::uint32_t> tets;
+      std::vector<std::vector<TriangleRecord>> out;
+    };
+    tbb::enumerable_thread_specific<ThreadState> states([&] {
+      ThreadState s;
+      s.out.resize(bucket_count);
+      return s;
+    });
+    const std::size_t block_records =
+        std::max<std::size_t>(1024, options.memory_bytes / 12 / sizeof(TriangleRecord));
+    Progress progress("binning triangles", triangle_count, options.progress);
+    in.records.for_each_block(block_records, [&](std::span<const TriangleRecord> block) {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 256),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          ThreadState& s = states.local();
+                          for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                            s.tets.clear();
+                            bin_triangle(mesh, block[i].triangle, s.scratch, s.tets);
+                            for (const std::uint32_t t : s.tets) {
+                              TriangleRecord copy = block[i];
+                              copy.tet = t;
+                              s.out[bucket_of[t]].push_back(copy);
+                            }
+                          }
+                        });
+      for (auto& s : states) {
+        for (std::size_t b = 0; b < bucket_count; ++b) {
+          buckets[b].append(s.out[b]);
+          s.out[b].clear();
+        }
+      }
+      progress.advance(block.size());
+    });
+    progress.finish();
+    for (auto& s : states) summary.exact_tet_tests += s.scratch.tet_tests;
+    in.records.clear();
+    clock.stop();
+  }
+
+  // 5. Shards, bucket by bucket, and 6. the index.
+  std::vector<std::uint32_t> tet_shard(tet_count, TetMesh::no_neighbour);
+  std::vector<std::uint32_t> shard_tet, shard_triangles;
+  std::vector<std::uint8_t> shard_kind;
+  {
+    StageClock clock(summary, "shards");
+    const double query_extent = options.query_extent > 0 ? options.query_extent : [&] {
+      const Vec3 size = in.bounds.size();
+      return 0.05 * std::max({size[0], size[1], size[2]});
+    }();
+    summary.query_extent = query_extent;
+    const ShardCostModel cost_model;
+    Progress progress("building shards", tet_count, options.progress);
+    for (auto& bucket : buckets) {
+      std::vector<TriangleRecord> records = bucket.read_all();
+      bucket.clear();
+      tbb::parallel_sort(records.begin(), records.end(), [&](const TriangleRecord& a, const TriangleRecord& b) {
+        return rank[a.tet] != rank[b.tet] ? rank[a.tet] < rank[b.tet] : a.id < b.id;
+      });
+      std::vector<std::size_t> group_start;
+      for (std::size_t i = 0; i < records.size(); ++i)
+        if (i == 0 || records[i].tet != records[i - 1].tet) group_start.push_back(i);
+      const std::size_t groups = group_start.size();
+      group_start.push_back(records.size());
+      std::vector<BuiltShard> built(groups);
+      tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
+        const std::size_t first = group_start[g], last = group_start[g + 1];
+        std::vector<geometry::Triangle> triangles;
+        std::vector<std::uint64_t> ids;
+        std::vector<std::uint32_t> parts;
+        triangles.reserve(last - first);
+        ids.reserve(last - first);
+        parts.reserve(last - first);
+        for (std::size_t i = first; i < last; ++i) {
+          triangles.push_back(records[i].triangle);
+          ids.push_back(records[i].id);
+          parts.push_back(records[i].part);
+        }
+        const ShardTriangles region{triangles, ids, parts};
+        if (options.shard == ShardChoice::automatic) {
+          const ShardCostReport costs = estimate_shard_costs(region, query_extent, options.precision, cost_model);
+          built[g] = build_shard(region, costs.chosen, options.precision, costs.chosen_estimate().layout);
+        } else {
+          built[g] = build_shard(region, options.shard == ShardChoice::grid ? ShardKind::grid : ShardKind::rtree,
+                                 options.precision);
+        }
+      });
+      for (std::size_t g = 0; g < groups; ++g) {
+        const std::uint32_t tet = records[group_start[g]].tet;
+        const std::uint32_t shard = writer.append_shard(built[g].payload);
+        tet_shard[tet] = shard;
+        shard_tet.push_back(tet);
+        shard_kind.push_back(std::uint8_t(built[g].kind));
+        shard_triangles.push_back(built[g].triangle_count);
+        summary.stored_triangles += built[g].triangle_count;
+        summary.shard_payload_bytes += built[g].payload.size();
+        summary.max_rounding_distance = std::max(summary.max_rounding_distance, built[g].max_rounding_distance);
+        (built[g].kind == ShardKind::grid ? summary.grid_shards : summary.rtree_shards) += 1;
+        std::vector<std::byte>().swap(built[g].payload);
+      }
+      progress.advance(groups);
+    }
+    progress.finish();
+    summary.empty_regions = tet_count - shard_tet.size();
+    summary.duplication_factor = double(summary.stored_triangles) / double(triangle_count);
+    clock.stop();
+  }
+  {
+    StageClock clock(summary, "write index");
+    writer.write_mesh(mesh);
+    writer.write_table("tet_shard", std::span<const std::uint32_t>(tet_shard));
+    writer.write_table("shard_tet", std::span<const std::uint32_t>(shard_tet));
+    writer.write_table("shard_kind", std::span<const std::uint8_t>(shard_kind));
+    writer.write_table("shard_triangles", std::span<const std::uint32_t>(shard_triangles));
+    IndexHeader header;
+    header.precision = summary.precision;
+    header.input_triangles = triangle_count;
+    header.stored_triangles = summary.stored_triangles;
+    header.region_count = tet_count;
+    header.shard_count = shard_tet.size();
+    header.max_rounding_distance = summary.max_rounding_distance;
+    header.bounds = in.bounds;
+    std::string source;
+    for (const auto& input : inputs) source += (source.empty() ? "" : "\n") + input.string();
+    header.source = source;
+    header.created_by = "tetrapage preprocess";
+    summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    header.build_report_json = summary.to_json();
+    summary.bytes_written = writer.commit(header);
+    clock.stop();
+  }
+  summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  summary.peak_resident_bytes = 0;
+  for (const auto& stage : summary.stages)
+    summary.peak_resident_bytes = std::max(summary.peak_resident_bytes, stage.peak_resident_bytes);
+  return summary;
+}
+
+std::string PreprocessSummary::to_json() const {
+  nlohmann::ordered_json j;
+  j["output"] = output.string();
+  j["files_read"] = files_read;
+  j["parts"] = parts;
+  j["triangles_read"] = triangles_read;
+  j["degenerate_dropped"] = degenerate_dropped;
+  j["sites"] = sites;
+  j["regions"] = regions;
+  j["empty_regions"] = empty_regions;
+  j["grid_shards"] = grid_shards;
+  j["rtree_shards"] = rtree_shards;
+  j["stored_triangles"] = stored_triangles;
+  j["duplication_factor"] = duplication_factor;
+  j["exact_tet_tests"] = exact_tet_tests;
+  j["shard_payload_bytes"] = shard_payload_bytes;
+  j["bytes_written"] = bytes_written;
+  j["bytes_per_triangle"] = triangles_read ? double(bytes_written) / double(triangles_read) : 0.0;
+  j["precision"] = precision;
+  j["max_rounding_distance"] = max_rounding_distance;
+  j["query_extent"] = query_extent;
+  j["memory_budget_bytes"] = memory_budget_bytes;
+  j["buckets"] = buckets;
+  j["spilled"] = spilled;
+  j["seconds"] = seconds;
+  j["triangles_per_second"] = seconds > 0 ? double(triangles_read) / seconds : 0.0;
+  j["peak_rss_bytes"] = peak_resident_bytes;
+  auto& stage_list = j["stages"] = nlohmann::ordered_json::array();
+  for (const auto& stage : stages)
+    stage_list.push_back({{"name", stage.name}, {"seconds", stage.seconds}, {"peak_rss_bytes", stage.peak_resident_bytes}});
+  return j.dump(2);
+}
+
+std::string PreprocessSummary::to_text() const {
+  std::ostringstream text;
+  char line[256];
+  std::snprintf(line, sizeof line, "triangles read %llu (degenerate dropped %llu) from %llu files, %llu parts\n",
+                (unsigned long long)triangles_read, (unsigned long long)degenerate_dropped,
+                (unsigned long long)files_read, (unsigned long long)parts);
+  text << line;
+  std::snprintf(line, sizeof line, "regions %llu (empty %llu), shards: grid %llu, rtree %llu; duplication factor %.3f\n",
+                (unsigned long long)regions, (unsigned long long)empty_regions,
+                (unsigned long long)grid_shards, (unsigned long long)rtree_shards, duplication_factor);
+  text << line;
+  std::snprintf(line, sizeof line, "index %s: %s (%.1f B/triangle), shards decoded %s; %s coordinates, max rounding %.3g\n",
+                output.string().c_str(), format_byte_size(bytes_written).c_str(),
+                triangles_read ? double(bytes_written) / double(triangles_read) : 0.0,
+                format_byte_size(shard_payload_bytes).c_str(), precision.c_str(), max_rounding_distance);
+  text << line;
+  for (const auto& stage : stages) {
+    std::snprintf(line, sizeof line, "  %-12s %8.2f s  peak RSS %s\n", stage.name.c_str(), stage.seconds,
+                  format_byte_size(stage.peak_resident_bytes).c_str());
+    text << line;
+  }
+  std::snprintf(line, sizeof line, "total %.2f s (%.2f M triangles/s), peak RSS %s against --memory %s%s\n", seconds,
+                seconds > 0 ? double(triangles_read) / seconds / 1e6 : 0.0,
+                format_byte_size(peak_resident_bytes).c_str(), format_byte_size(memory_budget_bytes).c_str(),
+                spilled ? " (spilled to disk)" : "");
+  text << line;
+  return text.str();
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,218 @@
+// The preprocess pipeline end to end: every tet's triangle set equals brute force (CGAL's
+// exact-construction kernel as the independent oracle), stored coordinates keep the promised
+// rounding, a run that spills to disk under a small budget writes the same index as one in
+// memory, and bad input leaves nothing behind.
+
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/tools/MeshLibrary.h"
+#include "tetrapage/tools/SceneGenerator.h"
+#include "tetrapage/tools/TetrasGenerator.h"
+
+namespace tetrapage {
+namespace {
+
+using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
+namespace fs = std::filesystem;
+
+fs::path test_folder(const std::string& name) {
+  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "preprocess" / name;
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+fs::path make_scene(const fs::path& folder, std::uint64_t triangles, std::uint64_t seed) {
+  const fs::path path = folder / "scene.ply";
+  static const MeshLibrary library = MeshLibrary::load_default();
+  SceneOptions options;
+  options.triangles = triangles;
+  options.seed = seed;
+  MeshWriter writer(path);
+  generate_scene(library, options, writer);
+  writer.commit();
+  return path;
+}
+
+fs::path make_tetras(const fs::path& folder, std::uint64_t count, std::uint64_t seed) {
+  const fs::path path = folder / "tetras.ply";
+  TetrasOptions options;
+  options.triangles = 4 * count;
+  options.seed = seed;
+  MeshWriter writer(path);
+  generate_tetras(options, writer);
+  writer.commit();
+  return path;
+}
+
+Epeck::Point_3 to_epeck(const Vec3& p) { return {p[0], p[1], p[2]}; }
+
+// Each tet's shard holds exactly the triangles that meet the tet (Epeck do_intersect over all
+// pairs whose boxes overlap), with their input ids, and stored coordinates within the
+// recorded rounding distance of the input (equal in double precision).
+void expect_tets_match_brute_force(const fs::path& input, const fs::path& index_path, bool exact_coordinates) {
+  const TriangleSoup soup = read_mesh(input);
+  const IndexReader index(index_path);
+  const TetMesh mesh = index.read_mesh();
+  const auto tet_shard = index.read_table_uint32("tet_shard");
+  ASSERT_EQ(tet_shard.size(), mesh.tet_count());
+  EXPECT_EQ(index.header().input_triangles, soup.triangle_count());
+  const double rounding = index.header().max_rounding_distance;
+  if (exact_coordinates) {
+    EXPECT_EQ(rounding, 0.0);
+  }
+
+  std::vector<BoundingBox> triangle_boxes(soup.triangle_count());
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
+    for (const auto& p : soup.corners(t)) triangle_boxes[t].extend(p);
+
+  std::uint64_t stored = 0, mismatched_tets = 0;
+  for (std::uint32_t tet = 0; tet < mesh.tet_count(); ++tet) {
+    const auto corners = mesh.corners(tet);
+    const BoundingBox tet_box = mesh.bounds(tet);
+    const Epeck::Tetrahedron_3 tetrahedron(to_epeck(corners[0]), to_epeck(corners[1]), to_epeck(corners[2]),
+                                           to_epeck(corners[3]));
+    std::set<std::uint64_t> expected;
+    for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+      const auto& b = triangle_boxes[t];
+      if (b.lo[0] > tet_box.hi[0] || b.hi[0] < tet_box.lo[0] || b.lo[1] > tet_box.hi[1] ||
+          b.hi[1] < tet_box.lo[1] || b.lo[2] > tet_box.hi[2] || b.hi[2] < tet_box.lo[2])
+        continue;
+      const auto c = soup.corners(t);
+      if (CGAL::do_intersect(Epeck::Triangle_3(to_epeck(c[0]), to_epeck(c[1]), to_epeck(c[2])), tetrahedron))
+        expected.insert(t);
+    }
+    std::set<std::uint64_t> got;
+    if (tet_shard[tet] != TetMesh::no_neighbour) {
+      const Shard shard = Shard::decode(index.read_shard(tet_shard[tet]));
+      for (std::uint32_t local = 0; local < shard.triangle_count(); ++local) {
+        const std::uint64_t id = shard.triangle_id(local);
+        got.insert(id);
+        ASSERT_LT(id, soup.triangle_count());
+        EXPECT_EQ(shard.part_id(local), soup.part_of.empty() ? 0u : soup.part_of[id]);
+        // Stored vertices: the same triangle up to the recorded rounding (as a set of
+        // corners: a shard may start a triangle at another corner).
+        const auto input_corners = soup.corners(id);
+        const auto stored_triangle = shard.triangle(local);
+        for (const auto& p : stored_triangle) {
+          double best = 1e300;
+          for (const auto& q : input_corners)
+            best = std::min(best, std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]));
+          EXPECT_LE(best, rounding * (1 + 1e-12)) << "tet " << tet << " triangle " << id;  // hypot vs sqrt: an ulp
+        }
+      }
+      stored += shard.triangle_count();
+    }
+    if (got != expected) ++mismatched_tets;
+    EXPECT_EQ(got, expected) << "tet " << tet << " of " << index_path;
+    if (mismatched_tets > 3) break;
+  }
+  EXPECT_EQ(stored, index.header().stored_triangles);
+}
+
+TEST(Preprocess, SceneTetsHoldExactlyTheTrianglesTheyMeet) {
+  const fs::path folder = test_folder("scene");
+  const fs::path input = make_scene(folder, 6000, 3);
+  PreprocessOptions options;
+  options.region_triangles = 300;
+  options.precision = StoredPrecision::float64;
+  const PreprocessSummary summary = preprocess({input}, folder / "scene.tpi", options);
+  EXPECT_GT(summary.regions, 20u);
+  EXPECT_GT(summary.empty_regions, 0u);  // the enlarged box's corners make empty tets
+  EXPECT_GE(summary.duplication_factor, 1.0);
+  EXPECT_EQ(summary.grid_shards + summary.rtree_shards + summary.empty_regions, summary.regions);
+  expect_tets_match_brute_force(input, folder / "scene.tpi", true);
+}
+
+TEST(Preprocess, TetrasWithFloatStorageAndForcedKinds) {
+  const fs::path folder = test_folder("tetras");
+  const fs::path input = make_tetras(folder, 400, 5);
+  for (const ShardChoice choice : {ShardChoice::grid, ShardChoice::rtree}) {
+    PreprocessOptions options;
+    options.region_triangles = 100;
+    options.shard = choice;
+    const fs::path output = folder / (choice == ShardChoice::grid ? "grid.tpi" : "rtree.tpi");
+    const PreprocessSummary summary = preprocess({input}, output, options);
+    EXPECT_EQ(choice == ShardChoice::grid ? summary.rtree_shards : summary.grid_shards, 0u);
+    EXPECT_GT(summary.max_rounding_distance, 0.0);  // float storage rounds
+    EXPECT_LT(summary.max_rounding_distance, 1e-6);
+    expect_tets_match_brute_force(input, output, false);
+  }
+}
+
+// The budget forces spill files and several buckets; the index must be the same as in memory.
+TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
+  const fs::path folder = test_folder("spill");
+  // Under 87,381 triangles the sample (memory / 192 B) holds every centroid, so both runs build
+  // the same coarse mesh; 7 MB of records still exceed the 4 MiB held in memory.
+  const fs::path input = make_scene(folder, 80000, 7);
+  PreprocessOptions in_memory;
+  in_memory.region_triangles = 4000;
+  in_memory.shard = ShardChoice::rtree;
+  const PreprocessSummary a = preprocess({input}, folder / "memory.tpi", in_memory);
+  EXPECT_FALSE(a.spilled);
+  PreprocessOptions small = in_memory;
+  small.memory_bytes = 16 << 20;
+  const PreprocessSummary b = preprocess({input}, folder / "spilled.tpi", small);
+  EXPECT_TRUE(b.spilled);
+  EXPECT_GT(b.buckets, 1u);
+  // No spill file is left behind.
+  for (const auto& entry : fs::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename().string().find(".tetrapage-spill"), std::string::npos) << entry.path();
+
+  const IndexReader ra(folder / "memory.tpi"), rb(folder / "spilled.tpi");
+  ASSERT_EQ(ra.shard_count(), rb.shard_count());
+  EXPECT_EQ(ra.read_table_uint32("tet_shard"), rb.read_table_uint32("tet_shard"));
+  for (std::uint32_t s = 0; s < ra.shard_count(); ++s) ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << "shard " << s;
+}
+
+TEST(Preprocess, DeterministicBytes) {
+  const fs::path folder = test_folder("deterministic");
+  const fs::path input = make_scene(folder, 5000, 11);
+  PreprocessOptions options;
+  options.region_triangles = 500;
+  preprocess({input}, folder / "a.tpi", options);
+  options.threads = 1;
+  preprocess({input}, folder / "b.tpi", options);
+  const IndexReader a(folder / "a.tpi"), b(folder / "b.tpi");
+  ASSERT_EQ(a.shard_count(), b.shard_count());
+  for (std::uint32_t s = 0; s < a.shard_count(); ++s) ASSERT_EQ(a.read_shard(s), b.read_shard(s));
+}
+
+TEST(Preprocess, BadInputLeavesNothingBehind) {
+  const fs::path folder = test_folder("bad");
+  {
+    std::ofstream obj(folder / "nan.obj");
+    obj << "v 0 0 0\nv 1 0 0\nv 0 nan 1\nf 1 2 3\n";
+  }
+  {
+    std::ofstream obj(folder / "empty.obj");
+    obj << "# nothing\n";
+  }
+  EXPECT_THROW(preprocess({folder / "missing.ply"}, folder / "out.tpi", {}), IoError);
+  EXPECT_THROW(preprocess({folder / "nan.obj"}, folder / "out.tpi", {}), Error);
+  EXPECT_THROW(preprocess({folder / "empty.obj"}, folder / "out.tpi", {}), Error);
+  PreprocessOptions tiny;
+  tiny.memory_bytes = 1000;
+  EXPECT_THROW(preprocess({folder / "nan.obj"}, folder / "out.tpi", tiny), InputError);
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    EXPECT_TRUE(name == "nan.obj" || name == "empty.obj") << "left behind: " << name;
+  }
+}
+
+}  // namespace
+}  // namespace tetrapage

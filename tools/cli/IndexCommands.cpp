@@ -1,0 +1,211 @@
+// `tetrapage preprocess`, `inspect` and `validate`: build an index, show where its bytes go,
+// and check it from end to end.
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <thread>
+
+#include "Commands.h"
+#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/geometry/Predicates.h"
+
+namespace tetrapage::cli {
+namespace {
+
+struct PreprocessArguments {
+  std::vector<std::filesystem::path> inputs;
+  std::filesystem::path output;
+  std::size_t region_triangles = 2048;
+  std::string memory = "1G";
+  unsigned threads = 0;
+  std::string shard = "auto";
+  std::string precision = "float";
+  double query_extent = 0;
+  std::filesystem::path report;
+};
+
+void run_preprocess(const PreprocessArguments& args) {
+  check_writable(args.report);
+  PreprocessOptions options;
+  options.region_triangles = args.region_triangles;
+  options.memory_bytes = parse_byte_size(args.memory);
+  options.threads = args.threads;
+  options.shard = parse_shard_choice(args.shard);
+  options.precision = parse_stored_precision(args.precision);
+  options.query_extent = args.query_extent;
+  options.progress = true;
+  const PreprocessSummary summary = preprocess(args.inputs, args.output, options);
+  std::fputs(summary.to_text().c_str(), stdout);
+  if (!args.report.empty()) write_report(args.report, nlohmann::json::parse(summary.to_json()));
+}
+
+struct InspectArguments {
+  std::filesystem::path index;
+  std::filesystem::path report;
+};
+
+void run_inspect(const InspectArguments& args) {
+  const IndexReader reader(args.index);
+  const IndexHeader& header = reader.header();
+  const TetMesh mesh = reader.read_mesh();
+  const auto shard_kind = reader.read_table_uint8("shard_kind");
+  const auto shard_triangles = reader.read_table_uint32("shard_triangles");
+  std::uint64_t decoded = 0, stored = 0, kinds[2] = {0, 0}, kind_bytes[2] = {0, 0};
+  std::uint32_t largest = 0, most_triangles = 0;
+  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    decoded += reader.shard_size(s);
+    stored += reader.stored_shard_size(s);
+    const int kind = shard_kind.at(s) == 0 ? 0 : 1;
+    ++kinds[kind];
+    kind_bytes[kind] += reader.stored_shard_size(s);
+    if (reader.shard_size(s) > reader.shard_size(largest)) largest = s;
+    most_triangles = std::max(most_triangles, shard_triangles.at(s));
+  }
+  const double triangles = double(std::max<std::uint64_t>(1, header.input_triangles));
+  std::printf("index %s: format version %u, %s coordinates, %s on disk\n", args.index.c_str(),
+              header.version, header.precision.c_str(), format_byte_size(reader.file_bytes()).c_str());
+  std::printf("model: %llu triangles, bounds [%g %g %g]-[%g %g %g], max rounding distance %.3g\n",
+              (unsigned long long)header.input_triangles, header.bounds.lo[0], header.bounds.lo[1],
+              header.bounds.lo[2], header.bounds.hi[0], header.bounds.hi[1], header.bounds.hi[2],
+              header.max_rounding_distance);
+  std::printf("coarse mesh: %zu vertices, %zu tets (%zu empty)\n", mesh.vertices.size(), mesh.tet_count(),
+              mesh.tet_count() - reader.shard_count());
+  std::printf("shards: %u (grid %llu, rtree %llu), %llu stored triangles (duplication %.3f), largest %s (%u triangles max)\n",
+              reader.shard_count(), (unsigned long long)kinds[0], (unsigned long long)kinds[1],
+              (unsigned long long)header.stored_triangles, double(header.stored_triangles) / triangles,
+              format_byte_size(reader.shard_size(largest)).c_str(), most_triangles);
+  std::printf("bytes: shards on disk %s (%.1f B/triangle; grid %s, rtree %s), decoded %s (%.1f B/triangle)\n",
+              format_byte_size(stored).c_str(), double(stored) / triangles, format_byte_size(kind_bytes[0]).c_str(),
+              format_byte_size(kind_bytes[1]).c_str(), format_byte_size(decoded).c_str(),
+              double(decoded) / triangles);
+  if (!args.report.empty()) {
+    nlohmann::json report{{"index", args.index.string()},
+                          {"version", header.version},
+                          {"precision", header.precision},
+                          {"file_bytes", reader.file_bytes()},
+                          {"triangles", header.input_triangles},
+                          {"stored_triangles", header.stored_triangles},
+                          {"tets", mesh.tet_count()},
+                          {"shards", reader.shard_count()},
+                          {"grid_shards", kinds[0]},
+                          {"rtree_shards", kinds[1]},
+                          {"shard_stored_bytes", stored},
+                          {"shard_decoded_bytes", decoded},
+                          {"max_rounding_distance", header.max_rounding_distance}};
+    write_report(args.report, report);
+  }
+}
+
+// Everything an index promises, checked; returns the problems found.
+std::vector<std::string> validate_index(const IndexReader& reader) {
+  std::vector<std::string> problems = reader.validate();
+  const TetMesh mesh = reader.read_mesh();
+  auto problem = [&](std::string text) {
+    if (problems.size() < 100) problems.push_back(std::move(text));
+  };
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    for (const auto v : mesh.tets[t])
+      if (v >= mesh.vertices.size()) problem("tet " + std::to_string(t) + " names vertex " + std::to_string(v));
+  }
+  if (!problems.empty()) return problems;
+  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
+    const auto c = mesh.corners(t);
+    if (geometry::orient3d(c[0], c[1], c[2], c[3]) != geometry::Sign::positive)
+      problem("tet " + std::to_string(t) + " is not positively oriented");
+    for (int i = 0; i < 4; ++i) {
+      const std::uint32_t n = mesh.neighbours[t][i];
+      if (n == TetMesh::no_neighbour) continue;
+      if (n >= mesh.tet_count()) {
+        problem("tet " + std::to_string(t) + " names neighbour " + std::to_string(n));
+        continue;
+      }
+      bool back = false;
+      for (int j = 0; j < 4; ++j) back |= mesh.neighbours[n][j] == t;
+      if (!back) problem("tets " + std::to_string(t) + " and " + std::to_string(n) + " are not mutual neighbours");
+    }
+  }
+  const auto tet_shard = reader.read_table_uint32("tet_shard");
+  const auto shard_tet = reader.read_table_uint32("shard_tet");
+  const auto shard_triangles = reader.read_table_uint32("shard_triangles");
+  if (tet_shard.size() != mesh.tet_count()) problem("tet_shard has " + std::to_string(tet_shard.size()) + " entries");
+  if (shard_tet.size() != reader.shard_count() || shard_triangles.size() != reader.shard_count())
+    problem("shard tables do not have one entry per shard");
+  if (!problems.empty()) return problems;
+  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    if (shard_tet[s] >= tet_shard.size() || tet_shard[shard_tet[s]] != s)
+      problem("shard " + std::to_string(s) + " and tet " + std::to_string(shard_tet[s]) + " do not name each other");
+    try {
+      const Shard shard = Shard::decode(reader.read_shard(s));
+      if (shard.triangle_count() != shard_triangles[s])
+        problem("shard " + std::to_string(s) + " holds " + std::to_string(shard.triangle_count()) +
+                " triangles, the table says " + std::to_string(shard_triangles[s]));
+    } catch (const Error& error) {
+      problem("shard " + std::to_string(s) + ": " + error.what());
+    }
+  }
+  return problems;
+}
+
+void run_validate(const std::filesystem::path& index) {
+  const IndexReader reader(index);
+  const auto problems = validate_index(reader);
+  for (const auto& p : problems) std::printf("problem: %s\n", p.c_str());
+  if (!problems.empty())
+    throw FormatError(index.string() + ": invalid index (" + std::to_string(problems.size()) + " problems)");
+  std::printf("%s: valid (%u shards, %llu triangles)\n", index.c_str(), reader.shard_count(),
+              (unsigned long long)reader.header().input_triangles);
+}
+
+}  // namespace
+
+void add_index_commands(CLI::App& app) {
+  auto pre = std::make_shared<PreprocessArguments>();
+  auto* command = app.add_subcommand(
+      "preprocess",
+      "Cut an assembly into a coarse tetrahedral mesh of regions, each with a grid or R-tree\n"
+      "shard of the triangles it meets (exact test), and write one HDF5 index.\n"
+      "The index is written under a temporary name and renamed only when complete.");
+  command->add_option("inputs", pre->inputs, "Mesh files (obj, stl, ply, off, gltf, glb, ...) or manifests (.json)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("-o,--output", pre->output, "The index file to write (e.g. model.tpi)")->required();
+  command->add_option("--region-triangles", pre->region_triangles, "Target triangles per region")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  command->add_option("--memory", pre->memory,
+                      "Working-memory budget (e.g. 512M, 4G); larger models spill to disk next to the output")
+      ->capture_default_str();
+  command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")->capture_default_str();
+  command->add_option("--shard", pre->shard, "Shard kind: auto (measured cost model), grid or rtree")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "grid", "rtree"}));
+  command->add_option("--precision", pre->precision,
+                      "Stored coordinates: float or double (the largest rounding distance is reported)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"float", "double"}));
+  command->add_option("--query-extent", pre->query_extent,
+                      "Side of the query boxes the cost model plans for (0: 5% of the model's size)")
+      ->capture_default_str();
+  command->add_option("--report", pre->report, "Write the summary as JSON");
+  command->callback([pre] { run_preprocess(*pre); });
+
+  auto inspect = std::make_shared<InspectArguments>();
+  auto* inspect_command = app.add_subcommand("inspect", "Show what an index holds and where its bytes go");
+  inspect_command->add_option("index", inspect->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
+  inspect_command->add_option("--report", inspect->report, "Write the figures as JSON");
+  inspect_command->callback([inspect] { run_inspect(*inspect); });
+
+  auto index = std::make_shared<std::filesystem::path>();
+  auto* validate = app.add_subcommand(
+      "validate", "Check an index from end to end: checksums, extents, mesh orientation and\n"
+                  "adjacency, shard tables, every shard decoded. Exit 0 only when valid.");
+  validate->add_option("index", *index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
+  validate->callback([index] { run_validate(*index); });
+}
+
+}  // namespace tetrapage::cli
