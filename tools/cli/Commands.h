@@ -21,6 +21,8 @@ void add_replay_command(CLI::App& app);
 void add_mesh_commands(CLI::App& app);
 /// `preprocess`, `inspect`, `validate` (tools/cli/IndexCommands.cpp)
 void add_index_commands(CLI::App& app);
+/// `fly` (tools/cli/FlyCommand.cpp)
+void add_fly_command(CLI::App& app);
 
 /// Writes a JSON report under a temporary name and renames it (never half-written).
 /// @throw IoError on failure.

@@ -197,6 +197,13 @@ class ShardCache {
   /// Whether `shard` is resident now (pinned or not; not while it is loading).
   /// @throw InputError if `shard` is out of range.
   bool contains(std::uint32_t shard) const;
+  /// Acquisitions that had to load (cheap: one atomic read; counters() sorts latencies).
+  std::uint64_t miss_count() const { return misses_.load(std::memory_order_relaxed); }
+  /// The highest resident + reserved bytes so far (one lock; no latency sort).
+  std::uint64_t peak_resident_bytes() const {
+    std::lock_guard lock(mutex_);
+    return peak_;
+  }
 
   /// A snapshot of the counters, gauges and page-in latency percentiles.
   ShardCacheCounters counters() const;

@@ -10,7 +10,9 @@
 /// query answers exactly what the brute-force reference (the same test on every triangle)
 /// answers, in every accuracy mode.
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <vector>
@@ -56,6 +58,47 @@ class ObjectBVH {
   std::size_t all_hits(const Triangle& query, const Accuracy& accuracy,
                        std::vector<std::uint32_t>& hits, QueryCounters* counters = nullptr) const;
 
+  /// Calls visit(index) (index in the input) for every triangle whose box overlaps the closed
+  /// `box` (object coordinates), until visit returns false. Conservative: node boxes are
+  /// rounded outwards, and the query box is rounded outwards to float.
+  template <class Visit>
+  void for_each_in_box(const Box& box, Visit&& visit, QueryCounters* counters = nullptr) const {
+    FloatBox q;
+    for (int k = 0; k < 3; ++k) {
+      q.lo[k] = float_below(box.lo[k]);
+      q.hi[k] = float_above(box.hi[k]);
+    }
+    auto overlaps = [&q](const Node& n) {
+      return n.lo[0] <= q.hi[0] && q.lo[0] <= n.hi[0] && n.lo[1] <= q.hi[1] && q.lo[1] <= n.hi[1] &&
+             n.lo[2] <= q.hi[2] && q.lo[2] <= n.hi[2];
+    };
+    std::uint64_t visited = 0, tests = 0;
+    std::uint32_t stack[kMaxStack];
+    int top = 0;
+    if (overlaps(nodes_[0])) stack[top++] = 0;
+    while (top > 0) {
+      const Node& node = nodes_[stack[--top]];
+      const std::uint32_t index = std::uint32_t(&node - nodes_.data());
+      ++visited;
+      if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+          ++tests;
+          if (boxes_overlap(box, box_of(triangles_[i])) && !visit(original_[i])) {
+            top = 0;
+            break;
+          }
+        }
+        continue;
+      }
+      if (overlaps(nodes_[node.first])) stack[top++] = node.first;
+      if (overlaps(nodes_[index + 1])) stack[top++] = index + 1;
+    }
+    if (counters) {
+      counters->nodes_visited += visited;
+      counters->triangle_tests += tests;
+    }
+  }
+
   /// The reference: triangles_collide(query, t, accuracy) on every triangle, in index order.
   /// first_hit_brute_force returns the lowest colliding index.
   std::optional<std::uint32_t> first_hit_brute_force(const Triangle& query,
@@ -73,6 +116,15 @@ class ObjectBVH {
   struct FloatBox {
     float lo[3], hi[3];
   };
+  // The float nearest below / above a double (NaN stays NaN, overlapping nothing).
+  static float float_below(double x) {
+    const float f = static_cast<float>(x);
+    return double(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity()) : f;
+  }
+  static float float_above(double x) {
+    const float f = static_cast<float>(x);
+    return double(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+  }
   static constexpr int kMaxStack = 128;  // the build bounds the depth well below this
   struct BuildItem;
 

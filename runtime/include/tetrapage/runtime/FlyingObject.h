@@ -1,0 +1,121 @@
+#pragma once
+/// @file FlyingObject.h
+/// A rigid object moving through an index, and the runtime step of DESIGN.md:
+///  1. the pose; the world box of the object by hill-climbing on its convex hull;
+///  2. the box's centre located by walking from the previous tet;
+///  3. the tets overlapping the box, breadth first;
+///  4. their shards pinned in the cache (a prefetch hint for where the motion heads);
+///  5. phase I: shard triangles whose boxes meet the object's box; phase II: those against the
+///     object's BVH, decided on the object's world coordinates (apply_pose, the canonical
+///     placement), so that the exact mode answers exactly what an exact oracle answers.
+/// One FlyingObject is used from one thread at a time; many may share a CollisionIndex.
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/runtime/BoxSearch.h"
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/geometry/Accuracy.h"
+#include "tetrapage/runtime/geometry/ObjectBVH.h"
+
+namespace tetrapage {
+
+enum class QueryMode : std::uint8_t { first_hit, all_contacts };
+
+struct QueryOptions {
+  geometry::Accuracy accuracy = geometry::Accuracy::exact();
+  QueryMode mode = QueryMode::first_hit;
+};
+
+/// One contact: an environment triangle (its part and model-wide id) and an object triangle.
+struct Contact {
+  std::uint32_t environment_part = 0;
+  std::uint64_t environment_triangle = 0;
+  std::uint32_t object_triangle = 0;
+  bool operator==(const Contact&) const = default;
+};
+
+/// What one step did (the counters that explain its time).
+struct StepCounters {
+  std::uint32_t tets_crossed = 0;   ///< by the walk that located the box's centre
+  std::uint32_t tets_visited = 0;   ///< by the box search
+  std::uint32_t tets_overlapping = 0;
+  std::uint32_t shards_touched = 0;
+  std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
+  std::uint64_t candidates = 0;     ///< phase I: shard triangles meeting the object's box
+  std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
+  double locate_seconds = 0;
+  double search_seconds = 0;
+  double shard_seconds = 0;         ///< acquiring shards (page-ins included)
+  double test_seconds = 0;          ///< phase I and II
+};
+
+struct QueryResult {
+  bool collides = false;
+  /// first_hit: the first contact found; all_contacts: every pair (unordered).
+  std::vector<Contact> contacts;
+  /// The object's box lies entirely outside the model's coarse mesh (nothing to touch).
+  bool outside_model = false;
+  geometry::Box world_box;
+  StepCounters counters;
+};
+
+class FlyingObject {
+ public:
+  /// @throw InputError for an empty object or non-finite coordinates (as ObjectBVH).
+  FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object);
+  ~FlyingObject();
+  FlyingObject(FlyingObject&&) noexcept;
+  FlyingObject& operator=(FlyingObject&&) noexcept;
+
+  /// One step at `pose`. Reuses `result`'s buffers.
+  /// @throw InputError for a non-finite or non-unit pose; what the shard cache throws (a
+  ///        budget smaller than one shard, I/O and checksum errors naming the index).
+  void query(const Pose& pose, const QueryOptions& options, QueryResult& result);
+  QueryResult query(const Pose& pose, const QueryOptions& options = {}) {
+    QueryResult result;
+    query(pose, options, result);
+    return result;
+  }
+
+  /// The world box of the object at `pose` (hill-climbing on the hull), slightly enlarged to
+  /// cover the rounding of the placement.
+  geometry::Box world_box(const Pose& pose);
+
+  const TriangleSoup& object() const { return object_; }
+  std::size_t hull_vertex_count() const { return hull_vertices_.size(); }
+
+ private:
+  void place(const Pose& pose);
+  const Vec3& world_vertex(std::uint32_t v);
+  geometry::Triangle world_triangle(std::uint32_t t);
+
+  std::shared_ptr<const CollisionIndex> index_;
+  TriangleSoup object_;
+  geometry::ObjectBVH bvh_;
+  double object_radius_ = 0;  ///< largest |x| over the object's vertices (object frame)
+  // The convex hull as a vertex graph: object vertex ids and neighbour lists (CSR).
+  std::vector<std::uint32_t> hull_vertices_;
+  std::vector<std::uint32_t> hull_offsets_, hull_neighbours_;  // indices into hull_vertices_
+  std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
+
+  // Per-step state.
+  std::array<double, 9> rotation_{};
+  Vec3 translation_{};
+  std::uint64_t step_ = 0;
+  std::vector<Vec3> world_;
+  std::vector<std::uint64_t> world_step_;
+  std::uint32_t last_tet_ = 0;
+  bool have_previous_ = false;
+  Vec3 previous_centre_{};
+  BoxSearchScratch search_;
+  BoxSearchScratch prefetch_search_;
+  std::vector<std::uint32_t> shards_;
+  std::vector<std::uint32_t> hints_;
+};
+
+}  // namespace tetrapage

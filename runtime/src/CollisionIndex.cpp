@@ -1,0 +1,51 @@
+#include "tetrapage/runtime/CollisionIndex.h"
+
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage {
+
+CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndexOptions options)
+    : reader_(path), options_(options) {
+  if (options_.memory_budget_bytes == 0) throw InputError("the shard memory budget must be positive");
+  mesh_ = reader_.read_mesh();
+  for (const auto& v : mesh_.vertices) mesh_bounds_.extend(v);
+  tet_shard_ = reader_.read_table_uint32("tet_shard");
+  const std::string where = path.string() + ": ";
+  if (tet_shard_.size() != mesh_.tet_count())
+    throw FormatError(where + "/tables/tet_shard has " + std::to_string(tet_shard_.size()) +
+                      " entries for " + std::to_string(mesh_.tet_count()) + " tets");
+  if (mesh_.tet_count() == 0) throw FormatError(where + "the coarse mesh has no tet");
+  const std::uint32_t shards = reader_.shard_count();
+  for (std::size_t t = 0; t < tet_shard_.size(); ++t)
+    if (tet_shard_[t] != TetMesh::no_neighbour && tet_shard_[t] >= shards)
+      throw FormatError(where + "/tables/tet_shard names shard " + std::to_string(tet_shard_[t]) + " for tet " +
+                        std::to_string(t) + ", but there are " + std::to_string(shards) + " shards");
+  for (std::size_t t = 0; t < mesh_.tet_count(); ++t)
+    for (int i = 0; i < 4; ++i) {
+      if (mesh_.tets[t][i] >= mesh_.vertices.size())
+        throw FormatError(where + "tet " + std::to_string(t) + " names vertex " + std::to_string(mesh_.tets[t][i]));
+      const std::uint32_t n = mesh_.neighbours[t][i];
+      if (n != TetMesh::no_neighbour && n >= mesh_.tet_count())
+        throw FormatError(where + "tet " + std::to_string(t) + " names neighbour " + std::to_string(n));
+    }
+  shard_bytes_.resize(shards);
+  for (std::uint32_t s = 0; s < shards; ++s) {
+    // The decoded shard holds its payload's arrays plus the object itself: announce an upper
+    // bound so that the cache reserves enough before loading.
+    shard_bytes_[s] = reader_.shard_size(s) + 4096;
+    total_shard_bytes_ += shard_bytes_[s];
+  }
+  ShardCacheOptions cache_options;
+  cache_options.prefetch_threads = options_.prefetch ? std::max<std::size_t>(1, options_.prefetch_threads) : 0;
+  const IndexReader* reader = &reader_;
+  cache_ = std::make_unique<ShardCache<Shard>>(
+      options_.memory_budget_bytes,
+      [reader](std::uint32_t shard) {
+        return std::make_shared<const Shard>(Shard::decode(reader->read_shard(shard), "shard " + std::to_string(shard)));
+      },
+      shards, [this](std::uint32_t shard) { return shard_bytes_[shard]; }, cache_options);
+}
+
+CollisionIndex::~CollisionIndex() = default;
+
+}  // namespace tetrapage

@@ -1,0 +1,259 @@
+#include "tetrapage/runtime/FlyingObject.h"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/convex_hull_3.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/geometry/TriangleTriangle.h"
+
+namespace tetrapage {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Hill-climbing pays off on objects with many hull vertices; tiny ones are placed whole.
+constexpr std::size_t kHillClimbMinimum = 32;
+
+}  // namespace
+
+FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
+    : index_(std::move(index)), object_(std::move(object)), bvh_(object_) {
+  if (!index_) throw InputError("a flying object needs an index");
+  for (const auto& v : object_.vertices)
+    object_radius_ = std::max(object_radius_, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+  world_.resize(object_.vertices.size());
+  world_step_.assign(object_.vertices.size(), ~std::uint64_t{0});
+
+  // The hull's vertex graph, for hill-climbing the world box. Vertices not on any triangle
+  // do not matter; a flat object has no 3D hull and is placed whole.
+  std::vector<Kernel::Point_3> points;
+  std::map<std::array<double, 3>, std::uint32_t> id_of;
+  for (const auto& t : object_.triangles)
+    for (const auto v : t)
+      if (id_of.emplace(object_.vertices[v], v).second)
+        points.emplace_back(object_.vertices[v][0], object_.vertices[v][1], object_.vertices[v][2]);
+  if (points.size() >= kHillClimbMinimum) {
+    CGAL::Surface_mesh<Kernel::Point_3> hull;
+    CGAL::convex_hull_3(points.begin(), points.end(), hull);
+    if (hull.number_of_faces() > 0) {
+      std::map<CGAL::Surface_mesh<Kernel::Point_3>::Vertex_index, std::uint32_t> position;
+      for (const auto v : hull.vertices()) {
+        const auto& p = hull.point(v);
+        position[v] = std::uint32_t(hull_vertices_.size());
+        hull_vertices_.push_back(id_of.at({p.x(), p.y(), p.z()}));
+      }
+      hull_offsets_.push_back(0);
+      for (const auto v : hull.vertices()) {
+        for (const auto h : CGAL::halfedges_around_target(hull.halfedge(v), hull))
+          hull_neighbours_.push_back(position.at(hull.source(h)));
+        hull_offsets_.push_back(std::uint32_t(hull_neighbours_.size()));
+      }
+    }
+  }
+  if (hull_vertices_.empty()) {
+    // No usable hull: every vertex, no graph (world_box scans them all).
+    for (const auto& [point, id] : id_of) hull_vertices_.push_back(id);
+  }
+}
+
+FlyingObject::~FlyingObject() = default;
+FlyingObject::FlyingObject(FlyingObject&&) noexcept = default;
+FlyingObject& FlyingObject::operator=(FlyingObject&&) noexcept = default;
+
+void FlyingObject::place(const Pose& pose) {
+  const double n = pose.rotation[0] * pose.rotation[0] + pose.rotation[1] * pose.rotation[1] +
+                   pose.rotation[2] * pose.rotation[2] + pose.rotation[3] * pose.rotation[3];
+  if (!(std::isfinite(pose.translation[0]) && std::isfinite(pose.translation[1]) &&
+        std::isfinite(pose.translation[2])) ||
+      !std::isfinite(n) || std::fabs(n - 1) > 1e-6) {
+    char text[200];
+    std::snprintf(text, sizeof text, "invalid pose: translation (%g, %g, %g), quaternion (%g, %g, %g, %g)",
+                  pose.translation[0], pose.translation[1], pose.translation[2], pose.rotation[0],
+                  pose.rotation[1], pose.rotation[2], pose.rotation[3]);
+    throw InputError(text);
+  }
+  rotation_ = rotation_matrix(pose.rotation);
+  translation_ = pose.translation;
+  ++step_;
+}
+
+const Vec3& FlyingObject::world_vertex(std::uint32_t v) {
+  if (world_step_[v] != step_) {
+    world_[v] = apply_pose(rotation_, translation_, object_.vertices[v]);
+    world_step_[v] = step_;
+  }
+  return world_[v];
+}
+
+geometry::Triangle FlyingObject::world_triangle(std::uint32_t t) {
+  const auto& c = object_.triangles[t];
+  return {world_vertex(c[0]), world_vertex(c[1]), world_vertex(c[2])};
+}
+
+geometry::Box FlyingObject::world_box(const Pose& pose) {
+  place(pose);
+  geometry::Box box;
+  if (hull_offsets_.empty()) {
+    for (const auto v : hull_vertices_) box.extend(world_vertex(v));
+  } else {
+    // Per axis and side, climb from the last extreme to a vertex no neighbour beats: on a
+    // convex polytope a local extreme of a linear function is the global one.
+    for (int k = 0; k < 6; ++k) {
+      const int axis = k / 2;
+      const double sign = k % 2 == 0 ? -1.0 : 1.0;
+      std::uint32_t at = extreme_[k];
+      double best = sign * world_vertex(hull_vertices_[at])[axis];
+      for (bool moved = true; moved;) {
+        moved = false;
+        for (std::uint32_t i = hull_offsets_[at]; i < hull_offsets_[at + 1]; ++i) {
+          const std::uint32_t next = hull_neighbours_[i];
+          const double value = sign * world_vertex(hull_vertices_[next])[axis];
+          if (value > best) best = value, at = next, moved = true;
+        }
+      }
+      extreme_[k] = at;
+      box.extend(world_vertex(hull_vertices_[at]));
+    }
+  }
+  // The placement rounds each coordinate; rounded values can make a near-tie climb stop one
+  // vertex short. Grow the box far beyond those roundings (it only prunes).
+  const double magnitude = object_radius_ + std::max({std::fabs(translation_[0]), std::fabs(translation_[1]),
+                                                      std::fabs(translation_[2])});
+  const double margin = magnitude * 0x1p-40;
+  for (int a = 0; a < 3; ++a) box.lo[a] -= margin, box.hi[a] += margin;
+  return box;
+}
+
+void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryResult& result) {
+  result.collides = false;
+  result.contacts.clear();
+  result.outside_model = false;
+  result.counters = {};
+  StepCounters& counters = result.counters;
+  const CollisionIndex& index = *index_;
+  const TetMesh& mesh = index.mesh();
+
+  auto start = Clock::now();
+  geometry::Box box = world_box(pose);
+  // Environment triangles within the accuracy's reach of the object count: grow the box.
+  const double reach = geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
+  if (reach > 0)
+    for (int a = 0; a < 3; ++a) box.lo[a] -= reach, box.hi[a] += reach;
+  result.world_box = box;
+  if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
+    result.outside_model = true;
+    counters.locate_seconds = seconds_since(start);
+    have_previous_ = false;
+    return;
+  }
+
+  // 2. Locate: the box's centre, clamped into the mesh's box, from the previous tet.
+  Vec3 centre = box.center();
+  for (int a = 0; a < 3; ++a)
+    centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
+  const WalkResult located = locate_point(mesh, last_tet_, centre);
+  counters.tets_crossed = located.tets_crossed;
+  if (located.tet == TetMesh::no_neighbour) {
+    // The mesh is convex and covers its box only up to its hull: a clamped centre can still
+    // fall outside. Such a box meets the model's empty margin only.
+    result.outside_model = true;
+    counters.locate_seconds = seconds_since(start);
+    return;
+  }
+  last_tet_ = located.tet;
+  counters.locate_seconds = seconds_since(start);
+
+  // 3. The tets overlapping the box.
+  start = Clock::now();
+  const BoxSearchResult found = tets_overlapping_box(mesh, located.tet, box, search_);
+  counters.tets_visited = found.tets_visited;
+  counters.tets_overlapping = std::uint32_t(found.tets.size());
+  shards_.clear();
+  for (const std::uint32_t tet : found.tets) {
+    const std::uint32_t shard = index.shard_of_tet(tet);
+    if (shard != TetMesh::no_neighbour) shards_.push_back(shard);
+  }
+  counters.search_seconds = seconds_since(start);
+
+  // 4. Prefetch where the motion heads: the box moved one more step ahead.
+  if (index.options().prefetch && have_previous_) {
+    const Vec3 now = box.center();
+    geometry::Box ahead = box;
+    for (int a = 0; a < 3; ++a) {
+      const double d = now[a] - previous_centre_[a];
+      ahead.lo[a] += d, ahead.hi[a] += d;
+    }
+    Vec3 ahead_centre = ahead.center();
+    for (int a = 0; a < 3; ++a)
+      ahead_centre[a] = std::clamp(ahead_centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
+    const WalkResult ahead_tet = locate_point(mesh, located.tet, ahead_centre);
+    if (ahead_tet.tet != TetMesh::no_neighbour && geometry::boxes_overlap(ahead, mesh.bounds(ahead_tet.tet))) {
+      hints_.clear();
+      for (const std::uint32_t tet : tets_overlapping_box(mesh, ahead_tet.tet, ahead, prefetch_search_).tets) {
+        const std::uint32_t shard = index.shard_of_tet(tet);
+        if (shard != TetMesh::no_neighbour && !index.cache().contains(shard)) hints_.push_back(shard);
+      }
+      if (!hints_.empty()) index.cache().prefetch(hints_);
+    }
+  }
+  previous_centre_ = box.center();
+  have_previous_ = true;
+
+  // 5. Phase I and II, one pinned shard at a time (the working set of a step is one shard).
+  const bool all = options.mode == QueryMode::all_contacts;
+  for (const std::uint32_t shard_id : shards_) {
+    auto acquire_start = Clock::now();
+    const std::uint64_t misses_before = index.cache().miss_count();
+    auto pin = index.cache().acquire(shard_id);
+    counters.shard_misses += std::uint32_t(index.cache().miss_count() - misses_before);
+    ++counters.shards_touched;
+    counters.shard_seconds += seconds_since(acquire_start);
+    const auto test_start = Clock::now();
+    const Shard& shard = *pin;
+    bool stop = false;
+    shard.for_each_candidate(box, [&](std::uint32_t local) {
+      if (stop) return;  // the shard query cannot be cut short; skip the rest
+      ++counters.candidates;
+      const geometry::Triangle environment = shard.triangle(local);
+      // The environment triangle in the object's frame (rounded: used to prune only).
+      geometry::Box query;
+      for (const auto& p : environment) {
+        const Vec3 d{p[0] - translation_[0], p[1] - translation_[1], p[2] - translation_[2]};
+        const Vec3 local_point{rotation_[0] * d[0] + rotation_[3] * d[1] + rotation_[6] * d[2],
+                               rotation_[1] * d[0] + rotation_[4] * d[1] + rotation_[7] * d[2],
+                               rotation_[2] * d[0] + rotation_[5] * d[1] + rotation_[8] * d[2]};
+        query.extend(local_point);
+      }
+      // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
+      double magnitude = object_radius_;
+      for (const auto& p : environment)
+        for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
+      const double grow = reach + magnitude * 0x1p-40;
+      for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
+      bvh_.for_each_in_box(query, [&](std::uint32_t object_triangle) {
+        ++counters.triangle_tests;
+        if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;
+        result.collides = true;
+        if (all || result.contacts.empty())
+          result.contacts.push_back({shard.part_id(local), shard.triangle_id(local), object_triangle});
+        if (!all) stop = true;
+        return all;
+      });
+    });
+    counters.test_seconds += seconds_since(test_start);
+    if (stop) break;
+  }
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,273 @@
+// The paged runtime against the exact oracle (tools' ReferenceCollider: CGAL AABB tree with
+// Epick predicates, sharing no code with the runtime) on billiard flights through scenes,
+// tetras and terrains; a tight budget gives the same answers and never exceeds itself;
+// several threads agree with one; bad poses and damaged indexes fail cleanly.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <thread>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/geometry/TriangleTriangle.h"
+#include "tetrapage/tools/FlightGenerator.h"
+#include "tetrapage/tools/MeshLibrary.h"
+#include "tetrapage/tools/ObjectGenerator.h"
+#include "tetrapage/tools/ReferenceCollider.h"
+#include "tetrapage/tools/SceneGenerator.h"
+#include "tetrapage/tools/TerrainGenerator.h"
+#include "tetrapage/tools/TetrasGenerator.h"
+
+namespace tetrapage {
+namespace {
+
+namespace fs = std::filesystem;
+
+const MeshLibrary& library() {
+  static const MeshLibrary instance = MeshLibrary::load_default();
+  return instance;
+}
+
+struct World {
+  fs::path environment_path, index_path;
+  TriangleSoup environment, object;
+  Flight flight;
+};
+
+enum class Kind { scene, tetras, terrain };
+
+// Generates an environment and an object, preprocesses (double storage: the stored geometry
+// is the input's, so exact answers must equal the oracle's), and flies a billiard path.
+World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triangles, std::size_t steps,
+                 std::uint64_t seed, std::size_t region_triangles = 400) {
+  const std::string name = kind == Kind::scene ? "scene" : (kind == Kind::tetras ? "tetras" : "terrain");
+  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "flying" / (name + std::to_string(seed));
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  World world;
+  world.environment_path = folder / "environment.ply";
+  {
+    MeshWriter writer(world.environment_path);
+    if (kind == Kind::scene) {
+      SceneOptions options;
+      options.triangles = triangles;
+      options.seed = seed;
+      generate_scene(library(), options, writer);
+    } else if (kind == Kind::tetras) {
+      TetrasOptions options;
+      options.triangles = triangles;
+      options.seed = seed;
+      generate_tetras(options, writer);
+    } else {
+      TerrainOptions options;
+      options.triangles = triangles;
+      options.seed = seed;
+      generate_terrain(options, writer);
+    }
+    writer.commit();
+  }
+  world.environment = read_mesh(world.environment_path);
+  ObjectOptions object_options;
+  object_options.triangles = object_triangles;
+  object_options.seed = seed;
+  world.object = generate_object(object_options, &library()).soup;
+  const ReferenceCollider oracle(world.environment, world.object);
+  FlightOptions flight_options;
+  flight_options.steps = steps;
+  flight_options.seed = seed;
+  world.flight = generate_billiard_flight(oracle, flight_options);
+  world.index_path = folder / "environment.tpi";
+  PreprocessOptions options;
+  options.region_triangles = region_triangles;
+  options.precision = StoredPrecision::float64;
+  preprocess({world.environment_path}, world.index_path, options);
+  return world;
+}
+
+std::vector<std::uint8_t> fly(const World& world, CollisionIndexOptions options, std::uint64_t* peak = nullptr) {
+  auto index = std::make_shared<const CollisionIndex>(world.index_path, options);
+  FlyingObject object(index, world.object);
+  std::vector<std::uint8_t> answers;
+  QueryResult result;
+  for (const Pose& pose : world.flight.poses) {
+    object.query(pose, {}, result);
+    answers.push_back(result.collides ? 1 : 0);
+    // The budget is a promise at every step.
+    EXPECT_LE(index->cache().peak_resident_bytes(), options.memory_budget_bytes);
+  }
+  if (peak) *peak = index->cache().peak_resident_bytes();
+  return answers;
+}
+
+void expect_same_answers(const std::vector<std::uint8_t>& got, const World& world, const std::string& what) {
+  ASSERT_EQ(got.size(), world.flight.collides.size());
+  std::size_t wrong = 0, collisions = 0;
+  for (std::size_t i = 0; i < got.size(); ++i) {
+    collisions += world.flight.collides[i];
+    if (got[i] != world.flight.collides[i] && ++wrong <= 5)
+      ADD_FAILURE() << what << ": step " << i << " runtime " << int(got[i]) << " oracle " << int(world.flight.collides[i]);
+  }
+  EXPECT_EQ(wrong, 0u) << what;
+  EXPECT_GT(collisions, 0u) << what << ": the flight must test collisions, not only free space";
+}
+
+TEST(FlyingObject, ExactAnswersEqualTheOracleOnScenesTetrasAndTerrains) {
+  const World scene = make_world(Kind::scene, 30000, 500, 1500, 1);
+  expect_same_answers(fly(scene, {}), scene, "scene");
+  const World tetras = make_world(Kind::tetras, 4000, 116, 1500, 2, 200);
+  expect_same_answers(fly(tetras, {}), tetras, "tetras");
+  const World terrain = make_world(Kind::terrain, 8000, 116, 1500, 3);
+  expect_same_answers(fly(terrain, {}), terrain, "terrain");
+}
+
+TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
+  const World world = make_world(Kind::scene, 10000, 116, 400, 4, 200);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+  FlyingObject object(index, world.object);
+  QueryOptions all;
+  all.mode = QueryMode::all_contacts;
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i) {
+    const Pose& pose = world.flight.poses[i];
+    const QueryResult first = object.query(pose);
+    const QueryResult every = object.query(pose, all);
+    ASSERT_EQ(first.collides, every.collides);
+    ASSERT_EQ(every.collides, !every.contacts.empty());
+    if (!every.collides) continue;
+    // Each contact pair really touches (exact test on the same world coordinates), and
+    // none is repeated.
+    std::set<std::pair<std::uint64_t, std::uint32_t>> seen;
+    for (const Contact& c : every.contacts) {
+      EXPECT_TRUE(seen.insert({c.environment_triangle, c.object_triangle}).second);
+      const auto e = world.environment.corners(c.environment_triangle);
+      const auto o = world.object.triangles[c.object_triangle];
+      const geometry::Triangle placed{apply_pose(pose, world.object.vertices[o[0]]),
+                                      apply_pose(pose, world.object.vertices[o[1]]),
+                                      apply_pose(pose, world.object.vertices[o[2]])};
+      EXPECT_TRUE(geometry::triangles_intersect(e, placed)) << "step " << i;
+    }
+    // Brute force over every environment triangle near the object: the same pairs.
+    std::size_t expected = 0;
+    const auto box = every.world_box;
+    for (std::size_t t = 0; t < world.environment.triangle_count(); ++t) {
+      const auto e = world.environment.corners(t);
+      if (!geometry::boxes_overlap(geometry::box_of(e), box)) continue;
+      for (std::uint32_t k = 0; k < world.object.triangle_count(); ++k) {
+        const auto o = world.object.triangles[k];
+        const geometry::Triangle placed{apply_pose(pose, world.object.vertices[o[0]]),
+                                        apply_pose(pose, world.object.vertices[o[1]]),
+                                        apply_pose(pose, world.object.vertices[o[2]])};
+        expected += geometry::triangles_intersect(e, placed);
+      }
+    }
+    EXPECT_EQ(every.contacts.size(), expected) << "step " << i;
+  }
+}
+
+TEST(FlyingObject, ATightBudgetGivesTheSameAnswersWithinItself) {
+  const World world = make_world(Kind::scene, 30000, 500, 1500, 5, 200);
+  const std::vector<std::uint8_t> unlimited = fly(world, {});
+  auto probe = std::make_shared<const CollisionIndex>(world.index_path);
+  CollisionIndexOptions tight;
+  tight.memory_budget_bytes = probe->total_shard_bytes() / 20;  // 5 %
+  std::uint64_t peak = 0;
+  for (const bool prefetch : {false, true}) {
+    tight.prefetch = prefetch;
+    const std::vector<std::uint8_t> paged = fly(world, tight, &peak);
+    EXPECT_EQ(paged, unlimited) << "prefetch " << prefetch;
+    EXPECT_LE(peak, tight.memory_budget_bytes);
+    EXPECT_GT(peak, 0u);
+  }
+  expect_same_answers(unlimited, world, "unlimited");
+}
+
+TEST(FlyingObject, SeveralThreadsAgreeWithOne) {
+  const World world = make_world(Kind::scene, 20000, 116, 800, 6, 200);
+  const std::vector<std::uint8_t> alone = fly(world, {});
+  CollisionIndexOptions options;
+  options.memory_budget_bytes = std::make_shared<const CollisionIndex>(world.index_path)->total_shard_bytes() / 8;
+  auto index = std::make_shared<const CollisionIndex>(world.index_path, options);
+  constexpr int kThreads = 3;
+  std::vector<std::vector<std::uint8_t>> answers(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      FlyingObject object(index, world.object);
+      QueryResult result;
+      // Each thread flies the path from a different start, wrapping around.
+      const std::size_t n = world.flight.poses.size();
+      answers[t].assign(n, 0);
+      for (std::size_t k = 0; k < n; ++k) {
+        const std::size_t i = (k + std::size_t(t) * n / kThreads) % n;
+        try {
+          object.query(world.flight.poses[i], {}, result);
+        } catch (const InputError&) {
+          // The budget may be too small for all threads' pins at once; retry alone.
+          object.query(world.flight.poses[i], {}, result);
+        }
+        answers[t][i] = result.collides;
+      }
+    });
+  for (auto& thread : threads) thread.join();
+  for (int t = 0; t < kThreads; ++t) EXPECT_EQ(answers[t], alone) << "thread " << t;
+  EXPECT_LE(index->cache().peak_resident_bytes(), options.memory_budget_bytes);
+}
+
+TEST(FlyingObject, BadPosesAndFarPoses) {
+  const World world = make_world(Kind::tetras, 2000, 4, 50, 7, 200);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+  FlyingObject object(index, world.object);
+  Pose nan_pose;
+  nan_pose.translation = {std::nan(""), 0, 0};
+  EXPECT_THROW(object.query(nan_pose), InputError);
+  Pose bad_rotation;
+  bad_rotation.rotation = {2, 0, 0, 0};
+  EXPECT_THROW(object.query(bad_rotation), InputError);
+  for (const double far : {10.0, -1e6, 1e12}) {
+    Pose pose;
+    pose.translation = {far, 0.5, 0.5};
+    const QueryResult result = object.query(pose);
+    EXPECT_FALSE(result.collides);
+    EXPECT_TRUE(result.outside_model);
+  }
+  // Back inside after leaving: the walk restarts and answers again.
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i)
+    EXPECT_EQ(object.query(world.flight.poses[i]).collides, bool(world.flight.collides[i])) << i;
+}
+
+TEST(FlyingObject, DamagedIndexesFailCleanly) {
+  const World world = make_world(Kind::tetras, 2000, 4, 20, 8, 200);
+  const fs::path folder = world.index_path.parent_path();
+  EXPECT_THROW(CollisionIndex(folder / "missing.tpi"), IoError);
+  const auto size = fs::file_size(world.index_path);
+  std::vector<char> bytes(size);
+  std::ifstream(world.index_path, std::ios::binary).read(bytes.data(), std::streamsize(size));
+  for (const double fraction : {0.0, 0.1, 0.5, 0.9, 0.999}) {
+    const fs::path truncated = folder / "truncated.tpi";
+    std::ofstream(truncated, std::ios::binary).write(bytes.data(), std::streamsize(double(size) * fraction));
+    EXPECT_THROW(CollisionIndex{truncated}, Error) << fraction;
+  }
+  // Bit flips anywhere: opening or flying throws tetrapage::Error, or answers as before
+  // (a flip in padding or unused metadata); never a crash.
+  for (std::size_t k = 1; k < 24; ++k) {
+    std::vector<char> flipped = bytes;
+    flipped[k * size / 24] ^= 0x5a;
+    const fs::path path = folder / "flipped.tpi";
+    std::ofstream(path, std::ios::binary).write(flipped.data(), std::streamsize(size));
+    try {
+      auto index = std::make_shared<const CollisionIndex>(path);
+      FlyingObject object(index, world.object);
+      for (const Pose& pose : world.flight.poses) object.query(pose);
+    } catch (const Error&) {
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tetrapage

@@ -1,0 +1,161 @@
+// `tetrapage fly`: fly a pose file through an index with the paged runtime.
+
+#include <chrono>
+#include <cstdio>
+
+#include "Commands.h"
+#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/MemoryUsage.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/tools/AnswerFile.h"
+#include "tetrapage/tools/LatencySummary.h"
+
+namespace tetrapage::cli {
+namespace {
+
+struct FlyArguments {
+  std::filesystem::path index, object, path, answers, check, report;
+  std::string memory = "256M";
+  std::string accuracy = "exact";
+  bool all_contacts = false;
+  bool no_prefetch = false;
+};
+
+void run_fly(const FlyArguments& args) {
+  for (const auto* output : {&args.answers, &args.report}) check_writable(*output);
+  QueryOptions query_options;
+  query_options.accuracy = geometry::parse_accuracy(args.accuracy);
+  query_options.mode = args.all_contacts ? QueryMode::all_contacts : QueryMode::first_hit;
+  CollisionIndexOptions index_options;
+  index_options.memory_budget_bytes = parse_byte_size(args.memory);
+  index_options.prefetch = !args.no_prefetch;
+
+  const TriangleSoup object_mesh = read_mesh(args.object);
+  const std::vector<Pose> poses = read_poses(args.path);
+  std::vector<std::uint8_t> expected;
+  if (!args.check.empty()) {
+    expected = read_answers(args.check);
+    if (expected.size() != poses.size())
+      throw InputError("answers '" + args.check.string() + "' have " + std::to_string(expected.size()) +
+                       " rows but the path has " + std::to_string(poses.size()) + " poses");
+  }
+  const auto open_start = std::chrono::steady_clock::now();
+  auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
+  FlyingObject object(index, object_mesh);
+  QueryResult result;
+  double first_answer_seconds = 0;
+
+  std::vector<std::uint8_t> answers(poses.size());
+  std::vector<double> seconds(poses.size());
+  std::uint64_t collisions = 0, disagreements = 0, outside = 0, contacts = 0;
+  std::uint64_t candidates = 0, triangle_tests = 0, tets_visited = 0, shards_touched = 0;
+  std::uint64_t peak_resident = 0;
+  Progress progress("flying", poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    object.query(poses[i], query_options, result);
+    const auto end = std::chrono::steady_clock::now();
+    seconds[i] = std::chrono::duration<double>(end - start).count();
+    if (i == 0) first_answer_seconds = std::chrono::duration<double>(end - open_start).count();
+    answers[i] = result.collides ? 1 : 0;
+    collisions += answers[i];
+    contacts += result.contacts.size();
+    outside += result.outside_model ? 1 : 0;
+    candidates += result.counters.candidates;
+    triangle_tests += result.counters.triangle_tests;
+    tets_visited += result.counters.tets_visited;
+    shards_touched += result.counters.shards_touched;
+    peak_resident = std::max(peak_resident, index->cache().peak_resident_bytes());
+    if (!expected.empty() && expected[i] != answers[i] && ++disagreements <= 10)
+      std::fprintf(stderr, "step %zu: fly says %d, '%s' says %d\n", i, answers[i], args.check.c_str(), expected[i]);
+    progress.advance();
+  }
+  progress.finish();
+  double total = 0;
+  for (double s : seconds) total += s;
+  const double steps_per_second = total > 0 ? double(poses.size()) / total : 0;
+  const auto latency = LatencySummary::of(seconds);
+  const ShardCacheCounters cache = index->cache().counters();
+  const double lookups = double(cache.hits + cache.misses);
+  const double hit_rate = lookups > 0 ? double(cache.hits) / lookups : 1.0;
+  const double steps = std::max<double>(1, double(poses.size()));
+  std::printf("fly (%s, %s): %zu steps, %llu collisions\n", args.accuracy.c_str(),
+              args.no_prefetch ? "no prefetch" : "prefetch", poses.size(), (unsigned long long)collisions);
+  std::printf("%.0f steps/s, latency p50 %.1f us, p95 %.1f us, p99 %.1f us, max %.1f us; open to first answer %.1f ms\n",
+              steps_per_second, latency.p50_us, latency.p95_us, latency.p99_us, latency.max_us,
+              first_answer_seconds * 1e3);
+  std::printf("shards: peak resident %s of budget %s (index shards %s), page-ins %llu (%s read), hit rate %.4f, "
+              "page-in p50 %.0f us p99 %.0f us\n",
+              format_byte_size(cache.peak_resident_bytes).c_str(), format_byte_size(index_options.memory_budget_bytes).c_str(),
+              format_byte_size(index->total_shard_bytes()).c_str(), (unsigned long long)cache.page_ins,
+              format_byte_size(cache.bytes_loaded).c_str(), hit_rate, cache.page_in_p50_us, cache.page_in_p99_us);
+  std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; peak RSS %s\n",
+              double(tets_visited) / steps, double(shards_touched) / steps, double(candidates) / steps,
+              double(triangle_tests) / steps, format_byte_size(peak_resident_bytes()).c_str());
+  if (!expected.empty())
+    std::printf("disagreements with %s: %llu\n", args.check.c_str(), (unsigned long long)disagreements);
+  if (!args.answers.empty()) write_answers(args.answers, answers);
+  if (!args.report.empty())
+    write_report(args.report, {{"command", "fly"},
+                               {"index", args.index.string()},
+                               {"accuracy", args.accuracy},
+                               {"prefetch", !args.no_prefetch},
+                               {"steps", poses.size()},
+                               {"collisions", collisions},
+                               {"contacts", contacts},
+                               {"steps_outside_model", outside},
+                               {"steps_per_second", steps_per_second},
+                               {"latency_us", latency.to_json()},
+                               {"open_to_first_answer_ms", first_answer_seconds * 1e3},
+                               {"budget_bytes", index_options.memory_budget_bytes},
+                               {"index_shard_bytes", index->total_shard_bytes()},
+                               {"peak_resident_shard_bytes", cache.peak_resident_bytes},
+                               {"peak_rss_bytes", peak_resident_bytes()},
+                               {"page_ins", cache.page_ins},
+                               {"bytes_read", cache.bytes_loaded},
+                               {"bytes_read_per_step", double(cache.bytes_loaded) / steps},
+                               {"cache_hit_rate", hit_rate},
+                               {"prefetch_loads", cache.prefetch_loads},
+                               {"prefetch_hits", cache.prefetch_hits},
+                               {"page_in_latency_us", {{"p50", cache.page_in_p50_us}, {"p99", cache.page_in_p99_us},
+                                                       {"max", cache.page_in_max_us}}},
+                               {"per_step", {{"tets_visited", double(tets_visited) / steps},
+                                             {"shards_touched", double(shards_touched) / steps},
+                                             {"candidates", double(candidates) / steps},
+                                             {"triangle_tests", double(triangle_tests) / steps}}},
+                               {"disagreements", disagreements}});
+  if (disagreements > 0)
+    throw Error(std::to_string(disagreements) + " answers disagree with '" + args.check.string() + "'");
+}
+
+}  // namespace
+
+void add_fly_command(CLI::App& app) {
+  auto args = std::make_shared<FlyArguments>();
+  auto* command = app.add_subcommand(
+      "fly",
+      "Fly a pose file through an index with the paged runtime: shards are paged in around the\n"
+      "object under --memory, and every pose is answered. Prints steps per second, latency\n"
+      "percentiles, page-ins, the cache hit rate and the collisions.");
+  command->add_option("index", args->index, "Index file (.tpi) from `tetrapage preprocess`")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--object", args->object, "Flying object mesh")->required()->check(CLI::ExistingFile);
+  command->add_option("--path", args->path, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz)")->required()->check(CLI::ExistingFile);
+  command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")->capture_default_str();
+  command->add_option("--accuracy", args->accuracy,
+                      "exact, double_eps, float_eps (optionally :EPSILON) or clearance:D")
+      ->capture_default_str();
+  command->add_flag("--all-contacts", args->all_contacts, "Collect every contact pair, not only the first hit");
+  command->add_flag("--no-prefetch", args->no_prefetch, "Disable the background prefetcher");
+  command->add_option("--answers", args->answers, "Write the answers (CSV step,collides)");
+  command->add_option("--check", args->check, "Compare with these answers; exit non-zero on any disagreement")
+      ->check(CLI::ExistingFile);
+  command->add_option("--report", args->report, "Write figures as JSON");
+  command->callback([args] { run_fly(*args); });
+}
+
+}  // namespace tetrapage::cli
