@@ -44,10 +44,21 @@ demo: build
 	  --steps 10000 --seed 1 -o $(DEMO_DIR)/flight.csv --answers $(DEMO_DIR)/answers.csv \
 	  --report $(DEMO_DIR)/flight.json
 	$(TETRAPAGE) replay $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
-	  --path $(DEMO_DIR)/flight.csv --check $(DEMO_DIR)/answers.csv --report $(DEMO_DIR)/replay.json
+	  --path $(DEMO_DIR)/flight.csv --report $(DEMO_DIR)/replay.json
+	$(TETRAPAGE) preprocess $(DEMO_DIR)/scene.ply -o $(DEMO_DIR)/scene.tpi --precision double \
+	  --report $(DEMO_DIR)/preprocess.json
+	$(TETRAPAGE) validate $(DEMO_DIR)/scene.tpi
+	$(TETRAPAGE) inspect $(DEMO_DIR)/scene.tpi
+	@echo "--- paged flight: a shard budget of 8 MiB, well under the index's shards ---"
+	$(TETRAPAGE) fly $(DEMO_DIR)/scene.tpi --object $(DEMO_DIR)/object.ply --path $(DEMO_DIR)/flight.csv \
+	  --memory 8M --check $(DEMO_DIR)/answers.csv --report $(DEMO_DIR)/fly.json
 
 bench: build
-	$(BUILD)/bench/tetrapage_bench_formats --benchmark_out=$(BUILD)/bench_formats.json --benchmark_out_format=json
+	@mkdir -p $(BUILD)/bench-results
+	for b in formats geometry index shard walk cache; do \
+	  $(BUILD)/bench/tetrapage_bench_$$b --benchmark_out=$(BUILD)/bench-results/$$b.json \
+	    --benchmark_out_format=json || exit 1; \
+	done
 
 format:
 	find formats runtime preprocess tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i
