@@ -202,49 +202,20 @@ template <class Visitor>
 void ObjectBVH::traverse(const Triangle& query, const Accuracy& accuracy, QueryCounters* counters,
                          Visitor&& visit) const {
   const Box exact_box = box_of(query);
+  // The grown box never drops a pair that triangles_collide accepts (collision_margin), so it
+  // prunes nodes and triangles alike.
   const double margin = collision_margin(accuracy, extent(exact_box), max_triangle_extent_);
   const Box box = margin > 0 ? inflated(exact_box, margin) : exact_box;
-  FloatBox q;
-  for (int k = 0; k < 3; ++k) {
-    q.lo[k] = round_down(box.lo[k]);
-    q.hi[k] = round_up(box.hi[k]);
-  }
-  auto overlaps = [&q](const Node& n) {
-    return n.lo[0] <= q.hi[0] && q.lo[0] <= n.hi[0] && n.lo[1] <= q.hi[1] && q.lo[1] <= n.hi[1] &&
-           n.lo[2] <= q.hi[2] && q.lo[2] <= n.hi[2];
-  };
   const bool exact = accuracy.mode == AccuracyMode::exact;
-  std::uint64_t visited = 0, tests = 0;
-  std::uint32_t stack[kMaxStack];
-  int top = 0;
-  if (overlaps(nodes_[0])) stack[top++] = 0;
-  while (top > 0) {
-    const std::uint32_t index = stack[--top];
-    const Node& node = nodes_[index];
-    ++visited;
-    if (node.count > 0) {
-      for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-        const Triangle& candidate = triangles_[i];
-        ++tests;
-        // In exact mode the box check is a shortcut of the exact test; the other modes do
-        // their own (grown) box checks inside triangles_collide.
-        const bool collides = exact ? boxes_overlap(exact_box, box_of(candidate)) &&
-                                          triangles_intersect(query, candidate)
+  for_each_in_box(
+      box,
+      [&](std::uint32_t index) {
+        const Triangle& candidate = triangle(index);
+        const bool collides = exact ? triangles_intersect(query, candidate)
                                     : triangles_collide(query, candidate, accuracy);
-        if (collides && !visit(original_[i])) {
-          top = 0;
-          break;
-        }
-      }
-      continue;
-    }
-    if (overlaps(nodes_[node.first])) stack[top++] = node.first;
-    if (overlaps(nodes_[index + 1])) stack[top++] = index + 1;
-  }
-  if (counters) {
-    counters->nodes_visited += visited;
-    counters->triangle_tests += tests;
-  }
+        return !collides || visit(index);
+      },
+      counters);
 }
 
 std::optional<std::uint32_t> ObjectBVH::first_hit(const Triangle& query, const Accuracy& accuracy,

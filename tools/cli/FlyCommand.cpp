@@ -10,6 +10,7 @@
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/tools/AnswerCheck.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/LatencySummary.h"
 
@@ -35,13 +36,7 @@ void run_fly(const FlyArguments& args) {
 
   const TriangleSoup object_mesh = read_mesh(args.object);
   const std::vector<Pose> poses = read_poses(args.path);
-  std::vector<std::uint8_t> expected;
-  if (!args.check.empty()) {
-    expected = read_answers(args.check);
-    if (expected.size() != poses.size())
-      throw InputError("answers '" + args.check.string() + "' have " + std::to_string(expected.size()) +
-                       " rows but the path has " + std::to_string(poses.size()) + " poses");
-  }
+  AnswerCheck check(args.check, poses.size(), "fly");
   const auto open_start = std::chrono::steady_clock::now();
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   FlyingObject object(index, object_mesh);
@@ -50,7 +45,7 @@ void run_fly(const FlyArguments& args) {
 
   std::vector<std::uint8_t> answers(poses.size());
   std::vector<double> seconds(poses.size());
-  std::uint64_t collisions = 0, disagreements = 0, outside = 0, contacts = 0;
+  std::uint64_t collisions = 0, outside = 0, contacts = 0;
   std::uint64_t candidates = 0, triangle_tests = 0, tets_visited = 0, shards_touched = 0;
   std::uint64_t peak_resident = 0;
   Progress progress("flying", poses.size());
@@ -69,8 +64,7 @@ void run_fly(const FlyArguments& args) {
     tets_visited += result.counters.tets_visited;
     shards_touched += result.counters.shards_touched;
     peak_resident = std::max(peak_resident, index->cache().peak_resident_bytes());
-    if (!expected.empty() && expected[i] != answers[i] && ++disagreements <= 10)
-      std::fprintf(stderr, "step %zu: fly says %d, '%s' says %d\n", i, answers[i], args.check.c_str(), expected[i]);
+    check.record(i, answers[i]);
     progress.advance();
   }
   progress.finish();
@@ -95,8 +89,6 @@ void run_fly(const FlyArguments& args) {
   std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; peak RSS %s\n",
               double(tets_visited) / steps, double(shards_touched) / steps, double(candidates) / steps,
               double(triangle_tests) / steps, format_byte_size(peak_resident_bytes()).c_str());
-  if (!expected.empty())
-    std::printf("disagreements with %s: %llu\n", args.check.c_str(), (unsigned long long)disagreements);
   if (!args.answers.empty()) write_answers(args.answers, answers);
   if (!args.report.empty())
     write_report(args.report, {{"command", "fly"},
@@ -126,9 +118,8 @@ void run_fly(const FlyArguments& args) {
                                              {"shards_touched", double(shards_touched) / steps},
                                              {"candidates", double(candidates) / steps},
                                              {"triangle_tests", double(triangle_tests) / steps}}},
-                               {"disagreements", disagreements}});
-  if (disagreements > 0)
-    throw Error(std::to_string(disagreements) + " answers disagree with '" + args.check.string() + "'");
+                               {"disagreements", check.disagreements()}});
+  check.finish();
 }
 
 }  // namespace

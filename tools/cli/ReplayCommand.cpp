@@ -7,6 +7,7 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/tools/AnswerCheck.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/LatencySummary.h"
 #include "tetrapage/tools/ReferenceCollider.h"
@@ -23,14 +24,7 @@ void run_replay(const ReplayArguments& args) {
   const TriangleSoup environment = load_inputs({args.environment});
   const TriangleSoup object = read_mesh(args.object);
   const std::vector<Pose> poses = read_poses(args.path);
-  std::vector<std::uint8_t> expected;
-  if (!args.check.empty()) {
-    expected = read_answers(args.check);
-    if (expected.size() != poses.size())
-      throw InputError("answers '" + args.check.string() + "' have " +
-                       std::to_string(expected.size()) + " rows but the path has " +
-                       std::to_string(poses.size()) + " poses");
-  }
+  AnswerCheck check(args.check, poses.size(), "reference");
   const auto build_start = std::chrono::steady_clock::now();
   const ReferenceCollider oracle(environment, object);
   const double build_seconds =
@@ -38,7 +32,7 @@ void run_replay(const ReplayArguments& args) {
 
   std::vector<std::uint8_t> answers(poses.size());
   std::vector<double> seconds(poses.size());
-  std::uint64_t collisions = 0, inside = 0, disagreements = 0;
+  std::uint64_t collisions = 0, inside = 0;
   Progress progress("replaying (reference)", poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
@@ -47,11 +41,7 @@ void run_replay(const ReplayArguments& args) {
     answers[i] = answer.collides ? 1 : 0;
     collisions += answers[i];
     inside += answer.object_inside ? 1 : 0;
-    if (!expected.empty() && expected[i] != answers[i]) {
-      if (++disagreements <= 10)
-        std::fprintf(stderr, "step %zu: reference says %d, '%s' says %d\n", i, answers[i],
-                     args.check.c_str(), expected[i]);
-    }
+    check.record(i, answers[i]);
     progress.advance();
   }
   progress.finish();
@@ -66,9 +56,6 @@ void run_replay(const ReplayArguments& args) {
       poses.size(), static_cast<unsigned long long>(collisions),
       static_cast<unsigned long long>(inside), steps_per_second, latency.p50_us, latency.p95_us,
       latency.p99_us, latency.max_us, build_seconds);
-  if (!expected.empty())
-    std::printf("disagreements with %s: %llu\n", args.check.c_str(),
-                static_cast<unsigned long long>(disagreements));
   if (!args.answers.empty()) write_answers(args.answers, answers);
   if (!args.report.empty())
     write_report(args.report, {{"command", "replay"},
@@ -78,10 +65,9 @@ void run_replay(const ReplayArguments& args) {
                                {"steps_per_second", steps_per_second},
                                {"latency_us", latency.to_json()},
                                {"build_seconds", build_seconds},
-                               {"disagreements", disagreements},
+                               {"disagreements", check.disagreements()},
                                {"peak_rss_bytes", peak_rss_bytes()}});
-  if (disagreements > 0)
-    throw Error(std::to_string(disagreements) + " answers disagree with '" + args.check.string() + "'");
+  check.finish();
 }
 
 }  // namespace
