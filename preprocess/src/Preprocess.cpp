@@ -331,6 +331,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   std::vector<std::uint32_t> tet_shard(tet_count, TetMesh::no_neighbour);
   std::vector<std::uint32_t> shard_tet, shard_triangles;
   std::vector<std::uint8_t> shard_kind;
+  std::vector<double> shard_bounds;  // 6 per shard: lo xyz, hi xyz, enclosing the stored triangles
   {
     StageClock clock(summary, "shards");
     const double query_extent = options.query_extent > 0 ? options.query_extent : [&] {
@@ -376,6 +377,21 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
       });
       for (std::size_t g = 0; g < groups; ++g) {
         const std::uint32_t tet = records[group_start[g]].tet;
+        // Stored vertices lie within the shard's rounding distance of the input ones: grow
+        // the input box by it (and a few ulps) so the runtime can skip shards unread.
+        BoundingBox bounds;
+        for (std::size_t i = group_start[g]; i < group_start[g + 1]; ++i)
+          for (const auto& p : records[i].triangle) bounds.extend(p);
+        for (int a = 0; a < 3; ++a) {
+          const double grow = built[g].max_rounding_distance +
+                              0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
+          shard_bounds.push_back(bounds.lo[a] - grow);
+        }
+        for (int a = 0; a < 3; ++a) {
+          const double grow = built[g].max_rounding_distance +
+                              0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
+          shard_bounds.push_back(bounds.hi[a] + grow);
+        }
         const std::uint32_t shard = writer.append_shard(built[g].payload);
         tet_shard[tet] = shard;
         shard_tet.push_back(tet);
@@ -401,6 +417,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     writer.write_table("shard_tet", std::span<const std::uint32_t>(shard_tet));
     writer.write_table("shard_kind", std::span<const std::uint8_t>(shard_kind));
     writer.write_table("shard_triangles", std::span<const std::uint32_t>(shard_triangles));
+    writer.write_table("shard_bounds", std::span<const double>(shard_bounds));
     IndexHeader header;
     header.precision = summary.precision;
     header.input_triangles = triangle_count;

@@ -28,6 +28,16 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
       if (n != TetMesh::no_neighbour && n >= mesh_.tet_count())
         throw FormatError(where + "tet " + std::to_string(t) + " names neighbour " + std::to_string(n));
     }
+  const auto bounds = reader_.read_table_double("shard_bounds");
+  if (bounds.size() != 6 * std::size_t(shards))
+    throw FormatError(where + "/tables/shard_bounds has " + std::to_string(bounds.size()) + " values for " +
+                      std::to_string(shards) + " shards (6 each)");
+  shard_bounds_.resize(shards);
+  for (std::uint32_t s = 0; s < shards; ++s)
+    for (int a = 0; a < 3; ++a) {
+      shard_bounds_[s].lo[a] = bounds[6 * s + a];
+      shard_bounds_[s].hi[a] = bounds[6 * s + 3 + a];
+    }
   shard_bytes_.resize(shards);
   for (std::uint32_t s = 0; s < shards; ++s) {
     // The decoded shard holds its payload's arrays plus the object itself: announce an upper

@@ -135,48 +135,26 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
   return box;
 }
 
-void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryResult& result) {
-  result.collides = false;
-  result.contacts.clear();
-  result.outside_model = false;
-  result.counters = {};
-  StepCounters& counters = result.counters;
+bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   const CollisionIndex& index = *index_;
   const TetMesh& mesh = index.mesh();
-
+  counters.searched = true;
   auto start = Clock::now();
-  geometry::Box box = world_box(pose);
-  // Environment triangles within the accuracy's reach of the object count: grow the box.
-  const double reach = geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
-  if (reach > 0)
-    for (int a = 0; a < 3; ++a) box.lo[a] -= reach, box.hi[a] += reach;
-  result.world_box = box;
-  if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
-    result.outside_model = true;
-    counters.locate_seconds = seconds_since(start);
-    have_previous_ = false;
-    return;
-  }
-
-  // 2. Locate: the box's centre, clamped into the mesh's box, from the previous tet.
+  // Grow by half the box's extent each side: a billiard object then crosses the margin in
+  // about ten steps of 0.005 for a 0.05 object, and re-searches that often.
+  const double grow = 0.5 * geometry::extent(box);
+  geometry::Box region = box;
+  for (int a = 0; a < 3; ++a) region.lo[a] -= grow, region.hi[a] += grow;
   Vec3 centre = box.center();
-  for (int a = 0; a < 3; ++a)
-    centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
+  for (int a = 0; a < 3; ++a) centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
   const WalkResult located = locate_point(mesh, last_tet_, centre);
   counters.tets_crossed = located.tets_crossed;
-  if (located.tet == TetMesh::no_neighbour) {
-    // The mesh is convex and covers its box only up to its hull: a clamped centre can still
-    // fall outside. Such a box meets the model's empty margin only.
-    result.outside_model = true;
-    counters.locate_seconds = seconds_since(start);
-    return;
-  }
-  last_tet_ = located.tet;
   counters.locate_seconds = seconds_since(start);
+  if (located.tet == TetMesh::no_neighbour) return false;
+  last_tet_ = located.tet;
 
-  // 3. The tets overlapping the box.
   start = Clock::now();
-  const BoxSearchResult found = tets_overlapping_box(mesh, located.tet, box, search_);
+  const BoxSearchResult found = tets_overlapping_box(mesh, located.tet, region, search_);
   counters.tets_visited = found.tets_visited;
   counters.tets_overlapping = std::uint32_t(found.tets.size());
   shards_.clear();
@@ -186,54 +164,92 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   }
   counters.search_seconds = seconds_since(start);
 
-  // 4. Prefetch where the motion heads: the box moved one more step ahead.
-  if (index.options().prefetch && have_previous_) {
-    const Vec3 now = box.center();
-    geometry::Box ahead = box;
-    for (int a = 0; a < 3; ++a) {
-      const double d = now[a] - previous_centre_[a];
-      ahead.lo[a] += d, ahead.hi[a] += d;
-    }
-    Vec3 ahead_centre = ahead.center();
-    for (int a = 0; a < 3; ++a)
-      ahead_centre[a] = std::clamp(ahead_centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
-    const WalkResult ahead_tet = locate_point(mesh, located.tet, ahead_centre);
-    if (ahead_tet.tet != TetMesh::no_neighbour && geometry::boxes_overlap(ahead, mesh.bounds(ahead_tet.tet))) {
-      hints_.clear();
-      for (const std::uint32_t tet : tets_overlapping_box(mesh, ahead_tet.tet, ahead, prefetch_search_).tets) {
-        const std::uint32_t shard = index.shard_of_tet(tet);
-        if (shard != TetMesh::no_neighbour && !index.cache().contains(shard)) hints_.push_back(shard);
-      }
-      if (!hints_.empty()) index.cache().prefetch(hints_);
-    }
-  }
-  previous_centre_ = box.center();
-  have_previous_ = true;
+  // Pins of the region's shards are taken when a step first needs them, and kept while the
+  // object stays in the region (unless the region outweighs an eighth of the budget, which
+  // other objects share: then each step pins one shard at a time).
+  pins_.clear();
+  std::uint64_t region_bytes = 0;
+  for (const std::uint32_t shard : shards_) region_bytes += index.shard_bytes(shard);
+  keep_pins_ = region_bytes <= index.options().memory_budget_bytes / 8;
+  if (keep_pins_) pins_.resize(shards_.size());
 
-  // 5. Phase I and II, one pinned shard at a time (the working set of a step is one shard).
+  if (index.options().prefetch && searched_valid_) {
+    // The next region, if the motion since the last search goes on.
+    geometry::Box next = region;
+    const Vec3 now = box.center();
+    for (int a = 0; a < 3; ++a) {
+      const double d = now[a] - searched_centre_[a];
+      next.lo[a] += d, next.hi[a] += d;
+    }
+    prefetch_ahead(next, located.tet);
+  }
+  searched_box_ = region;
+  searched_centre_ = box.center();
+  searched_valid_ = true;
+  return true;
+}
+
+void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet) {
+  const CollisionIndex& index = *index_;
+  const TetMesh& mesh = index.mesh();
+  Vec3 centre = next_region.center();
+  for (int a = 0; a < 3; ++a) centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
+  const WalkResult ahead = locate_point(mesh, from_tet, centre);
+  if (ahead.tet == TetMesh::no_neighbour || !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet))) return;
+  hints_.clear();
+  for (const std::uint32_t tet : tets_overlapping_box(mesh, ahead.tet, next_region, prefetch_search_).tets) {
+    const std::uint32_t shard = index.shard_of_tet(tet);
+    if (shard != TetMesh::no_neighbour && !index.cache().contains(shard)) hints_.push_back(shard);
+  }
+  if (!hints_.empty()) index.cache().prefetch(hints_);
+}
+
+void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryResult& result) {
+  result.collides = false;
+  result.contacts.clear();
+  result.outside_model = false;
+  result.counters = {};
+  StepCounters& counters = result.counters;
+  const CollisionIndex& index = *index_;
+
+  auto start = Clock::now();
+  geometry::Box box = world_box(pose);
+  // Environment triangles within the accuracy's reach of the object count: grow the box.
+  const double reach = geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
+  if (reach > 0)
+    for (int a = 0; a < 3; ++a) box.lo[a] -= reach, box.hi[a] += reach;
+  result.world_box = box;
+  counters.locate_seconds = seconds_since(start);
+  if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
+    result.outside_model = true;
+    return;
+  }
+  const bool inside_region = searched_valid_ && box.lo[0] >= searched_box_.lo[0] && box.lo[1] >= searched_box_.lo[1] &&
+                             box.lo[2] >= searched_box_.lo[2] && box.hi[0] <= searched_box_.hi[0] &&
+                             box.hi[1] <= searched_box_.hi[1] && box.hi[2] <= searched_box_.hi[2];
+  if (!inside_region && !search(box, counters)) {
+    // A centre outside the convex mesh: the box meets only the model's empty margin.
+    result.outside_model = true;
+    searched_valid_ = false;
+    return;
+  }
+
+  // Phase I and II over the region's shards whose bounds meet the box.
   const bool all = options.mode == QueryMode::all_contacts;
-  for (const std::uint32_t shard_id : shards_) {
-    auto acquire_start = Clock::now();
-    const std::uint64_t misses_before = index.cache().miss_count();
-    auto pin = index.cache().acquire(shard_id);
-    counters.shard_misses += std::uint32_t(index.cache().miss_count() - misses_before);
-    ++counters.shards_touched;
-    counters.shard_seconds += seconds_since(acquire_start);
+  bool stop = false;
+  auto test_shard = [&](const Shard& shard) {
     const auto test_start = Clock::now();
-    const Shard& shard = *pin;
-    bool stop = false;
     shard.for_each_candidate(box, [&](std::uint32_t local) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       ++counters.candidates;
       const geometry::Triangle environment = shard.triangle(local);
-      // The environment triangle in the object's frame (rounded: used to prune only).
+      // The environment triangle in the object's frame (rounded: it only prunes).
       geometry::Box query;
       for (const auto& p : environment) {
         const Vec3 d{p[0] - translation_[0], p[1] - translation_[1], p[2] - translation_[2]};
-        const Vec3 local_point{rotation_[0] * d[0] + rotation_[3] * d[1] + rotation_[6] * d[2],
-                               rotation_[1] * d[0] + rotation_[4] * d[1] + rotation_[7] * d[2],
-                               rotation_[2] * d[0] + rotation_[5] * d[1] + rotation_[8] * d[2]};
-        query.extend(local_point);
+        query.extend(Vec3{rotation_[0] * d[0] + rotation_[3] * d[1] + rotation_[6] * d[2],
+                          rotation_[1] * d[0] + rotation_[4] * d[1] + rotation_[7] * d[2],
+                          rotation_[2] * d[0] + rotation_[5] * d[1] + rotation_[8] * d[2]});
       }
       // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
       double magnitude = object_radius_;
@@ -252,7 +268,31 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       });
     });
     counters.test_seconds += seconds_since(test_start);
-    if (stop) break;
+  };
+  for (std::size_t k = 0; k < shards_.size() && !stop; ++k) {
+    const std::uint32_t shard_id = shards_[k];
+    // Shards whose stored triangles cannot meet the box are neither read nor pinned.
+    if (!geometry::boxes_overlap(box, index.shard_bounds(shard_id))) continue;
+    ++counters.shards_touched;
+    ShardCache<Shard>::Pin local_pin;
+    ShardCache<Shard>::Pin& pin = keep_pins_ ? pins_[k] : local_pin;
+    if (!pin) {
+      const auto acquire_start = Clock::now();
+      const std::uint64_t misses_before = index.cache().miss_count();
+      try {
+        pin = index.cache().acquire(shard_id);
+      } catch (const InputError&) {
+        if (!keep_pins_) throw;
+        // The budget cannot hold the region's pins after all: release them and go on one
+        // shard at a time.
+        keep_pins_ = false;
+        pins_.clear();
+        local_pin = index.cache().acquire(shard_id);
+      }
+      counters.shard_misses += std::uint32_t(index.cache().miss_count() - misses_before);
+      counters.shard_seconds += seconds_since(acquire_start);
+    }
+    test_shard(keep_pins_ ? *pins_[k] : *local_pin);
   }
 }
 

@@ -13,6 +13,7 @@
 #include "tetrapage/formats/TetMesh.h"
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/ShardCache.h"
+#include "tetrapage/runtime/geometry/Box.h"
 
 namespace tetrapage {
 
@@ -44,6 +45,10 @@ class CollisionIndex {
   /// The shard of a tet, or TetMesh::no_neighbour for an empty region.
   std::uint32_t shard_of_tet(std::uint32_t tet) const { return tet_shard_[tet]; }
   std::uint32_t shard_count() const { return std::uint32_t(shard_bytes_.size()); }
+  /// The bytes the cache reserves for a shard (an upper bound of its decoded size).
+  std::uint64_t shard_bytes(std::uint32_t shard) const { return shard_bytes_[shard]; }
+  /// A box enclosing the shard's stored triangles (without reading the shard).
+  const geometry::Box& shard_bounds(std::uint32_t shard) const { return shard_bounds_[shard]; }
   /// Decoded bytes of all shards (what "everything resident" costs).
   std::uint64_t total_shard_bytes() const { return total_shard_bytes_; }
 
@@ -56,6 +61,7 @@ class CollisionIndex {
   BoundingBox mesh_bounds_;
   std::vector<std::uint32_t> tet_shard_;
   std::vector<std::uint64_t> shard_bytes_;
+  std::vector<geometry::Box> shard_bounds_;
   std::uint64_t total_shard_bytes_ = 0;
   std::unique_ptr<ShardCache<Shard>> cache_;
 };

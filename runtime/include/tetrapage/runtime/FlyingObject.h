@@ -41,10 +41,11 @@ struct Contact {
 
 /// What one step did (the counters that explain its time).
 struct StepCounters {
+  bool searched = false;            ///< the box left the last searched region: walk + search ran
   std::uint32_t tets_crossed = 0;   ///< by the walk that located the box's centre
   std::uint32_t tets_visited = 0;   ///< by the box search
   std::uint32_t tets_overlapping = 0;
-  std::uint32_t shards_touched = 0;
+  std::uint32_t shards_touched = 0; ///< shards whose bounds met the object's box
   std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
   std::uint64_t candidates = 0;     ///< phase I: shard triangles meeting the object's box
   std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
@@ -91,6 +92,10 @@ class FlyingObject {
 
  private:
   void place(const Pose& pose);
+  // Walk, box search and pinning for a new searched region around `box`; false when the box
+  // lies outside the mesh.
+  bool search(const geometry::Box& box, StepCounters& counters);
+  void prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet);
   const Vec3& world_vertex(std::uint32_t v);
   geometry::Triangle world_triangle(std::uint32_t t);
 
@@ -110,11 +115,16 @@ class FlyingObject {
   std::vector<Vec3> world_;
   std::vector<std::uint64_t> world_step_;
   std::uint32_t last_tet_ = 0;
-  bool have_previous_ = false;
-  Vec3 previous_centre_{};
   BoxSearchScratch search_;
   BoxSearchScratch prefetch_search_;
+  // The searched region: a box grown around the object's box, its tets' shards, pinned while
+  // the object's box stays inside it (most steps then touch neither the mesh nor the cache).
+  geometry::Box searched_box_;
+  bool searched_valid_ = false;
+  Vec3 searched_centre_{};
   std::vector<std::uint32_t> shards_;
+  std::vector<ShardCache<Shard>::Pin> pins_;  ///< parallel to shards_; empty until needed
+  bool keep_pins_ = false;
   std::vector<std::uint32_t> hints_;
 };
 

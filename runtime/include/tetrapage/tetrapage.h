@@ -1,0 +1,203 @@
+/* tetrapage.h - the C API of the tetrapage runtime.
+ *
+ * Two opaque handles, each with create/release functions:
+ *  - tetrapage_index: an opened index file (the coarse mesh stays resident; shards are paged
+ *    in on demand under a byte budget that is never exceeded);
+ *  - tetrapage_object: a rigid flying object moving through one index; it remembers where it
+ *    was (queries along a motion are cheap) and the answer of its last query.
+ *
+ * Every function that can fail returns a tetrapage_status; on failure tetrapage_last_error()
+ * holds a one-line message naming the file, the element and the value at fault. No C++
+ * exception ever crosses this interface. Null handles and null output pointers are reported as
+ * TETRAPAGE_ERROR_INVALID_ARGUMENT, never dereferenced.
+ *
+ * Threads: an index may be shared by any number of objects used from different threads; one
+ * object is used from one thread at a time. Error messages are kept per thread.
+ *
+ * Typical use:
+ *
+ *   tetrapage_index* index = NULL;
+ *   tetrapage_object* object = NULL;
+ *   if (tetrapage_open("model.tpi", TETRAPAGE_DEFAULT_BUDGET_BYTES, &index) != TETRAPAGE_OK ||
+ *       tetrapage_object_create_from_file(index, "tool.ply", &object) != TETRAPAGE_OK) {
+ *     fprintf(stderr, "%s\n", tetrapage_last_error());
+ *     ...
+ *   }
+ *   const double pose[7] = {0.5, 0.5, 0.5, 1, 0, 0, 0};  // tx ty tz qw qx qy qz
+ *   int collides = 0;
+ *   tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0.0, 0, &collides);
+ *   tetrapage_object_destroy(object);
+ *   tetrapage_close(index);
+ */
+#ifndef TETRAPAGE_TETRAPAGE_H
+#define TETRAPAGE_TETRAPAGE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Status codes and messages                                                                   */
+
+typedef enum tetrapage_status {
+  TETRAPAGE_OK = 0,
+  /* A file could not be opened, read or written (missing, unreadable): tetrapage::IoError. */
+  TETRAPAGE_ERROR_IO = 1,
+  /* A file was readable but is not what its format requires (not an index, wrong version,
+     truncated, checksum mismatch, malformed mesh): tetrapage::FormatError. */
+  TETRAPAGE_ERROR_FORMAT = 2,
+  /* Well-formed but unusable input: NaN or infinite coordinates or poses, a non-unit
+     quaternion, indices out of range, an empty object, a zero budget, an invalid accuracy:
+     tetrapage::InputError. */
+  TETRAPAGE_ERROR_INPUT = 3,
+  /* A null handle or pointer where one is required. */
+  TETRAPAGE_ERROR_INVALID_ARGUMENT = 4,
+  /* Memory could not be allocated (std::bad_alloc). */
+  TETRAPAGE_ERROR_OUT_OF_MEMORY = 5,
+  /* Any other failure (another tetrapage::Error or an unexpected exception). */
+  TETRAPAGE_ERROR_INTERNAL = 6
+} tetrapage_status;
+
+/* The message of the last call on this thread that returned a status: empty ("") after a
+   success. The text stays valid until the next tetrapage call on this thread. Never null. */
+const char* tetrapage_last_error(void);
+
+/* A short constant name of a status ("ok", "I/O error", ...); "unknown status" for values
+   outside the enumeration. Never null. */
+const char* tetrapage_status_string(tetrapage_status status);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Index                                                                                       */
+
+typedef struct tetrapage_index tetrapage_index;
+
+/* The budget the C++ API uses by default: 256 MiB of decoded shards. */
+#define TETRAPAGE_DEFAULT_BUDGET_BYTES ((uint64_t)256 << 20)
+
+/* Opens an index file written by `tetrapage preprocess`, with a budget in bytes for the
+   decoded shards held in memory (must be positive; a background thread prefetches the shards
+   a motion heads for). On success *index receives a new handle; on failure it is set to
+   NULL.
+   Errors: TETRAPAGE_ERROR_IO (missing or unreadable file; the message names it),
+           TETRAPAGE_ERROR_FORMAT (not an index, wrong version, inconsistent tables),
+           TETRAPAGE_ERROR_INPUT (a zero budget), TETRAPAGE_ERROR_INVALID_ARGUMENT (null path
+           or index). */
+tetrapage_status tetrapage_open(const char* path, uint64_t budget_bytes, tetrapage_index** index);
+
+/* Releases the handle. Objects created from it stay usable: the index itself is freed with
+   the last of them. A null index is ignored. */
+void tetrapage_close(tetrapage_index* index);
+
+/* The box of the model's triangles as stored in the index: lo[3] and hi[3].
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument). */
+tetrapage_status tetrapage_index_bounds(const tetrapage_index* index, double lo[3], double hi[3]);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Flying objects                                                                              */
+
+typedef struct tetrapage_object tetrapage_object;
+
+/* Creates an object from a triangle mesh in its own coordinates: `vertices` holds
+   3 * vertex_count doubles (x, y, z per vertex), `triangles` 3 * triangle_count vertex
+   indices (0-based). The arrays are copied. On failure *object is set to NULL.
+   Errors: TETRAPAGE_ERROR_INPUT (no triangle, a non-finite coordinate, an index out of range),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument; vertices may be null only when
+           vertex_count is 0). */
+tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* vertices,
+                                         size_t vertex_count, const uint32_t* triangles,
+                                         size_t triangle_count, tetrapage_object** object);
+
+/* Creates an object from a mesh file (OBJ, PLY, OFF, STL, glTF/GLB, ...; all parts merged).
+   Errors: TETRAPAGE_ERROR_IO, TETRAPAGE_ERROR_FORMAT, TETRAPAGE_ERROR_INPUT (as the mesh
+           readers: the message names the file, the line or element and the value),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+tetrapage_status tetrapage_object_create_from_file(tetrapage_index* index, const char* path,
+                                                   tetrapage_object** object);
+
+/* Releases the object (and the index, if it was closed already). A null object is ignored. */
+void tetrapage_object_destroy(tetrapage_object* object);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Queries                                                                                     */
+
+/* How collisions are decided (see docs/USAGE.md, "Accuracy"). */
+typedef enum tetrapage_accuracy {
+  /* Exact signs on the stored coordinates; touching counts. `parameter` is ignored. */
+  TETRAPAGE_ACCURACY_EXACT = 0,
+  /* Epsilon-threshold floating tests in double / float; `parameter` is the relative epsilon,
+     0 for the default. Faster on some inputs, may answer wrongly near contact. */
+  TETRAPAGE_ACCURACY_DOUBLE_EPS = 1,
+  TETRAPAGE_ACCURACY_FLOAT_EPS = 2,
+  /* Everything within distance `parameter` (>= 0) of the environment counts. */
+  TETRAPAGE_ACCURACY_CLEARANCE = 3
+} tetrapage_accuracy;
+
+/* Parses the accuracy text the command line takes: "exact", "double_eps", "float_eps"
+   (optionally ":EPSILON"), "clearance:D".
+   Errors: TETRAPAGE_ERROR_INPUT (anything else; the message names the text),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* accuracy,
+                                          double* parameter);
+
+/* Places the object at `pose` and decides whether it touches the environment.
+   pose: tx, ty, tz, qw, qx, qy, qz (the pose-file order); it maps the object's coordinates x to
+   R(q) x + t, and q must be a unit quaternion (up to rounding).
+   all_contacts: 0 stops at the first contact found; non-zero collects every contact pair.
+   On success *collides is 1 or 0 and the contacts are kept in the object until its next
+   query (tetrapage_contact_count, tetrapage_get_contacts, tetrapage_last_query_info).
+   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, an invalid accuracy
+           or parameter, a budget smaller than one shard), TETRAPAGE_ERROR_IO /
+           TETRAPAGE_ERROR_FORMAT (a shard could not be read or failed its checksum),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT. After a failure the object holds no contact. */
+tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
+                                 tetrapage_accuracy accuracy, double parameter, int all_contacts,
+                                 int* collides);
+
+/* One contact: an environment triangle (its part and model-wide id) and an object triangle. */
+typedef struct tetrapage_contact {
+  uint64_t environment_triangle;
+  uint32_t environment_part;
+  uint32_t object_triangle;
+} tetrapage_contact;
+
+/* The number of contacts of the last successful query (first hit: 0 or 1).
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+tetrapage_status tetrapage_contact_count(const tetrapage_object* object, size_t* count);
+
+/* Copies the first min(capacity, count) contacts of the last query to `contacts` and their
+   number to *written. `contacts` may be null when capacity is 0.
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
+                                        tetrapage_contact* contacts, size_t capacity,
+                                        size_t* written);
+
+/* What the last query did: the counters that explain its time. */
+typedef struct tetrapage_query_info {
+  int collides;
+  /* The object's box lies entirely outside the model's coarse mesh. */
+  int outside_model;
+  /* The object's box in world coordinates. */
+  double world_lo[3];
+  double world_hi[3];
+  uint32_t tets_crossed;   /* by the walk that located the box */
+  uint32_t tets_visited;   /* by the search for the tets overlapping the box */
+  uint32_t shards_touched;
+  uint32_t shard_misses;   /* shards paged in synchronously */
+  uint64_t candidates;     /* environment triangles meeting the object's box */
+  uint64_t triangle_tests; /* triangle pair tests */
+  double seconds;          /* locate + search + shards + tests */
+} tetrapage_query_info;
+
+/* Fills *info for the last successful query (all zero before the first one).
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
+                                           tetrapage_query_info* info);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* TETRAPAGE_TETRAPAGE_H */

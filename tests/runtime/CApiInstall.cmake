@@ -1,0 +1,31 @@
+# Installs the build into a fresh prefix, then configures, builds and runs a consumer project
+# that finds it with find_package(tetrapage) and calls the C API.
+#   -DBUILD_DIR -DWORK -DCONSUMER (source folder) -DINDEX (an index to open) -DGENERATOR
+#   -DC_COMPILER -DCXX_COMPILER
+
+function(run_checked)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT result EQUAL 0)
+    string(REPLACE ";" " " command "${ARGN}")
+    message(FATAL_ERROR "failed (${result}): ${command}\n${out}\n${err}")
+  endif()
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+
+file(REMOVE_RECURSE "${WORK}")
+set(prefix "${WORK}/prefix")
+run_checked(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+foreach(installed lib/cmake/tetrapage/tetrapageConfig.cmake lib/cmake/tetrapage/tetrapageConfigVersion.cmake
+                  include/tetrapage/tetrapage.h include/tetrapage/runtime/FlyingObject.h
+                  include/tetrapage/formats/Error.h bin/tetrapage)
+  if(NOT EXISTS "${prefix}/${installed}")
+    message(FATAL_ERROR "not installed: ${prefix}/${installed}")
+  endif()
+endforeach()
+
+run_checked(${CMAKE_COMMAND} -S ${CONSUMER} -B ${WORK}/consumer-build -G ${GENERATOR}
+            -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=${C_COMPILER} -DCMAKE_CXX_COMPILER=${CXX_COMPILER}
+            -DCMAKE_PREFIX_PATH=${prefix})
+run_checked(${CMAKE_COMMAND} --build ${WORK}/consumer-build)
+run_checked(${WORK}/consumer-build/consumer ${INDEX})
+message(STATUS "${last_output}")

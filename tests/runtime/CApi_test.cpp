@@ -1,0 +1,567 @@
+// The C API (tetrapage.h): every function, its error paths (missing and corrupted files, null
+// arguments, NaN poses, invalid accuracies), and its answers against the C++ FlyingObject and
+// a brute-force oracle (every environment triangle against every object triangle, exactly) on
+// random poses. The index is built once by preprocess from a few hundred triangles (stored in
+// double precision, so the stored coordinates are the input's).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <random>
+#include <set>
+#include <string>
+#include <thread>
+#include <tuple>
+#include <vector>
+
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/geometry/Accuracy.h"
+#include "tetrapage/tetrapage.h"
+
+namespace tetrapage {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::uint64_t kBudget = std::uint64_t(64) << 20;
+
+/// Uniform doubles in [0, 1) from a fixed-seed generator (the same on every platform).
+class Uniform {
+ public:
+  explicit Uniform(std::uint64_t seed) : engine_(seed) {}
+  double operator()() { return double(engine_() >> 11) * 0x1.0p-53; }
+  double operator()(double lo, double hi) { return lo + (hi - lo) * (*this)(); }
+
+ private:
+  std::mt19937_64 engine_;
+};
+
+/// The surface of an axis-aligned box, each face split into n x n squares (12 n^2 triangles).
+void add_box(TriangleSoup& soup, const Vec3& lo, const Vec3& hi, int n) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    for (int side = 0; side < 2; ++side) {
+      const auto base = std::uint32_t(soup.vertices.size());
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j) {
+          Vec3 p;
+          p[axis] = side ? hi[axis] : lo[axis];
+          p[u] = lo[u] + (hi[u] - lo[u]) * i / n;
+          p[v] = lo[v] + (hi[v] - lo[v]) * j / n;
+          soup.vertices.push_back(p);
+        }
+      const auto at = [&](int i, int j) { return base + std::uint32_t(i * (n + 1) + j); };
+      for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+          soup.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+          soup.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+          soup.part_of.push_back(0);
+          soup.part_of.push_back(0);
+        }
+    }
+  }
+}
+
+/// A small closed object: a box of 12 triangles, 0.3 x 0.2 x 0.1, centred at its origin.
+TriangleSoup small_object() {
+  TriangleSoup object;
+  object.part_names = {"object"};
+  add_box(object, {-0.15, -0.1, -0.05}, {0.15, 0.1, 0.05}, 1);
+  return object;
+}
+
+std::vector<double> flat_vertices(const TriangleSoup& soup) {
+  std::vector<double> out;
+  for (const auto& v : soup.vertices) out.insert(out.end(), v.begin(), v.end());
+  return out;
+}
+
+std::vector<std::uint32_t> flat_triangles(const TriangleSoup& soup) {
+  std::vector<std::uint32_t> out;
+  for (const auto& t : soup.triangles) out.insert(out.end(), t.begin(), t.end());
+  return out;
+}
+
+/// A random pose: translation in [-0.5, 4.5]^3 (around and inside the environment), a uniform
+/// unit quaternion.
+std::array<double, 7> random_pose(Uniform& uniform) {
+  std::array<double, 7> pose{};
+  for (int a = 0; a < 3; ++a) pose[a] = uniform(-0.5, 4.5);
+  double norm = 0;
+  do {
+    norm = 0;
+    for (int c = 3; c < 7; ++c) {
+      pose[c] = uniform(-1, 1);
+      norm += pose[c] * pose[c];
+    }
+  } while (norm < 0.01 || norm > 1);
+  for (int c = 3; c < 7; ++c) pose[c] /= std::sqrt(norm);
+  return pose;
+}
+
+Pose to_pose(const std::array<double, 7>& p) {
+  Pose pose;
+  pose.translation = {p[0], p[1], p[2]};
+  pose.rotation = {p[3], p[4], p[5], p[6]};
+  return pose;
+}
+
+using ContactKey = std::tuple<std::uint32_t, std::uint64_t, std::uint32_t>;
+
+std::set<ContactKey> contact_set(const std::vector<tetrapage_contact>& contacts) {
+  std::set<ContactKey> out;
+  for (const auto& c : contacts) out.emplace(c.environment_part, c.environment_triangle, c.object_triangle);
+  return out;
+}
+
+std::set<ContactKey> contact_set(const std::vector<Contact>& contacts) {
+  std::set<ContactKey> out;
+  for (const auto& c : contacts) out.emplace(c.environment_part, c.environment_triangle, c.object_triangle);
+  return out;
+}
+
+class CApiTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    folder_ = fs::path(TETRAPAGE_TEST_TMP) / "capi";
+    fs::create_directories(folder_);
+    // Two subdivided boxes and a thin slab between them: 2 * 192 + 48 = 432 triangles, on
+    // dyadic coordinates.
+    TriangleSoup environment;
+    environment.part_names = {"environment"};
+    add_box(environment, {0, 0, 0}, {1.5, 1.5, 1.5}, 4);
+    add_box(environment, {2.5, 2.5, 2.5}, {4, 4, 4}, 4);
+    add_box(environment, {0.5, 2.5, 1.75}, {3.5, 3.5, 2}, 2);
+    environment_ = environment;
+    write_mesh(folder_ / "environment.obj", environment);
+    // What preprocess stores: the triangles as read back (the ids are their order).
+    environment_ = read_mesh(folder_ / "environment.obj");
+    PreprocessOptions options;
+    options.region_triangles = 40;
+    options.threads = 1;
+    options.precision = StoredPrecision::float64;
+    index_path_ = folder_ / "environment.tpi";
+    preprocess({folder_ / "environment.obj"}, index_path_, options);
+    write_mesh(folder_ / "object.obj", small_object());
+  }
+
+  void SetUp() override {
+    ASSERT_EQ(tetrapage_open(index_path_.c_str(), kBudget, &index_), TETRAPAGE_OK) << tetrapage_last_error();
+  }
+  void TearDown() override { tetrapage_close(index_); }
+
+  tetrapage_object* create_object() {
+    const auto object = small_object();
+    const auto vertices = flat_vertices(object);
+    const auto triangles = flat_triangles(object);
+    tetrapage_object* created = nullptr;
+    EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), object.vertices.size(), triangles.data(),
+                                      object.triangles.size(), &created),
+              TETRAPAGE_OK)
+        << tetrapage_last_error();
+    return created;
+  }
+
+  /// Every (part, environment triangle, object triangle) pair that meets at `pose`.
+  static std::set<ContactKey> brute_force(const std::array<double, 7>& p, const geometry::Accuracy& accuracy) {
+    const TriangleSoup object = small_object();
+    const Pose pose = to_pose(p);
+    const auto rotation = rotation_matrix(pose.rotation);
+    std::set<ContactKey> out;
+    for (std::uint32_t o = 0; o < object.triangles.size(); ++o) {
+      geometry::Triangle placed;
+      for (int c = 0; c < 3; ++c)
+        placed[c] = apply_pose(rotation, pose.translation, object.vertices[object.triangles[o][c]]);
+      for (std::uint64_t e = 0; e < environment_.triangles.size(); ++e)
+        if (geometry::triangles_collide(environment_.corners(e), placed, accuracy))
+          out.emplace(environment_.part_of[e], e, o);
+    }
+    return out;
+  }
+
+  static inline fs::path folder_;
+  static inline fs::path index_path_;
+  static inline TriangleSoup environment_;
+  tetrapage_index* index_ = nullptr;
+};
+
+TEST_F(CApiTest, StatusStringsAreDistinctAndNeverNull) {
+  std::set<std::string> names;
+  for (int s = TETRAPAGE_OK; s <= TETRAPAGE_ERROR_INTERNAL; ++s) {
+    const char* name = tetrapage_status_string(static_cast<tetrapage_status>(s));
+    ASSERT_NE(name, nullptr);
+    EXPECT_TRUE(names.insert(name).second) << "status " << s << " repeats " << name;
+  }
+  EXPECT_STREQ(tetrapage_status_string(static_cast<tetrapage_status>(99)), "unknown status");
+}
+
+TEST_F(CApiTest, MissingFileIsAnIoErrorNamingTheFile) {
+  const fs::path missing = folder_ / "no-such-index.tpi";
+  tetrapage_index* index = reinterpret_cast<tetrapage_index*>(&index_);  // must be reset
+  EXPECT_EQ(tetrapage_open(missing.c_str(), kBudget, &index), TETRAPAGE_ERROR_IO);
+  EXPECT_EQ(index, nullptr);
+  EXPECT_NE(std::string(tetrapage_last_error()).find(missing.string()), std::string::npos)
+      << tetrapage_last_error();
+  // A folder is no index either.
+  EXPECT_EQ(tetrapage_open(folder_.c_str(), kBudget, &index), TETRAPAGE_ERROR_IO);
+}
+
+TEST_F(CApiTest, CorruptedFilesAreFormatErrors) {
+  const fs::path garbage = folder_ / "garbage.tpi";
+  std::ofstream(garbage) << "this is not an HDF5 file at all\n";
+  tetrapage_index* index = nullptr;
+  EXPECT_EQ(tetrapage_open(garbage.c_str(), kBudget, &index), TETRAPAGE_ERROR_FORMAT);
+  EXPECT_EQ(index, nullptr);
+  EXPECT_NE(std::string(tetrapage_last_error()).find(garbage.string()), std::string::npos)
+      << tetrapage_last_error();
+
+  // The real index cut in half.
+  const fs::path truncated = folder_ / "truncated.tpi";
+  fs::copy_file(index_path_, truncated, fs::copy_options::overwrite_existing);
+  fs::resize_file(truncated, fs::file_size(index_path_) / 2);
+  EXPECT_EQ(tetrapage_open(truncated.c_str(), kBudget, &index), TETRAPAGE_ERROR_FORMAT)
+      << tetrapage_last_error();
+  EXPECT_EQ(index, nullptr);
+}
+
+TEST_F(CApiTest, ZeroBudgetIsAnInputError) {
+  tetrapage_index* index = nullptr;
+  EXPECT_EQ(tetrapage_open(index_path_.c_str(), 0, &index), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(index, nullptr);
+  EXPECT_STRNE(tetrapage_last_error(), "");
+}
+
+TEST_F(CApiTest, SuccessClearsTheMessageAndMessagesArePerThread) {
+  tetrapage_index* index = nullptr;
+  ASSERT_EQ(tetrapage_open(nullptr, kBudget, &index), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  const std::string message = tetrapage_last_error();
+  EXPECT_NE(message.find("path"), std::string::npos) << message;
+  std::string other_thread_message = "unset";
+  std::thread([&] { other_thread_message = tetrapage_last_error(); }).join();
+  EXPECT_EQ(other_thread_message, "");
+  EXPECT_EQ(tetrapage_last_error(), message);
+  double lo[3], hi[3];
+  ASSERT_EQ(tetrapage_index_bounds(index_, lo, hi), TETRAPAGE_OK);
+  EXPECT_STREQ(tetrapage_last_error(), "");
+}
+
+TEST_F(CApiTest, NullArgumentsAreReportedNotDereferenced) {
+  const auto object_soup = small_object();
+  const auto vertices = flat_vertices(object_soup);
+  const auto triangles = flat_triangles(object_soup);
+  const std::size_t vertex_count = object_soup.vertices.size(), triangle_count = object_soup.triangles.size();
+  constexpr auto invalid = TETRAPAGE_ERROR_INVALID_ARGUMENT;
+  const auto names = [](const char* word) {
+    return std::string(tetrapage_last_error()).find(word) != std::string::npos;
+  };
+  tetrapage_index* index = nullptr;
+  EXPECT_EQ(tetrapage_open(index_path_.c_str(), kBudget, nullptr), invalid);
+  EXPECT_TRUE(names("index")) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_open(nullptr, kBudget, &index), invalid);
+  double lo[3], hi[3];
+  EXPECT_EQ(tetrapage_index_bounds(nullptr, lo, hi), invalid);
+  EXPECT_EQ(tetrapage_index_bounds(index_, nullptr, hi), invalid);
+  EXPECT_EQ(tetrapage_index_bounds(index_, lo, nullptr), invalid);
+
+  tetrapage_object* object = nullptr;
+  EXPECT_EQ(tetrapage_object_create(nullptr, vertices.data(), vertex_count, triangles.data(), triangle_count, &object),
+            invalid);
+  EXPECT_EQ(tetrapage_object_create(index_, nullptr, vertex_count, triangles.data(), triangle_count, &object),
+            invalid);
+  EXPECT_TRUE(names("vertices")) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), vertex_count, nullptr, triangle_count, &object),
+            invalid);
+  EXPECT_TRUE(names("triangles")) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), vertex_count, triangles.data(), triangle_count, nullptr),
+            invalid);
+  EXPECT_EQ(tetrapage_object_create_from_file(nullptr, (folder_ / "object.obj").c_str(), &object), invalid);
+  EXPECT_EQ(tetrapage_object_create_from_file(index_, nullptr, &object), invalid);
+  EXPECT_EQ(tetrapage_object_create_from_file(index_, (folder_ / "object.obj").c_str(), nullptr), invalid);
+  EXPECT_EQ(object, nullptr);
+
+  tetrapage_accuracy accuracy;
+  double parameter;
+  EXPECT_EQ(tetrapage_parse_accuracy(nullptr, &accuracy, &parameter), invalid);
+  EXPECT_EQ(tetrapage_parse_accuracy("exact", nullptr, &parameter), invalid);
+  EXPECT_EQ(tetrapage_parse_accuracy("exact", &accuracy, nullptr), invalid);
+
+  object = create_object();
+  ASSERT_NE(object, nullptr);
+  const double pose[7] = {0.75, 0.75, 0.75, 1, 0, 0, 0};
+  int collides = 0;
+  EXPECT_EQ(tetrapage_query(nullptr, pose, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), invalid);
+  EXPECT_EQ(tetrapage_query(object, nullptr, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), invalid);
+  EXPECT_TRUE(names("pose")) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, 0, nullptr), invalid);
+  std::size_t count = 0, written = 0;
+  tetrapage_contact contact;
+  tetrapage_query_info info;
+  EXPECT_EQ(tetrapage_contact_count(nullptr, &count), invalid);
+  EXPECT_EQ(tetrapage_contact_count(object, nullptr), invalid);
+  EXPECT_EQ(tetrapage_get_contacts(nullptr, &contact, 1, &written), invalid);
+  EXPECT_EQ(tetrapage_get_contacts(object, nullptr, 1, &written), invalid);
+  EXPECT_EQ(tetrapage_get_contacts(object, &contact, 1, nullptr), invalid);
+  EXPECT_EQ(tetrapage_get_contacts(object, nullptr, 0, &written), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_last_query_info(nullptr, &info), invalid);
+  EXPECT_EQ(tetrapage_last_query_info(object, nullptr), invalid);
+  // Releasing null does nothing.
+  tetrapage_object_destroy(nullptr);
+  tetrapage_close(nullptr);
+  tetrapage_object_destroy(object);
+}
+
+TEST_F(CApiTest, BadObjectsAreInputOrFileErrors) {
+  auto soup = small_object();
+  auto vertices = flat_vertices(soup);
+  auto triangles = flat_triangles(soup);
+  tetrapage_object* object = nullptr;
+  // An index out of range, named in the message.
+  triangles[4] = std::uint32_t(soup.vertices.size());
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), soup.vertices.size(), triangles.data(),
+                                    soup.triangles.size(), &object),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find(std::to_string(soup.vertices.size())), std::string::npos)
+      << tetrapage_last_error();
+  triangles = flat_triangles(soup);
+  // A NaN coordinate.
+  vertices[7] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), soup.vertices.size(), triangles.data(),
+                                    soup.triangles.size(), &object),
+            TETRAPAGE_ERROR_INPUT);
+  vertices = flat_vertices(soup);
+  // No triangle.
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), soup.vertices.size(), nullptr, 0, &object),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(object, nullptr);
+
+  const fs::path missing = folder_ / "no-such-object.obj";
+  EXPECT_EQ(tetrapage_object_create_from_file(index_, missing.c_str(), &object), TETRAPAGE_ERROR_IO);
+  EXPECT_NE(std::string(tetrapage_last_error()).find(missing.string()), std::string::npos)
+      << tetrapage_last_error();
+  const fs::path malformed = folder_ / "malformed.off";
+  std::ofstream(malformed) << "OFF\n4 2 0\n0 0 0\n1 0 0\n";  // truncated vertex list
+  EXPECT_EQ(tetrapage_object_create_from_file(index_, malformed.c_str(), &object), TETRAPAGE_ERROR_FORMAT)
+      << tetrapage_last_error();
+  EXPECT_EQ(object, nullptr);
+}
+
+TEST_F(CApiTest, InvalidPosesAndAccuraciesAreInputErrorsAndClearTheContacts) {
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  // A colliding pose first, so that there are contacts to clear: the object straddles a face.
+  const double touching[7] = {1.5, 0.75, 0.75, 1, 0, 0, 0};
+  int collides = -1;
+  ASSERT_EQ(tetrapage_query(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), TETRAPAGE_OK);
+  ASSERT_EQ(collides, 1);
+  std::size_t count = 0;
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  ASSERT_GT(count, 0u);
+
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const double bad_poses[][7] = {{nan, 0.75, 0.75, 1, 0, 0, 0},
+                                 {0.75, 0.75, inf, 1, 0, 0, 0},
+                                 {0.75, 0.75, 0.75, nan, 0, 0, 0},
+                                 {0.75, 0.75, 0.75, 2, 0, 0, 0},
+                                 {0.75, 0.75, 0.75, 0, 0, 0, 0}};
+  for (const auto& pose : bad_poses) {
+    collides = -1;
+    EXPECT_EQ(tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), TETRAPAGE_ERROR_INPUT);
+    EXPECT_EQ(collides, 0);
+    EXPECT_STRNE(tetrapage_last_error(), "");
+    ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+    EXPECT_EQ(count, 0u);
+  }
+  EXPECT_EQ(tetrapage_query(object, touching, TETRAPAGE_ACCURACY_CLEARANCE, -1, 0, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_query(object, touching, TETRAPAGE_ACCURACY_CLEARANCE, nan, 0, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_query(object, touching, TETRAPAGE_ACCURACY_DOUBLE_EPS, nan, 0, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_query(object, touching, TETRAPAGE_ACCURACY_FLOAT_EPS, -1e-3, 0, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_query(object, touching, static_cast<tetrapage_accuracy>(42), 0, 0, &collides),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("42"), std::string::npos) << tetrapage_last_error();
+  // The object still works afterwards.
+  EXPECT_EQ(tetrapage_query(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK);
+  EXPECT_EQ(collides, 1);
+  tetrapage_object_destroy(object);
+}
+
+TEST_F(CApiTest, ParseAccuracyFollowsTheCommandLineSyntax) {
+  tetrapage_accuracy accuracy = TETRAPAGE_ACCURACY_EXACT;
+  double parameter = -1;
+  ASSERT_EQ(tetrapage_parse_accuracy("clearance:0.25", &accuracy, &parameter), TETRAPAGE_OK);
+  EXPECT_EQ(accuracy, TETRAPAGE_ACCURACY_CLEARANCE);
+  EXPECT_EQ(parameter, 0.25);
+  ASSERT_EQ(tetrapage_parse_accuracy("float_eps:1e-4", &accuracy, &parameter), TETRAPAGE_OK);
+  EXPECT_EQ(accuracy, TETRAPAGE_ACCURACY_FLOAT_EPS);
+  EXPECT_EQ(parameter, 1e-4);
+  ASSERT_EQ(tetrapage_parse_accuracy("double_eps", &accuracy, &parameter), TETRAPAGE_OK);
+  EXPECT_EQ(accuracy, TETRAPAGE_ACCURACY_DOUBLE_EPS);
+  EXPECT_EQ(parameter, 0.0);
+  ASSERT_EQ(tetrapage_parse_accuracy("exact", &accuracy, &parameter), TETRAPAGE_OK);
+  EXPECT_EQ(accuracy, TETRAPAGE_ACCURACY_EXACT);
+  EXPECT_EQ(tetrapage_parse_accuracy("roughly", &accuracy, &parameter), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("roughly"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_parse_accuracy("clearance:-1", &accuracy, &parameter), TETRAPAGE_ERROR_INPUT);
+}
+
+TEST_F(CApiTest, BoundsAreTheModelsBox) {
+  double lo[3], hi[3];
+  ASSERT_EQ(tetrapage_index_bounds(index_, lo, hi), TETRAPAGE_OK);
+  const BoundingBox expected = environment_.bounds();
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_EQ(lo[a], expected.lo[a]);
+    EXPECT_EQ(hi[a], expected.hi[a]);
+  }
+}
+
+// The answers of the C API are the C++ API's, and both are the brute force's, on random poses,
+// for the exact mode (first hit and all contacts) and a clearance.
+TEST_F(CApiTest, AnswersEqualTheCppApiAndBruteForce) {
+  constexpr std::uint64_t kSeed = 20240605;
+  SCOPED_TRACE("seed " + std::to_string(kSeed));
+  Uniform uniform(kSeed);
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  auto shared = std::make_shared<const CollisionIndex>(index_path_, CollisionIndexOptions{kBudget, true, 1});
+  FlyingObject reference(shared, small_object());
+
+  struct Setting {
+    tetrapage_accuracy accuracy;
+    double parameter;
+    geometry::Accuracy cpp;
+  };
+  const Setting settings[] = {{TETRAPAGE_ACCURACY_EXACT, 0, geometry::Accuracy::exact()},
+                              {TETRAPAGE_ACCURACY_CLEARANCE, 0.05, geometry::Accuracy::within(0.05)}};
+  std::size_t collisions = 0, poses = 0;
+  for (int k = 0; k < 150; ++k) {
+    const auto p = random_pose(uniform);
+    for (const auto& setting : settings) {
+      SCOPED_TRACE("pose " + std::to_string(k) + ", accuracy " + geometry::to_string(setting.cpp));
+      const auto expected = brute_force(p, setting.cpp);
+      for (const int all : {0, 1}) {
+        int collides = -1;
+        ASSERT_EQ(tetrapage_query(object, p.data(), setting.accuracy, setting.parameter, all, &collides),
+                  TETRAPAGE_OK)
+            << tetrapage_last_error();
+        const QueryResult cpp = reference.query(
+            to_pose(p), QueryOptions{setting.cpp, all ? QueryMode::all_contacts : QueryMode::first_hit});
+        EXPECT_EQ(collides, cpp.collides ? 1 : 0);
+        EXPECT_EQ(collides, expected.empty() ? 0 : 1);
+
+        std::size_t count = 0, written = 0;
+        ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+        std::vector<tetrapage_contact> contacts(count + 1);
+        ASSERT_EQ(tetrapage_get_contacts(object, contacts.data(), contacts.size(), &written), TETRAPAGE_OK);
+        ASSERT_EQ(written, count);
+        contacts.resize(written);
+        EXPECT_EQ(contact_set(contacts), contact_set(cpp.contacts));
+        if (all) {
+          EXPECT_EQ(contact_set(contacts), expected);
+        } else {
+          EXPECT_EQ(count, collides ? 1u : 0u);
+          if (count == 1) {
+            EXPECT_EQ(expected.count(*contact_set(contacts).begin()), 1u);
+          }
+        }
+
+        tetrapage_query_info info;
+        ASSERT_EQ(tetrapage_last_query_info(object, &info), TETRAPAGE_OK);
+        EXPECT_EQ(info.collides, collides);
+        EXPECT_EQ(info.outside_model, cpp.outside_model ? 1 : 0);
+        EXPECT_EQ(info.triangle_tests, cpp.counters.triangle_tests);
+        EXPECT_EQ(info.candidates, cpp.counters.candidates);
+        // The reported box holds the placed object.
+        const TriangleSoup soup = small_object();
+        for (const auto& v : soup.vertices) {
+          const Vec3 w = apply_pose(to_pose(p), v);
+          for (int a = 0; a < 3; ++a) {
+            EXPECT_LE(info.world_lo[a], w[a]);
+            EXPECT_GE(info.world_hi[a], w[a]);
+          }
+        }
+        if (setting.accuracy == TETRAPAGE_ACCURACY_EXACT && all) {
+          collisions += std::size_t(collides);
+          ++poses;
+        }
+      }
+    }
+  }
+  // Both answers occur, so the comparison means something.
+  EXPECT_GT(collisions, 10u);
+  EXPECT_LT(collisions, poses - 10);
+  tetrapage_object_destroy(object);
+}
+
+TEST_F(CApiTest, ContactsCopyAPrefixWhenTheBufferIsSmall) {
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  // Across an edge of the first box: many contacts.
+  const double pose[7] = {1.5, 1.5, 0.75, std::cos(0.3), 0.2, 0, std::sin(0.3)};
+  const double norm = std::sqrt(pose[3] * pose[3] + pose[4] * pose[4] + pose[6] * pose[6]);
+  const double unit[7] = {pose[0], pose[1], pose[2], pose[3] / norm, pose[4] / norm, 0, pose[6] / norm};
+  int collides = 0;
+  ASSERT_EQ(tetrapage_query(object, unit, TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), TETRAPAGE_OK);
+  std::size_t count = 0, written = 0;
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  ASSERT_GT(count, 3u);
+  std::vector<tetrapage_contact> all(count), some(2);
+  ASSERT_EQ(tetrapage_get_contacts(object, all.data(), all.size(), &written), TETRAPAGE_OK);
+  ASSERT_EQ(written, count);
+  ASSERT_EQ(tetrapage_get_contacts(object, some.data(), some.size(), &written), TETRAPAGE_OK);
+  ASSERT_EQ(written, 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(some[i].environment_triangle, all[i].environment_triangle);
+    EXPECT_EQ(some[i].environment_part, all[i].environment_part);
+    EXPECT_EQ(some[i].object_triangle, all[i].object_triangle);
+  }
+  tetrapage_object_destroy(object);
+}
+
+TEST_F(CApiTest, ObjectsFromFilesAnswerAsObjectsFromArraysAndOutliveTheirIndex) {
+  tetrapage_object* from_arrays = create_object();
+  tetrapage_object* from_file = nullptr;
+  ASSERT_EQ(tetrapage_object_create_from_file(index_, (folder_ / "object.obj").c_str(), &from_file), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  // Closing the index handle leaves the objects working.
+  tetrapage_close(index_);
+  index_ = nullptr;
+  Uniform uniform(7);
+  for (int k = 0; k < 40; ++k) {
+    const auto p = random_pose(uniform);
+    int a = -1, b = -1;
+    ASSERT_EQ(tetrapage_query(from_arrays, p.data(), TETRAPAGE_ACCURACY_EXACT, 0, 1, &a), TETRAPAGE_OK);
+    ASSERT_EQ(tetrapage_query(from_file, p.data(), TETRAPAGE_ACCURACY_EXACT, 0, 1, &b), TETRAPAGE_OK);
+    EXPECT_EQ(a, b) << "pose " << k << " (seed 7)";
+    EXPECT_EQ(a, brute_force(p, geometry::Accuracy::exact()).empty() ? 0 : 1) << "pose " << k << " (seed 7)";
+  }
+  tetrapage_object_destroy(from_arrays);
+  tetrapage_object_destroy(from_file);
+}
+
+TEST_F(CApiTest, NoQueryMeansNoContacts) {
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  std::size_t count = 1;
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  EXPECT_EQ(count, 0u);
+  tetrapage_query_info info;
+  info.collides = 7;
+  ASSERT_EQ(tetrapage_last_query_info(object, &info), TETRAPAGE_OK);
+  EXPECT_EQ(info.collides, 0);
+  EXPECT_EQ(info.triangle_tests, 0u);
+  tetrapage_object_destroy(object);
+}
+
+}  // namespace
+}  // namespace tetrapage
