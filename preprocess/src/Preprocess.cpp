@@ -115,8 +115,17 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     const auto part_offset = std::uint32_t(in.part_names.size());
     for (const auto& name : soup.part_names) in.part_names.push_back(name);
     if (soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
+    // Records go out in blocks, so that the held records never pass the limit by more than a
+    // block before they spill.
+    constexpr std::size_t kBlock = 1 << 16;
+    auto flush = [&] {
+      in.records.append(block);
+      block.clear();
+      if (!in.records.spilled() && in.records.size() * sizeof(TriangleRecord) > held_limit)
+        in.records.spill_to(spill_path(spill_folder, "triangles"));
+    };
     block.clear();
-    block.reserve(soup.triangle_count());
+    block.reserve(std::min<std::size_t>(kBlock, soup.triangle_count()));
     for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
       TriangleRecord record{};
       record.triangle = soup.corners(t);
@@ -132,10 +141,9 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
       }
       ++in.seen;
       block.push_back(record);
+      if (block.size() == kBlock) flush();
     }
-    in.records.append(block);
-    if (!in.records.spilled() && in.records.size() * sizeof(TriangleRecord) > held_limit)
-      in.records.spill_to(spill_path(spill_folder, "triangles"));
+    flush();
   };
 
   Progress progress("reading parts", inputs.size(), options.progress);
@@ -368,8 +376,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         }
         const ShardTriangles region{triangles, ids, parts};
         if (options.shard == ShardChoice::automatic) {
-          const ShardCostReport costs = estimate_shard_costs(region, query_extent, options.precision, cost_model);
-          built[g] = build_shard(region, costs.chosen, options.precision, costs.chosen_estimate().layout);
+          ShardCostReport costs = estimate_shard_costs(region, query_extent, options.precision, cost_model);
+          built[g] = std::move(costs.chosen == ShardKind::grid ? costs.grid.built : costs.rtree.built);
         } else {
           built[g] = build_shard(region, options.shard == ShardChoice::grid ? ShardKind::grid : ShardKind::rtree,
                                  options.precision);

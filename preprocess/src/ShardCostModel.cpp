@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/Shard.h"
@@ -34,7 +35,7 @@ ShardCostEstimate estimate(const ShardTriangles& region, ShardKind kind,
                            StoredPrecision precision, const ShardLayout& layout,
                            const std::vector<geometry::Box>& queries,
                            const ShardCostModel& model) {
-  const BuiltShard built = build_shard(region, kind, precision, layout);
+  BuiltShard built = build_shard(region, kind, precision, layout);
   const Shard shard = Shard::decode(built.payload);
   ShardQueryCounters counters;
   for (const geometry::Box& box : queries) shard.for_each_candidate(box, [](std::uint32_t) {}, counters);
@@ -54,6 +55,7 @@ ShardCostEstimate estimate(const ShardTriangles& region, ShardKind kind,
                 model.seconds_per_rtree_reference * e.references_per_query;
   e.paging_seconds = model.seconds_per_byte * double(e.payload_bytes) /
                      std::max(model.queries_per_page_in, 1e-9);
+  e.built = std::move(built);
   return e;
 }
 
@@ -85,17 +87,16 @@ ShardCostReport estimate_shard_costs(const ShardTriangles& region, double query_
   for (const double cells_per_triangle : {0.25, 1.0, 4.0}) {
     ShardLayout layout;
     layout.grid_cells_per_triangle = cells_per_triangle;
-    const ShardCostEstimate e = estimate(region, ShardKind::grid, precision, layout, queries, model);
-    if (first || e.total_seconds() < report.grid.total_seconds()) report.grid = e;
+    ShardCostEstimate e = estimate(region, ShardKind::grid, precision, layout, queries, model);
+    if (first || e.total_seconds() < report.grid.total_seconds()) report.grid = std::move(e);
     first = false;
   }
   first = true;
   for (const std::uint32_t leaf : {4u, 8u, 16u}) {
     ShardLayout layout;
     layout.rtree_leaf_size = leaf;
-    const ShardCostEstimate e =
-        estimate(region, ShardKind::rtree, precision, layout, queries, model);
-    if (first || e.total_seconds() < report.rtree.total_seconds()) report.rtree = e;
+    ShardCostEstimate e = estimate(region, ShardKind::rtree, precision, layout, queries, model);
+    if (first || e.total_seconds() < report.rtree.total_seconds()) report.rtree = std::move(e);
     first = false;
   }
   report.chosen = report.rtree.total_seconds() < report.grid.total_seconds() ? ShardKind::rtree

@@ -43,6 +43,8 @@ struct ShardCostEstimate {
   double query_seconds = 0;   ///< per query
   double paging_seconds = 0;  ///< per query: paging cost / queries_per_page_in
   double total_seconds() const { return query_seconds + paging_seconds; }
+  /// The shard the estimate measured (so the chosen one need not be built again).
+  BuiltShard built;
 };
 
 /// The estimates of both kinds (each with its best layout among a few tried) and the choice.
