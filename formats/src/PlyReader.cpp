@@ -3,6 +3,7 @@
 // "vertex_indices" (or "vertex_index"), with any count and index types. Every other element
 // and property is skipped by walking its declared layout, so it cannot desynchronise the read.
 
+#include <type_traits>
 #include <vector>
 
 #include "ReaderSupport.h"
@@ -55,46 +56,37 @@ bool parse_type(std::string_view name, PlyType& type) {
   return false;
 }
 
-double load_double(PlyType type, const char* bytes, bool big_endian) {
+// One stored value of any PLY type as Result. Integers are only asked of integer types (the
+// header check guarantees it for counts and indices), so no float is ever truncated.
+template <class Result>
+Result load_number(PlyType type, const char* bytes, bool big_endian) {
   switch (type) {
     case PlyType::int8:
-      return load_scalar<std::int8_t>(bytes, big_endian);
+      return Result(load_scalar<std::int8_t>(bytes, big_endian));
     case PlyType::uint8:
-      return load_scalar<std::uint8_t>(bytes, big_endian);
+      return Result(load_scalar<std::uint8_t>(bytes, big_endian));
     case PlyType::int16:
-      return load_scalar<std::int16_t>(bytes, big_endian);
+      return Result(load_scalar<std::int16_t>(bytes, big_endian));
     case PlyType::uint16:
-      return load_scalar<std::uint16_t>(bytes, big_endian);
+      return Result(load_scalar<std::uint16_t>(bytes, big_endian));
     case PlyType::int32:
-      return load_scalar<std::int32_t>(bytes, big_endian);
+      return Result(load_scalar<std::int32_t>(bytes, big_endian));
     case PlyType::uint32:
-      return load_scalar<std::uint32_t>(bytes, big_endian);
+      return Result(load_scalar<std::uint32_t>(bytes, big_endian));
     case PlyType::float32:
-      return load_scalar<float>(bytes, big_endian);
+      return std::is_floating_point_v<Result> ? Result(load_scalar<float>(bytes, big_endian)) : Result(0);
     case PlyType::float64:
-      return load_scalar<double>(bytes, big_endian);
+      return std::is_floating_point_v<Result> ? Result(load_scalar<double>(bytes, big_endian)) : Result(0);
   }
-  return 0;
+  return Result(0);
 }
 
-/// Integer types only (the header check guarantees it for counts and indices).
+double load_double(PlyType type, const char* bytes, bool big_endian) {
+  return load_number<double>(type, bytes, big_endian);
+}
+
 std::int64_t load_integer(PlyType type, const char* bytes, bool big_endian) {
-  switch (type) {
-    case PlyType::int8:
-      return load_scalar<std::int8_t>(bytes, big_endian);
-    case PlyType::uint8:
-      return load_scalar<std::uint8_t>(bytes, big_endian);
-    case PlyType::int16:
-      return load_scalar<std::int16_t>(bytes, big_endian);
-    case PlyType::uint16:
-      return load_scalar<std::uint16_t>(bytes, big_endian);
-    case PlyType::int32:
-      return load_scalar<std::int32_t>(bytes, big_endian);
-    case PlyType::uint32:
-      return load_scalar<std::uint32_t>(bytes, big_endian);
-    default:
-      return 0;
-  }
+  return load_number<std::int64_t>(type, bytes, big_endian);
 }
 
 struct PlyProperty {
