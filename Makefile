@@ -14,7 +14,7 @@ DEB_PACKAGES := cmake make g++ pkg-config \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
   libgtest-dev libbenchmark-dev
 
-.PHONY: deps configure build test demo bench clean format
+.PHONY: deps configure build test sanitize demo bench clean format
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -35,6 +35,15 @@ build: configure
 
 test: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS) --timeout 1200
+	$(MAKE) --no-print-directory sanitize
+
+# Threads flying through one index, built and run under AddressSanitizer + UBSan (only the
+# libraries that test needs, so that CI stays within its time).
+sanitize: configure
+	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=asan -DTETRAPAGE_WERROR=$(WERROR) \
+	  -DTETRAPAGE_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	cmake --build $(BUILD)-asan --target runtime_threads_tests -j $(JOBS)
+	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 ./tests/runtime/runtime_threads_tests
 
 demo: build
 	@mkdir -p $(DEMO_DIR)
@@ -64,4 +73,4 @@ format:
 	find formats runtime preprocess tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i
 
 clean:
-	rm -rf $(BUILD)
+	rm -rf $(BUILD) $(BUILD)-asan
