@@ -204,6 +204,13 @@ void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_
   if (!hints_.empty()) index.cache().prefetch(hints_);
 }
 
+void FlyingObject::release_region() {
+  // Outside the model nothing needs the region's shards: give their budget back.
+  pins_.clear();
+  shards_.clear();
+  searched_valid_ = false;
+}
+
 void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryResult& result) {
   result.collides = false;
   result.contacts.clear();
@@ -222,6 +229,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   counters.locate_seconds = seconds_since(start);
   if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
     result.outside_model = true;
+    release_region();
     return;
   }
   const bool inside_region = searched_valid_ && box.lo[0] >= searched_box_.lo[0] && box.lo[1] >= searched_box_.lo[1] &&
@@ -230,7 +238,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   if (!inside_region && !search(box, counters)) {
     // A centre outside the convex mesh: the box meets only the model's empty margin.
     result.outside_model = true;
-    searched_valid_ = false;
+    release_region();
     return;
   }
 

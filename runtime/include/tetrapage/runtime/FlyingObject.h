@@ -96,6 +96,7 @@ class FlyingObject {
   // lies outside the mesh.
   bool search(const geometry::Box& box, StepCounters& counters);
   void prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet);
+  void release_region();
   const Vec3& world_vertex(std::uint32_t v);
   geometry::Triangle world_triangle(std::uint32_t t);
 
