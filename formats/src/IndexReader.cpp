@@ -655,10 +655,20 @@ std::uint64_t IndexReader::shard_size(std::uint32_t shard) const {
 std::uint64_t IndexReader::stored_shard_size(std::uint32_t shard) const {
   const Impl& r = *impl_;
   r.check_shard(shard);
-  r.ensure_located();
   std::uint64_t bytes = 0;
-  for (std::uint64_t k = 0; k < r.chunk_count(shard); ++k)
-    bytes += r.chunks[r.first_chunk(shard) + k].stored_bytes;
+  if (r.located.load(std::memory_order_acquire)) {
+    for (std::uint64_t k = 0; k < r.chunk_count(shard); ++k)
+      bytes += r.chunks[r.first_chunk(shard) + k].stored_bytes;
+    return bytes;
+  }
+  // One chunk-index lookup per chunk, rather than locating every chunk of the file.
+  for (std::uint64_t k = 0; k < r.chunk_count(shard); ++k) {
+    hsize_t coordinate = (r.first_chunk(shard) + k) * r.chunk_bytes;
+    hsize_t stored = 0;
+    if (H5Dget_chunk_storage_size(r.shard_data.get(), &coordinate, &stored) < 0)
+      r.hdf5_format_error("cannot locate " + r.chunk_name(shard, k));
+    bytes += stored;
+  }
   return bytes;
 }
 
