@@ -15,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "PathSupport.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MeshReader.h"
 
@@ -179,14 +180,11 @@ Transform parse_instance(const json& instance, const JsonPlace& place) {
   return transform;
 }
 
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
-
 }  // namespace
+
+bool is_manifest_path(const std::filesystem::path& path) {
+  return detail::lower_extension(path) == ".json";
+}
 
 Manifest read_manifest(const std::filesystem::path& path) {
   const std::string file = path.string();
@@ -316,7 +314,7 @@ TriangleSoup load_inputs(const std::vector<std::filesystem::path>& inputs,
   TriangleSoup all;
   for (const auto& input : inputs) {
     TriangleSoup soup;
-    if (lower_extension(input) == ".json") {
+    if (is_manifest_path(input)) {
       soup = load_assembly(read_manifest(input), reports, progress);
     } else {
       ReadReport report;

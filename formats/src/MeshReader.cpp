@@ -10,6 +10,7 @@
 #include <cctype>
 #include <chrono>
 
+#include "PathSupport.h"
 #include "ReaderSupport.h"
 
 namespace tetrapage {
@@ -17,17 +18,10 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
-
 }  // namespace
 
 MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
-  const std::string extension = lower_extension(path);
+  const std::string extension = detail::lower_extension(path);
   if (extension == ".obj") return MeshFormat::obj;
   if (extension == ".stl") return MeshFormat::stl;
   if (extension == ".ply") return MeshFormat::ply;
@@ -135,7 +129,7 @@ TriangleSoup read_mesh_with_assimp(const std::filesystem::path& path, ReadReport
   ReadReport& out = report != nullptr ? *report : local;
   out = ReadReport{};
   out.path = path.string();
-  const std::string extension = lower_extension(path);
+  const std::string extension = detail::lower_extension(path);
   out.format = "assimp:" + (extension.empty() ? std::string() : extension.substr(1));
   out.bytes = file_size_or_zero(path);
   TriangleSoup soup = detail::read_assimp(path, out);

@@ -14,6 +14,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "PathSupport.h"
 #include "OutputFile.h"
 #include "TextNumbers.h"
 #include "tetrapage/formats/Error.h"
@@ -66,13 +67,6 @@ class MeshWriter::Impl {
 };
 
 namespace {
-
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string extension = path.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
 
 void check_part(const std::filesystem::path& path, std::span<const Vec3> vertices,
                 std::span<const TriangleIndices> triangles) {
@@ -441,7 +435,7 @@ class GltfWriter final : public MeshWriter::Impl {
 }  // namespace
 
 bool can_write_mesh(const std::filesystem::path& path) {
-  const std::string extension = lower_extension(path);
+  const std::string extension = detail::lower_extension(path);
   for (const char* writable : {".obj", ".stl", ".ply", ".off", ".gltf", ".glb"}) {
     if (extension == writable) return true;
   }
@@ -449,7 +443,7 @@ bool can_write_mesh(const std::filesystem::path& path) {
 }
 
 MeshWriter::MeshWriter(const std::filesystem::path& path) {
-  const std::string extension = lower_extension(path);
+  const std::string extension = detail::lower_extension(path);
   if (extension == ".obj") {
     impl_ = std::make_unique<ObjWriter>(path);
   } else if (extension == ".stl") {

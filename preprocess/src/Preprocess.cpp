@@ -148,7 +148,7 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
 
   Progress progress("reading parts", inputs.size(), options.progress);
   for (const auto& input : inputs) {
-    if (input.extension() == ".json") {
+    if (is_manifest_path(input)) {
       const Manifest manifest = read_manifest(input);
       for (const auto& part : manifest.parts) {
         // One part at a time: the ingest holds one part file, never the assembly.
@@ -220,9 +220,9 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
 
   // 2. Sample and 3. coarse mesh.
   TetMesh mesh;
+  SamplingOptions sampling;
   {
     StageClock clock(summary, "coarse mesh");
-    SamplingOptions sampling;
     // The sample stands for all triangles: scale the leaf size to its share.
     const double share = double(in.sample.size()) / double(triangle_count);
     sampling.leaf_triangles = std::max<std::size_t>(1, std::size_t(std::llround(double(options.region_triangles) * share)));
@@ -233,17 +233,18 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     clock.stop();
   }
   const std::size_t tet_count = mesh.tet_count();
+  // The box the coarse mesh covers: Morton codes of tets and sample points are taken in it.
+  const BoundingBox mesh_box = enlarged_bounds(in.bounds, sampling.margin);
 
   // Tets in Morton order of their centroids: neighbouring shards sit side by side on disk.
   std::vector<std::uint32_t> order(tet_count), rank(tet_count);
   {
-    const BoundingBox box = enlarged_bounds(in.bounds, SamplingOptions{}.margin);
     std::vector<std::uint64_t> code(tet_count);
     tbb::parallel_for(std::size_t(0), tet_count, [&](std::size_t t) {
       const auto c = mesh.corners(t);
       const Vec3 mid{(c[0][0] + c[1][0] + c[2][0] + c[3][0]) / 4, (c[0][1] + c[1][1] + c[2][1] + c[3][1]) / 4,
                      (c[0][2] + c[1][2] + c[2][2] + c[3][2]) / 4};
-      code[t] = morton_code(mid, box);
+      code[t] = morton_code(mid, mesh_box);
     });
     for (std::size_t t = 0; t < tet_count; ++t) order[t] = std::uint32_t(t);
     tbb::parallel_sort(order.begin(), order.end(),
@@ -260,12 +261,12 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     const double capacity = double(options.memory_bytes / 3) / double(sizeof(TriangleRecord));
     if (copies_per_sample * double(in.sample.size()) > capacity) {
       std::vector<double> estimate(tet_count, 0.0);
-      const BoundingBox box = enlarged_bounds(in.bounds, SamplingOptions{}.margin);
-      std::sort(in.sample.begin(), in.sample.end(), [&](const Vec3& a, const Vec3& b) {
-        return morton_code(a, box) < morton_code(b, box);
-      });
+      // Located in Morton order, each walk starts next to the last one.
+      std::vector<std::pair<std::uint64_t, Vec3>> coded(in.sample.size());
+      for (std::size_t i = 0; i < in.sample.size(); ++i) coded[i] = {morton_code(in.sample[i], mesh_box), in.sample[i]};
+      std::sort(coded.begin(), coded.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       std::uint32_t hint = 0;
-      for (const Vec3& c : in.sample) {
+      for (const auto& [code, c] : coded) {
         const WalkResult located = locate_point(mesh, hint, c);
         if (located.tet == TetMesh::no_neighbour) continue;
         hint = located.tet;
@@ -347,10 +348,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
       return 0.05 * std::max({size[0], size[1], size[2]});
     }();
     summary.query_extent = query_extent;
-    ShardCostModel cost_model;
-    // Eight sampled query boxes per layout rank the layouts as well as 48 (the choice matched
-    // on the 1M scene) at a sixth of the exact triangle/box tests, which dominated this stage.
-    cost_model.sample_queries = 8;
+    const ShardCostModel cost_model;
     Progress progress("building shards", tet_count, options.progress);
     for (auto& bucket : buckets) {
       std::vector<TriangleRecord> records = bucket.read_all();
@@ -396,13 +394,11 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         for (int a = 0; a < 3; ++a) {
           const double grow = built[g].max_rounding_distance +
                               0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
-          shard_bounds.push_back(bounds.lo[a] - grow);
+          bounds.lo[a] -= grow;
+          bounds.hi[a] += grow;
         }
-        for (int a = 0; a < 3; ++a) {
-          const double grow = built[g].max_rounding_distance +
-                              0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
-          shard_bounds.push_back(bounds.hi[a] + grow);
-        }
+        shard_bounds.insert(shard_bounds.end(), {bounds.lo[0], bounds.lo[1], bounds.lo[2], bounds.hi[0],
+                                                 bounds.hi[1], bounds.hi[2]});
         const std::uint32_t shard = writer.append_shard(built[g].payload);
         tet_shard[tet] = shard;
         shard_tet.push_back(tet);

@@ -7,7 +7,7 @@ namespace tetrapage {
 CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndexOptions options)
     : reader_(path), options_(options) {
   if (options_.memory_budget_bytes == 0) throw InputError("the shard memory budget must be positive");
-  mesh_ = reader_.read_mesh();
+  mesh_ = reader_.read_mesh();  // checks every vertex and neighbour index
   for (const auto& v : mesh_.vertices) mesh_bounds_.extend(v);
   tet_shard_ = reader_.read_table_uint32("tet_shard");
   const std::string where = path.string() + ": ";
@@ -20,14 +20,6 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
     if (tet_shard_[t] != TetMesh::no_neighbour && tet_shard_[t] >= shards)
       throw FormatError(where + "/tables/tet_shard names shard " + std::to_string(tet_shard_[t]) + " for tet " +
                         std::to_string(t) + ", but there are " + std::to_string(shards) + " shards");
-  for (std::size_t t = 0; t < mesh_.tet_count(); ++t)
-    for (int i = 0; i < 4; ++i) {
-      if (mesh_.tets[t][i] >= mesh_.vertices.size())
-        throw FormatError(where + "tet " + std::to_string(t) + " names vertex " + std::to_string(mesh_.tets[t][i]));
-      const std::uint32_t n = mesh_.neighbours[t][i];
-      if (n != TetMesh::no_neighbour && n >= mesh_.tet_count())
-        throw FormatError(where + "tet " + std::to_string(t) + " names neighbour " + std::to_string(n));
-    }
   const auto bounds = reader_.read_table_double("shard_bounds");
   if (bounds.size() != 6 * std::size_t(shards))
     throw FormatError(where + "/tables/shard_bounds has " + std::to_string(bounds.size()) + " values for " +

@@ -22,6 +22,13 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// The box's centre, clamped into the coarse mesh's box: where a walk for the box aims.
+Vec3 centre_in_mesh_box(const geometry::Box& box, const CollisionIndex& index) {
+  Vec3 centre = box.center();
+  for (int a = 0; a < 3; ++a) centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
+  return centre;
+}
+
 // Hill-climbing pays off on objects with many hull vertices; tiny ones are placed whole.
 constexpr std::size_t kHillClimbMinimum = 32;
 
@@ -145,11 +152,9 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   const double grow = 0.5 * geometry::extent(box);
   geometry::Box region = box;
   for (int a = 0; a < 3; ++a) region.lo[a] -= grow, region.hi[a] += grow;
-  Vec3 centre = box.center();
-  for (int a = 0; a < 3; ++a) centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
-  const WalkResult located = locate_point(mesh, last_tet_, centre);
+  const WalkResult located = locate_point(mesh, last_tet_, centre_in_mesh_box(box, index));
   counters.tets_crossed = located.tets_crossed;
-  counters.locate_seconds = seconds_since(start);
+  counters.locate_seconds += seconds_since(start);  // after the box time of query()
   if (located.tet == TetMesh::no_neighbour) return false;
   last_tet_ = located.tet;
 
@@ -192,9 +197,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
 void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet) {
   const CollisionIndex& index = *index_;
   const TetMesh& mesh = index.mesh();
-  Vec3 centre = next_region.center();
-  for (int a = 0; a < 3; ++a) centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
-  const WalkResult ahead = locate_point(mesh, from_tet, centre);
+  const WalkResult ahead = locate_point(mesh, from_tet, centre_in_mesh_box(next_region, index));
   if (ahead.tet == TetMesh::no_neighbour || !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet))) return;
   hints_.clear();
   for (const std::uint32_t tet : tets_overlapping_box(mesh, ahead.tet, next_region, prefetch_search_).tets) {

@@ -23,25 +23,6 @@ constexpr std::size_t kSmallLeaf = 2;     // never split below this
 constexpr std::size_t kLargestLeaf = 8;   // always split above this
 constexpr std::size_t kMedianDepth = 48;  // below this depth, split at the median (bounded depth)
 constexpr double kTraversalCost = 1.0;    // relative to one triangle test
-constexpr float kFloatMax = std::numeric_limits<float>::max();
-constexpr float kFloatInfinity = std::numeric_limits<float>::infinity();
-
-// A float no larger than x (no smaller for round_up), also for x beyond float's range.
-float round_down(double x) {
-  if (x > double(kFloatMax)) return kFloatMax;
-  if (x < -double(kFloatMax)) return -kFloatInfinity;
-  float f = static_cast<float>(x);
-  if (double(f) > x) f = std::nextafter(f, -kFloatInfinity);
-  return f;
-}
-float round_up(double x) {
-  if (x < -double(kFloatMax)) return -kFloatMax;
-  if (x > double(kFloatMax)) return kFloatInfinity;
-  float f = static_cast<float>(x);
-  if (double(f) < x) f = std::nextafter(f, kFloatInfinity);
-  return f;
-}
-
 double half_area(const Box& b) {
   if (b.empty()) return 0.0;
   const double dx = b.hi[0] - b.lo[0], dy = b.hi[1] - b.lo[1], dz = b.hi[2] - b.lo[2];
@@ -100,8 +81,8 @@ std::uint32_t ObjectBVH::build(std::vector<BuildItem>& items, const std::vector<
   const auto node_index = static_cast<std::uint32_t>(nodes_.size());
   Node node{};
   for (int k = 0; k < 3; ++k) {
-    node.lo[k] = round_down(box.lo[k]);
-    node.hi[k] = round_up(box.hi[k]);
+    node.lo[k] = float_below(box.lo[k]);
+    node.hi[k] = float_above(box.hi[k]);
   }
   nodes_.push_back(node);
 

@@ -33,7 +33,4 @@ void write_report(const std::filesystem::path& path, const nlohmann::json& repor
 /// @throw IoError naming the path and the reason.
 void check_writable(const std::filesystem::path& path);
 
-/// Peak resident set size of this process in bytes (VmHWM), 0 if unknown.
-std::uint64_t peak_rss_bytes();
-
 }  // namespace tetrapage::cli

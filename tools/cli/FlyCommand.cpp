@@ -47,7 +47,6 @@ void run_fly(const FlyArguments& args) {
   std::vector<double> seconds(poses.size());
   std::uint64_t collisions = 0, outside = 0, contacts = 0;
   std::uint64_t candidates = 0, triangle_tests = 0, tets_visited = 0, shards_touched = 0;
-  std::uint64_t peak_resident = 0;
   Progress progress("flying", poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
@@ -63,7 +62,6 @@ void run_fly(const FlyArguments& args) {
     triangle_tests += result.counters.triangle_tests;
     tets_visited += result.counters.tets_visited;
     shards_touched += result.counters.shards_touched;
-    peak_resident = std::max(peak_resident, index->cache().peak_resident_bytes());
     check.record(i, answers[i]);
     progress.advance();
   }

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "Commands.h"
+#include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
@@ -52,7 +53,7 @@ MeshLibrary load_library(const std::filesystem::path& folder) {
 void finish(const Common& common, const Outcome& outcome, const nlohmann::json& seed,
             std::chrono::steady_clock::time_point start) {
   const double seconds = seconds_since(start);
-  const std::uint64_t rss = peak_rss_bytes();
+  const std::uint64_t rss = peak_resident_bytes();
   const auto& lo = outcome.bounds.lo;
   const auto& hi = outcome.bounds.hi;
   std::printf(

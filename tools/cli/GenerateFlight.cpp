@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "Commands.h"
+#include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/tools/AnswerFile.h"
@@ -76,7 +77,7 @@ void run_generate_flight(const FlightArguments& args) {
                   {"read_seconds", read_seconds},
                   {"build_seconds", build_seconds},
                   {"flight_seconds", fly_seconds},
-                  {"peak_rss_bytes", peak_rss_bytes()}});
+                  {"peak_rss_bytes", peak_resident_bytes()}});
   }
 }
 

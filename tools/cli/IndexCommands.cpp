@@ -58,11 +58,12 @@ void run_inspect(const InspectArguments& args) {
   std::uint64_t decoded = 0, stored = 0, kinds[2] = {0, 0}, kind_bytes[2] = {0, 0};
   std::uint32_t largest = 0, most_triangles = 0;
   for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    const std::uint64_t stored_bytes = reader.stored_shard_size(s);  // a chunk lookup each
     decoded += reader.shard_size(s);
-    stored += reader.stored_shard_size(s);
+    stored += stored_bytes;
     const int kind = shard_kind.at(s) == 0 ? 0 : 1;
     ++kinds[kind];
-    kind_bytes[kind] += reader.stored_shard_size(s);
+    kind_bytes[kind] += stored_bytes;
     if (reader.shard_size(s) > reader.shard_size(largest)) largest = s;
     most_triangles = std::max(most_triangles, shard_triangles.at(s));
   }
@@ -104,15 +105,11 @@ void run_inspect(const InspectArguments& args) {
 // Everything an index promises, checked; returns the problems found.
 std::vector<std::string> validate_index(const IndexReader& reader) {
   std::vector<std::string> problems = reader.validate();
-  const TetMesh mesh = reader.read_mesh();
+  if (!problems.empty()) return problems;
+  const TetMesh mesh = reader.read_mesh();  // checks every vertex and neighbour index
   auto problem = [&](std::string text) {
     if (problems.size() < 100) problems.push_back(std::move(text));
   };
-  for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
-    for (const auto v : mesh.tets[t])
-      if (v >= mesh.vertices.size()) problem("tet " + std::to_string(t) + " names vertex " + std::to_string(v));
-  }
-  if (!problems.empty()) return problems;
   for (std::size_t t = 0; t < mesh.tet_count(); ++t) {
     const auto c = mesh.corners(t);
     if (geometry::orient3d(c[0], c[1], c[2], c[3]) != geometry::Sign::positive)
@@ -120,10 +117,6 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
     for (int i = 0; i < 4; ++i) {
       const std::uint32_t n = mesh.neighbours[t][i];
       if (n == TetMesh::no_neighbour) continue;
-      if (n >= mesh.tet_count()) {
-        problem("tet " + std::to_string(t) + " names neighbour " + std::to_string(n));
-        continue;
-      }
       bool back = false;
       for (int j = 0; j < 4; ++j) back |= mesh.neighbours[n][j] == t;
       if (!back) problem("tets " + std::to_string(t) + " and " + std::to_string(n) + " are not mutual neighbours");
@@ -132,8 +125,10 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
   const auto tet_shard = reader.read_table_uint32("tet_shard");
   const auto shard_tet = reader.read_table_uint32("shard_tet");
   const auto shard_triangles = reader.read_table_uint32("shard_triangles");
+  const auto shard_bounds = reader.read_table_double("shard_bounds");
   if (tet_shard.size() != mesh.tet_count()) problem("tet_shard has " + std::to_string(tet_shard.size()) + " entries");
-  if (shard_tet.size() != reader.shard_count() || shard_triangles.size() != reader.shard_count())
+  if (shard_tet.size() != reader.shard_count() || shard_triangles.size() != reader.shard_count() ||
+      shard_bounds.size() != 6 * std::size_t(reader.shard_count()))
     problem("shard tables do not have one entry per shard");
   if (!problems.empty()) return problems;
   for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
@@ -144,6 +139,12 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
       if (shard.triangle_count() != shard_triangles[s])
         problem("shard " + std::to_string(s) + " holds " + std::to_string(shard.triangle_count()) +
                 " triangles, the table says " + std::to_string(shard_triangles[s]));
+      // The runtime skips a shard by these bounds without reading it: they must hold it.
+      for (int a = 0; a < 3; ++a)
+        if (shard.triangle_count() > 0 &&
+            (shard.bounds().lo[a] < shard_bounds[6 * s + a] || shard.bounds().hi[a] > shard_bounds[6 * s + 3 + a]))
+          problem("shard " + std::to_string(s) + " reaches beyond its /tables/shard_bounds on axis " +
+                  std::to_string(a));
     } catch (const Error& error) {
       problem("shard " + std::to_string(s) + ": " + error.what());
     }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "Commands.h"
+#include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
@@ -109,7 +110,7 @@ void run_info(const InfoArguments& args) {
   if (!args.report.empty()) {
     write_report(
         args.report,
-        {{"command", "mesh info"}, {"files", files}, {"peak_rss_bytes", peak_rss_bytes()}});
+        {{"command", "mesh info"}, {"files", files}, {"peak_rss_bytes", peak_resident_bytes()}});
   }
 }
 
@@ -151,7 +152,7 @@ void run_convert(const ConvertArguments& args) {
                                {"write_seconds", write_seconds},
                                {"output_bytes", error ? 0 : output_bytes},
                                {"files", inputs},
-                               {"peak_rss_bytes", peak_rss_bytes()}});
+                               {"peak_rss_bytes", peak_resident_bytes()}});
   }
 }
 

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "Commands.h"
+#include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
@@ -66,7 +67,7 @@ void run_replay(const ReplayArguments& args) {
                                {"latency_us", latency.to_json()},
                                {"build_seconds", build_seconds},
                                {"disagreements", check.disagreements()},
-                               {"peak_rss_bytes", peak_rss_bytes()}});
+                               {"peak_rss_bytes", peak_resident_bytes()}});
   check.finish();
 }
 

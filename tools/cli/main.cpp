@@ -40,15 +40,6 @@ void check_writable(const std::filesystem::path& path) {
   std::filesystem::remove(temporary, ec);
 }
 
-std::uint64_t peak_rss_bytes() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoull(line.substr(6)) * 1024;
-  }
-  return 0;
-}
-
 }  // namespace tetrapage::cli
 
 int main(int argc, char** argv) {

@@ -94,6 +94,22 @@ std::filesystem::path MeshLibrary::default_folder() {
   return TETRAPAGE_DEFAULT_MESH_DIR;
 }
 
+MeshLibrary MeshLibrary::load_files(const std::filesystem::path& folder,
+                                    std::span<const std::filesystem::path> files, Progress& progress) {
+  MeshLibrary library;
+  library.folder_ = folder;
+  for (const auto& path : files) {
+    try {
+      library.meshes_.push_back(read_library_mesh(path));
+    } catch (const Error& e) {
+      library.skipped_.push_back(path.filename().string() + ": " + e.what());
+    }
+    progress.advance();
+  }
+  if (library.meshes_.empty()) throw InputError(no_mesh_message(folder, library.skipped_));
+  return library;
+}
+
 MeshLibrary MeshLibrary::load_default(Progress& progress) {
   const std::filesystem::path folder = default_folder();
   const char* from_environment = std::getenv("TETRAPAGE_MESH_DIR");
@@ -111,18 +127,7 @@ MeshLibrary MeshLibrary::load_default(Progress& progress) {
   }
   if (present.empty() && environment) return load_folder(folder, progress);
 
-  MeshLibrary library;
-  library.folder_ = folder;
-  for (const auto& path : present) {
-    try {
-      library.meshes_.push_back(read_library_mesh(path));
-    } catch (const Error& e) {
-      library.skipped_.push_back(path.filename().string() + ": " + e.what());
-    }
-    progress.advance();
-  }
-  if (library.meshes_.empty()) throw InputError(no_mesh_message(folder, library.skipped_));
-  return library;
+  return load_files(folder, present, progress);
 }
 
 MeshLibrary MeshLibrary::load_folder(const std::filesystem::path& folder, Progress& progress) {
@@ -139,18 +144,7 @@ MeshLibrary MeshLibrary::load_folder(const std::filesystem::path& folder, Progre
     return a.filename().string() < b.filename().string();
   });
 
-  MeshLibrary library;
-  library.folder_ = folder;
-  for (const auto& path : files) {
-    try {
-      library.meshes_.push_back(read_library_mesh(path));
-    } catch (const Error& e) {
-      library.skipped_.push_back(path.filename().string() + ": " + e.what());
-    }
-    progress.advance();
-  }
-  if (library.meshes_.empty()) throw InputError(no_mesh_message(folder, library.skipped_));
-  return library;
+  return load_files(folder, files, progress);
 }
 
 std::uint64_t MeshLibrary::total_triangles() const {

@@ -49,6 +49,9 @@ struct Manifest {
 /// @throw InputError for an unknown unit name.
 double metres_per_unit(const std::string& unit);
 
+/// Whether `path` names a manifest rather than a mesh: a ".json" extension, in any case.
+bool is_manifest_path(const std::filesystem::path& path);
+
 /// Parses a manifest. @throw IoError, FormatError (bad JSON, names the file and the JSON
 /// path of the bad field), InputError (unknown unit, non-finite or singular transform).
 Manifest read_manifest(const std::filesystem::path& path);

@@ -10,7 +10,6 @@
 ///     placement), so that the exact mode answers exactly what an exact oracle answers.
 /// One FlyingObject is used from one thread at a time; many may share a CollisionIndex.
 
-#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -49,7 +48,7 @@ struct StepCounters {
   std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
   std::uint64_t candidates = 0;     ///< phase I: shard triangles meeting the object's box
   std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
-  double locate_seconds = 0;
+  double locate_seconds = 0;        ///< the object's box, and the walk when it searched
   double search_seconds = 0;
   double shard_seconds = 0;         ///< acquiring shards (page-ins included)
   double test_seconds = 0;          ///< phase I and II

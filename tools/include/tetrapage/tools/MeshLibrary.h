@@ -72,6 +72,9 @@ class MeshLibrary {
 
  private:
   MeshLibrary() = default;
+  // Reads each file (a file that fails is skipped and listed), as both loaders do.
+  static MeshLibrary load_files(const std::filesystem::path& folder,
+                                std::span<const std::filesystem::path> files, Progress& progress);
 
   std::vector<LibraryMesh> meshes_;
   std::vector<std::string> skipped_;
