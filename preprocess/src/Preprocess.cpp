@@ -12,11 +12,13 @@
 #include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <limits>
 #include <optional>
 #include <random>
 #include <sstream>
 
 #include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/Manifest.h"
@@ -100,6 +102,9 @@ struct Ingest {
   std::uint64_t seen = 0;
   BoundingBox bounds;
   std::vector<std::string> part_names;
+  // Per part: whether its surface is closed, and its triangle count.
+  std::vector<EdgeParity> part_parity;
+  std::vector<std::uint64_t> part_triangles;
 };
 
 void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
@@ -115,6 +120,8 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     const auto part_offset = std::uint32_t(in.part_names.size());
     for (const auto& name : soup.part_names) in.part_names.push_back(name);
     if (soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
+    in.part_parity.resize(in.part_names.size());
+    in.part_triangles.resize(in.part_names.size());
     // Records go out in blocks, so that the held records never pass the limit by more than a
     // block before they spill.
     constexpr std::size_t kBlock = 1 << 16;
@@ -131,6 +138,8 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
       record.triangle = soup.corners(t);
       record.id = in.seen;
       record.part = part_offset + (soup.part_of.empty() ? 0 : soup.part_of[t]);
+      in.part_parity[record.part].add_triangle(record.triangle);
+      ++in.part_triangles[record.part];
       for (const auto& p : record.triangle) in.bounds.extend(p);
       const Vec3 c = centroid(record.triangle);
       if (in.sample.size() < sample_capacity) {
@@ -175,6 +184,87 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   summary.triangles_read = in.seen;
   summary.parts = in.part_names.size();
   if (in.seen == 0) throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
+}
+
+// The interiors: each tet's reference point classified against the closed parts, as CSR
+// tables by tet (see docs/FORMAT.md). Needs the closed parts' triangles in the classifier at
+// once: skipped, and said, when they would not fit the budget.
+struct Interiors {
+  std::vector<std::uint8_t> part_closed;
+  std::vector<double> reference_points;  // 3 per tet; NaN for a tet without one
+  std::vector<std::uint64_t> offsets;    // tet_count + 1
+  std::vector<std::uint32_t> parts;      // kInteriorUndecided marks an undecided tet
+  bool stored = false;
+};
+
+constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
+
+Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOptions& options,
+                             PreprocessSummary& summary) {
+  Interiors result;
+  std::uint64_t closed_triangles = 0;
+  result.part_closed.resize(in.part_names.size());
+  for (std::size_t p = 0; p < in.part_names.size(); ++p) {
+    result.part_closed[p] = in.part_parity[p].closed() ? 1 : 0;
+    if (result.part_closed[p]) ++summary.closed_parts, closed_triangles += in.part_triangles[p];
+  }
+  if (!options.interior_classifier) return result;
+  if (summary.closed_parts == 0) {
+    summary.interiors = "none closed";
+    return result;
+  }
+  std::unique_ptr<InteriorClassifier> classifier = options.interior_classifier();
+  const std::uint64_t needed = closed_triangles * classifier->bytes_per_triangle();
+  if (needed > options.memory_bytes) {
+    summary.interiors = "skipped: the closed parts' " + std::to_string(closed_triangles) + " triangles need about " +
+                        format_byte_size(needed) + " to classify, over --memory " +
+                        format_byte_size(options.memory_bytes);
+    return result;
+  }
+  Progress progress("classifying interiors", in.seen + mesh.tet_count(), options.progress);
+  std::vector<std::array<Vec3, 3>> run;
+  in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+    // Runs of one part go to the classifier together.
+    for (std::size_t i = 0; i < block.size();) {
+      std::size_t j = i;
+      run.clear();
+      while (j < block.size() && block[j].part == block[i].part) run.push_back(block[j++].triangle);
+      if (result.part_closed[block[i].part]) classifier->add_triangles(block[i].part, run);
+      i = j;
+    }
+    progress.advance(block.size());
+  });
+  const std::size_t tet_count = mesh.tet_count();
+  std::vector<Vec3> points(tet_count);
+  std::vector<bool> has_point(tet_count);
+  result.reference_points.resize(3 * tet_count);
+  tbb::parallel_for(std::size_t(0), tet_count, [&](std::size_t t) {
+    const auto reference = walk_reference_point(mesh, std::uint32_t(t));
+    has_point[t] = reference.has_value();
+    points[t] = reference ? *reference : mesh.vertices[mesh.tets[t][0]];
+    for (int a = 0; a < 3; ++a)
+      result.reference_points[3 * t + a] = reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
+  });
+  std::vector<PointInterior> answers;
+  classifier->classify(points, answers);
+  result.offsets.reserve(tet_count + 1);
+  result.offsets.push_back(0);
+  for (std::size_t t = 0; t < tet_count; ++t) {
+    if (!has_point[t] || !answers[t].decided) {
+      result.parts.push_back(kInteriorUndecided);
+      ++summary.interior_undecided;
+    } else {
+      std::sort(answers[t].parts.begin(), answers[t].parts.end());
+      result.parts.insert(result.parts.end(), answers[t].parts.begin(), answers[t].parts.end());
+      if (!answers[t].parts.empty()) ++summary.interior_tets;
+    }
+    result.offsets.push_back(result.parts.size());
+  }
+  progress.advance(tet_count);
+  progress.finish();
+  result.stored = true;
+  summary.interiors = "stored";
+  return result;
 }
 
 }  // namespace
@@ -235,6 +325,13 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   const std::size_t tet_count = mesh.tet_count();
   // The box the coarse mesh covers: Morton codes of tets and sample points are taken in it.
   const BoundingBox mesh_box = enlarged_bounds(in.bounds, sampling.margin);
+
+  Interiors interiors;
+  {
+    StageClock clock(summary, "interiors");
+    interiors = classify_interiors(in, mesh, options, summary);
+    clock.stop();
+  }
 
   // Tets in Morton order of their centroids: neighbouring shards sit side by side on disk.
   std::vector<std::uint32_t> order(tet_count), rank(tet_count);
@@ -425,6 +522,12 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     writer.write_table("shard_kind", std::span<const std::uint8_t>(shard_kind));
     writer.write_table("shard_triangles", std::span<const std::uint32_t>(shard_triangles));
     writer.write_table("shard_bounds", std::span<const double>(shard_bounds));
+    if (interiors.stored) {
+      writer.write_table("part_closed", std::span<const std::uint8_t>(interiors.part_closed));
+      writer.write_table("reference_points", std::span<const double>(interiors.reference_points));
+      writer.write_table("interior_offsets", std::span<const std::uint64_t>(interiors.offsets));
+      writer.write_table("interior_parts", std::span<const std::uint32_t>(interiors.parts));
+    }
     IndexHeader header;
     header.precision = summary.precision;
     header.input_triangles = triangle_count;
@@ -471,6 +574,10 @@ std::string PreprocessSummary::to_json() const {
   j["max_rounding_distance"] = max_rounding_distance;
   j["query_extent"] = query_extent;
   j["memory_budget_bytes"] = memory_budget_bytes;
+  j["closed_parts"] = closed_parts;
+  j["interiors"] = interiors;
+  j["interior_tets"] = interior_tets;
+  j["interior_undecided"] = interior_undecided;
   j["buckets"] = buckets;
   j["spilled"] = spilled;
   j["seconds"] = seconds;
@@ -497,6 +604,10 @@ std::string PreprocessSummary::to_text() const {
                 output.string().c_str(), format_byte_size(bytes_written).c_str(),
                 triangles_read ? double(bytes_written) / double(triangles_read) : 0.0,
                 format_byte_size(shard_payload_bytes).c_str(), precision.c_str(), max_rounding_distance);
+  text << line;
+  std::snprintf(line, sizeof line, "closed parts %llu; interiors %s (%llu tets inside, %llu undecided)\n",
+                (unsigned long long)closed_parts, interiors.c_str(), (unsigned long long)interior_tets,
+                (unsigned long long)interior_undecided);
   text << line;
   for (const auto& stage : stages) {
     std::snprintf(line, sizeof line, "  %-12s %8.2f s  peak RSS %s\n", stage.name.c_str(), stage.seconds,

@@ -2,6 +2,9 @@
 
 #include "tetrapage/formats/Error.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace tetrapage {
 
 CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndexOptions options)
@@ -37,6 +40,7 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
     shard_bytes_[s] = reader_.shard_size(s) + 4096;
     total_shard_bytes_ += shard_bytes_[s];
   }
+  read_interiors(where);
   ShardCacheOptions cache_options;
   cache_options.prefetch_threads = options_.prefetch ? std::max<std::size_t>(1, options_.prefetch_threads) : 0;
   const IndexReader* reader = &reader_;
@@ -49,5 +53,42 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
 }
 
 CollisionIndex::~CollisionIndex() = default;
+
+void CollisionIndex::read_interiors(const std::string& where) {
+  const auto names = reader_.table_names();
+  const auto has = [&](const char* name) { return std::find(names.begin(), names.end(), name) != names.end(); };
+  if (!has("interior_offsets")) return;  // written without interiors: surfaces only
+  const std::size_t tets = mesh_.tet_count();
+  part_closed_ = reader_.read_table_uint8("part_closed");
+  const auto points = reader_.read_table_double("reference_points");
+  auto offsets = reader_.read_table_uint64("interior_offsets");
+  interior_parts_ = reader_.read_table_uint32("interior_parts");
+  if (points.size() != 3 * tets)
+    throw FormatError(where + "/tables/reference_points has " + std::to_string(points.size()) + " values for " +
+                      std::to_string(tets) + " tets (3 each)");
+  if (offsets.size() != tets + 1 || offsets.front() != 0 || offsets.back() != interior_parts_.size())
+    throw FormatError(where + "/tables/interior_offsets does not delimit /tables/interior_parts for " +
+                      std::to_string(tets) + " tets");
+  for (std::size_t t = 0; t < tets; ++t) {
+    if (offsets[t + 1] < offsets[t])
+      throw FormatError(where + "/tables/interior_offsets decreases at tet " + std::to_string(t));
+    for (std::uint64_t i = offsets[t]; i < offsets[t + 1]; ++i) {
+      const std::uint32_t part = interior_parts_[i];
+      const bool undecided = part == kInteriorUndecided && offsets[t + 1] - offsets[t] == 1;
+      if (!undecided && !part_closed(part))
+        throw FormatError(where + "/tables/interior_parts names part " + std::to_string(part) + " for tet " +
+                          std::to_string(t) + ", which is not a closed part");
+    }
+  }
+  reference_points_.resize(tets);
+  for (std::size_t t = 0; t < tets; ++t) {
+    reference_points_[t] = {points[3 * t], points[3 * t + 1], points[3 * t + 2]};
+    // A NaN point is stored for an undecided tet only; any other must lie in its tet.
+    const bool finite = std::isfinite(points[3 * t]) && std::isfinite(points[3 * t + 1]) && std::isfinite(points[3 * t + 2]);
+    if (!finite && !(offsets[t + 1] - offsets[t] == 1 && interior_parts_[offsets[t]] == kInteriorUndecided))
+      throw FormatError(where + "/tables/reference_points holds a non-finite point for tet " + std::to_string(t));
+  }
+  interior_offsets_ = std::move(offsets);
+}
 
 }  // namespace tetrapage

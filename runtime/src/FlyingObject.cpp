@@ -9,7 +9,10 @@
 #include <map>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/runtime/geometry/SegmentTriangle.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 
 namespace tetrapage {
@@ -39,6 +42,9 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, Triangle
   if (!index_) throw InputError("a flying object needs an index");
   for (const auto& v : object_.vertices)
     object_radius_ = std::max(object_radius_, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+  EdgeParity parity;
+  for (std::size_t t = 0; t < object_.triangle_count(); ++t) parity.add_triangle(object_.corners(t));
+  closed_ = parity.closed();
   world_.resize(object_.vertices.size());
   world_step_.assign(object_.vertices.size(), ~std::uint64_t{0});
 
@@ -216,7 +222,10 @@ void FlyingObject::release_region() {
 
 void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryResult& result) {
   result.collides = false;
+  result.containment = Containment::none;
+  result.containing_part = 0;
   result.contacts.clear();
+  enclosed_.clear();
   result.outside_model = false;
   result.counters = {};
   StepCounters& counters = result.counters;
@@ -254,6 +263,9 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       ++counters.candidates;
       const geometry::Triangle environment = shard.triangle(local);
+      if (closed_ && !result.collides && geometry::box_contains(box, environment[0]) &&
+          geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]))
+        enclosed_.emplace_back(environment[0], shard.part_id(local));
       // The environment triangle in the object's frame (rounded: it only prunes).
       geometry::Box query;
       for (const auto& p : environment) {
@@ -305,6 +317,73 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     }
     test_shard(keep_pins_ ? *pins_[k] : *local_pin);
   }
+  if (!result.collides) check_containment(box, result);
+}
+
+void FlyingObject::check_containment(const geometry::Box& box, QueryResult& result) {
+  const auto start = Clock::now();
+  // The object inside an obstacle: with no surface contact, one vertex decides for all.
+  if (index_->has_interiors()) {
+    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(object_.triangles[0][0]));
+    if (inside.containment == ObstacleContainment::inside) {
+      result.collides = true;
+      result.containment = Containment::object_inside_obstacle;
+      result.containing_part = inside.part;
+    }
+  }
+  // An obstacle inside the object: each enclosed candidate triangle lies wholly inside or
+  // wholly outside (its surface does not cross the object's), so one vertex decides.
+  for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
+    if (i > 0 && enclosed_[i].first == enclosed_[i - 1].first) continue;
+    if (object_holds(enclosed_[i].first, box)) {
+      result.collides = true;
+      result.containment = Containment::obstacle_inside_object;
+      result.containing_part = enclosed_[i].second;
+    }
+  }
+  result.counters.interior_seconds = seconds_since(start);
+}
+
+bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& box) {
+  // Parity of crossings with the placed object along a segment from p to beyond the object's
+  // box; a direction whose segment meets an edge, a vertex or a plane is replaced by the next.
+  static constexpr std::array<std::array<double, 3>, 5> kDirections{{{0.0123457, 0.0345679, 1.0},
+                                                                     {0.9134, -0.2718, 0.3011},
+                                                                     {-0.3141, 0.8660, -0.3890},
+                                                                     {-0.5772, -0.6931, 0.4142},
+                                                                     {0.2236, 0.1414, -0.9643}}};
+  const double reach = 2 * std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
+  for (const auto& d : kDirections) {
+    const double largest = std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
+    const geometry::Point far{p[0] + d[0] * reach / largest, p[1] + d[1] * reach / largest,
+                              p[2] + d[2] * reach / largest};
+    const geometry::Segment segment{p, far};
+    // The segment's box in the object's frame (rounded: it only prunes), as in phase II.
+    geometry::Box query;
+    double magnitude = object_radius_;
+    for (const auto& q : segment) {
+      const Vec3 e{q[0] - translation_[0], q[1] - translation_[1], q[2] - translation_[2]};
+      query.extend(Vec3{rotation_[0] * e[0] + rotation_[3] * e[1] + rotation_[6] * e[2],
+                        rotation_[1] * e[0] + rotation_[4] * e[1] + rotation_[7] * e[2],
+                        rotation_[2] * e[0] + rotation_[5] * e[1] + rotation_[8] * e[2]});
+      for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(q[a]) + std::fabs(translation_[a]));
+    }
+    const double grow = magnitude * 0x1p-40;
+    for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
+    bool generic = true, odd = false;
+    bvh_.for_each_in_box(query, [&](std::uint32_t t) {
+      const auto hit = geometry::classify_segment_triangle(segment, world_triangle(t));
+      if (!hit) return true;
+      if (hit.contact != geometry::SegmentTriangleContact::interior || hit.at_endpoint) {
+        generic = false;
+        return false;
+      }
+      odd = !odd;
+      return true;
+    });
+    if (generic) return odd;
+  }
+  return false;  // every direction grazed the object: taken as outside
 }
 
 }  // namespace tetrapage

@@ -45,7 +45,7 @@ void run_fly(const FlyArguments& args) {
 
   std::vector<std::uint8_t> answers(poses.size());
   std::vector<double> seconds(poses.size());
-  std::uint64_t collisions = 0, outside = 0, contacts = 0;
+  std::uint64_t collisions = 0, outside = 0, contacts = 0, containments = 0;
   std::uint64_t candidates = 0, triangle_tests = 0, tets_visited = 0, shards_touched = 0;
   Progress progress("flying", poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
@@ -56,6 +56,7 @@ void run_fly(const FlyArguments& args) {
     if (i == 0) first_answer_seconds = std::chrono::duration<double>(end - open_start).count();
     answers[i] = result.collides ? 1 : 0;
     collisions += answers[i];
+    containments += result.containment != Containment::none ? 1 : 0;
     contacts += result.contacts.size();
     outside += result.outside_model ? 1 : 0;
     candidates += result.counters.candidates;
@@ -74,8 +75,10 @@ void run_fly(const FlyArguments& args) {
   const double lookups = double(cache.hits + cache.misses);
   const double hit_rate = lookups > 0 ? double(cache.hits) / lookups : 1.0;
   const double steps = std::max<double>(1, double(poses.size()));
-  std::printf("fly (%s, %s): %zu steps, %llu collisions\n", args.accuracy.c_str(),
-              args.no_prefetch ? "no prefetch" : "prefetch", poses.size(), (unsigned long long)collisions);
+  std::printf("fly (%s, %s): %zu steps, %llu collisions (%llu by containment: one body inside the other)%s\n",
+              args.accuracy.c_str(), args.no_prefetch ? "no prefetch" : "prefetch", poses.size(),
+              (unsigned long long)collisions, (unsigned long long)containments,
+              index->has_interiors() ? "" : "; the index has no interiors: objects inside obstacles go unseen");
   std::printf("%.0f steps/s, latency p50 %.1f us, p95 %.1f us, p99 %.1f us, max %.1f us; open to first answer %.1f ms\n",
               steps_per_second, latency.p50_us, latency.p95_us, latency.p99_us, latency.max_us,
               first_answer_seconds * 1e3);
@@ -95,6 +98,8 @@ void run_fly(const FlyArguments& args) {
                                {"prefetch", !args.no_prefetch},
                                {"steps", poses.size()},
                                {"collisions", collisions},
+                               {"containments", containments},
+                               {"index_has_interiors", index->has_interiors()},
                                {"contacts", contacts},
                                {"steps_outside_model", outside},
                                {"steps_per_second", steps_per_second},

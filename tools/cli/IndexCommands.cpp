@@ -1,6 +1,7 @@
 // `tetrapage preprocess`, `inspect` and `validate`: build an index, show where its bytes go,
 // and check it from end to end.
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -13,6 +14,7 @@
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
+#include "tetrapage/tools/EmbreeInteriorClassifier.h"
 
 namespace tetrapage::cli {
 namespace {
@@ -26,6 +28,7 @@ struct PreprocessArguments {
   std::string shard = "auto";
   std::string precision = "float";
   double query_extent = 0;
+  std::string interiors = "on";
   std::filesystem::path report;
 };
 
@@ -39,6 +42,7 @@ void run_preprocess(const PreprocessArguments& args) {
   options.precision = parse_stored_precision(args.precision);
   options.query_extent = args.query_extent;
   options.progress = true;
+  if (args.interiors == "on") options.interior_classifier = embree_interior_classifier();
   const PreprocessSummary summary = preprocess(args.inputs, args.output, options);
   std::fputs(summary.to_text().c_str(), stdout);
   if (!args.report.empty()) write_report(args.report, nlohmann::json::parse(summary.to_json()));
@@ -48,6 +52,32 @@ struct InspectArguments {
   std::filesystem::path index;
   std::filesystem::path report;
 };
+
+struct InteriorFigures {
+  std::string text;
+  nlohmann::json json;
+};
+
+// What the interiors tables hold (preprocess --interiors): closed parts, tets inside, undecided.
+InteriorFigures interior_figures(const IndexReader& reader, std::size_t tets) {
+  const auto names = reader.table_names();
+  if (std::find(names.begin(), names.end(), "interior_offsets") == names.end())
+    return {"interiors: not stored (objects inside obstacles go unseen)", {{"stored", false}}};
+  const auto closed = reader.read_table_uint8("part_closed");
+  const auto offsets = reader.read_table_uint64("interior_offsets");
+  const auto parts = reader.read_table_uint32("interior_parts");
+  std::uint64_t closed_parts = 0, inside = 0, undecided = 0;
+  for (const auto c : closed) closed_parts += c != 0;
+  for (std::size_t t = 0; t + 1 < offsets.size() && t < tets; ++t) {
+    if (offsets[t + 1] == offsets[t]) continue;
+    if (offsets[t + 1] - offsets[t] == 1 && offsets[t] < parts.size() && parts[offsets[t]] == 0xffffffffu) ++undecided;
+    else ++inside;
+  }
+  char line[256];
+  std::snprintf(line, sizeof line, "interiors: %llu of %zu parts closed; %llu tets with their reference point inside, %llu undecided",
+                (unsigned long long)closed_parts, closed.size(), (unsigned long long)inside, (unsigned long long)undecided);
+  return {line, {{"stored", true}, {"closed_parts", closed_parts}, {"tets_inside", inside}, {"tets_undecided", undecided}}};
+}
 
 void run_inspect(const InspectArguments& args) {
   const IndexReader reader(args.index);
@@ -84,6 +114,8 @@ void run_inspect(const InspectArguments& args) {
               format_byte_size(stored).c_str(), double(stored) / triangles, format_byte_size(kind_bytes[0]).c_str(),
               format_byte_size(kind_bytes[1]).c_str(), format_byte_size(decoded).c_str(),
               double(decoded) / triangles);
+  const InteriorFigures interiors = interior_figures(reader, mesh.tet_count());
+  std::printf("%s\n", interiors.text.c_str());
   if (!args.report.empty()) {
     nlohmann::json report{{"index", args.index.string()},
                           {"version", header.version},
@@ -97,7 +129,8 @@ void run_inspect(const InspectArguments& args) {
                           {"rtree_shards", kinds[1]},
                           {"shard_stored_bytes", stored},
                           {"shard_decoded_bytes", decoded},
-                          {"max_rounding_distance", header.max_rounding_distance}};
+                          {"max_rounding_distance", header.max_rounding_distance},
+                          {"interiors", interiors.json}};
     write_report(args.report, report);
   }
 }
@@ -192,6 +225,12 @@ void add_index_commands(CLI::App& app) {
   command->add_option("--query-extent", pre->query_extent,
                       "Side of the query boxes the cost model plans for (0: 5% of the model's size)")
       ->capture_default_str();
+  command->add_option("--interiors", pre->interiors,
+                      "Classify each region's reference point against the closed parts (Embree ray parity)\n"
+                      "so that the runtime reports an object inside an obstacle; needs the closed parts'\n"
+                      "triangles in memory (about 190 B each), skipped with a note when over --memory")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"on", "off"}));
   command->add_option("--report", pre->report, "Write the summary as JSON");
   command->callback([pre] { run_preprocess(*pre); });
 

@@ -6,7 +6,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "tetrapage/formats/Error.h"
@@ -24,9 +26,40 @@ using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
 
 Point to_point(const Vec3& v) { return Point(v[0], v[1], v[2]); }
 
-// A direction with no rational relation to the axes, so that rays from generated points
-// almost never graze an edge; mostly +z so that "below a terrain" reads as inside.
-const Kernel::Vector_3 kParityDirection(0.01234567890123, 0.03456789012345, 1.0);
+// Directions with no rational relation to the axes or each other; a parity is the majority
+// of the three, so that one ray grazing an edge cannot decide alone.
+const std::array<Kernel::Vector_3, 3> kParityDirections{Kernel::Vector_3(0.01234567890123, 0.03456789012345, 1.0),
+                                                        Kernel::Vector_3(0.7071067811865, -0.5772156649015, 0.2718281828459),
+                                                        Kernel::Vector_3(-0.4142135623731, 0.6180339887499, -0.5)};
+
+// Exact closedness per part (the oracle does not share EdgeParity's hashing): every edge, an
+// unordered pair of vertex positions, is used an even number of times.
+std::vector<bool> closed_by_edge_count(const TriangleSoup& soup) {
+  std::vector<std::vector<std::array<Vec3, 2>>> edges(std::max<std::size_t>(1, soup.part_count()));
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    const auto c = soup.corners(t);
+    auto& list = edges[soup.part_of.empty() ? 0 : soup.part_of[t]];
+    for (int k = 0; k < 3; ++k) {
+      std::array<Vec3, 2> edge{c[k], c[(k + 1) % 3]};
+      for (auto& p : edge)
+        for (auto& x : p) x = x == 0.0 ? 0.0 : x;
+      if (edge[1] < edge[0]) std::swap(edge[0], edge[1]);
+      list.push_back(edge);
+    }
+  }
+  std::vector<bool> closed(edges.size(), true);
+  for (std::size_t part = 0; part < edges.size(); ++part) {
+    auto& list = edges[part];
+    std::sort(list.begin(), list.end());
+    for (std::size_t i = 0; i < list.size();) {
+      std::size_t j = i;
+      while (j < list.size() && list[j] == list[i]) ++j;
+      if ((j - i) % 2 == 1) closed[part] = false;
+      i = j;
+    }
+  }
+  return closed;
+}
 
 }  // namespace
 
@@ -36,10 +69,14 @@ class ReferenceCollider::Impl {
     if (environment.triangles.empty())
       throw InputError("reference collider: the environment has no triangle");
     if (object.triangles.empty()) throw InputError("reference collider: the object has no triangle");
+    environment_closed_ = closed_by_edge_count(environment);
+    object_closed_ = closed_by_edge_count(object).front();
     environment_triangles_.reserve(environment.triangles.size());
+    environment_part_.reserve(environment.triangles.size());
     for (std::size_t t = 0; t < environment.triangles.size(); ++t) {
       const auto c = environment.corners(t);
       environment_triangles_.emplace_back(to_point(c[0]), to_point(c[1]), to_point(c[2]));
+      environment_part_.push_back(environment.part_of.empty() ? 0 : environment.part_of[t]);
     }
     environment_bounds_ = environment.bounds();
     environment_tree_.rebuild(environment_triangles_.begin(), environment_triangles_.end());
@@ -66,13 +103,51 @@ class ReferenceCollider::Impl {
     environment_tree_.all_intersected_primitives(object_box, std::back_inserter(candidates));
     answer.candidates = candidates.size();
     if (!candidates.empty()) answer.surfaces_touch = surfaces_touch(placed, candidates);
-    if (!answer.surfaces_touch) answer.object_inside = inside(placed.front());
-    answer.collides = answer.surfaces_touch || answer.object_inside;
+    if (!answer.surfaces_touch) answer.object_inside = inside(placed[object_triangles_.front()[0]]);
+    if (!answer.surfaces_touch && !answer.object_inside && object_closed_)
+      answer.obstacle_inside = obstacle_inside(placed, box, candidates);
+    answer.collides = answer.surfaces_touch || answer.object_inside || answer.obstacle_inside;
     return answer;
   }
 
+  // Inside some closed part: per part, the majority of three ray parities.
   bool inside(const Point& p) const {
-    return environment_tree_.number_of_intersected_primitives(Ray(p, kParityDirection)) % 2 == 1;
+    std::map<std::uint32_t, int> votes;
+    for (const auto& direction : kParityDirections) {
+      std::vector<Tree::Primitive_id> hits;
+      environment_tree_.all_intersected_primitives(Ray(p, direction), std::back_inserter(hits));
+      std::map<std::uint32_t, int> crossings;
+      for (const auto& id : hits) {
+        const std::uint32_t part = environment_part_[std::size_t(id - environment_triangles_.begin())];
+        if (environment_closed_[part]) ++crossings[part];
+      }
+      for (const auto& [part, count] : crossings) votes[part] += count % 2;
+    }
+    for (const auto& [part, odd] : votes)
+      if (odd >= 2) return true;
+    return false;
+  }
+
+  // Some environment triangle inside the closed object: only candidates whose box lies in the
+  // object's box can be; with no surface contact, one vertex decides for its whole triangle.
+  bool obstacle_inside(const std::vector<Point>& placed, const BoundingBox& box,
+                       const std::vector<Tree::Primitive_id>& candidates) const {
+    for (const auto& id : candidates) {
+      const CGAL::Bbox_3 b = id->bbox();
+      if (b.xmin() < box.lo[0] || b.ymin() < box.lo[1] || b.zmin() < box.lo[2] || b.xmax() > box.hi[0] ||
+          b.ymax() > box.hi[1] || b.zmax() > box.hi[2])
+        continue;
+      int odd = 0;
+      for (const auto& direction : kParityDirections) {
+        const Ray ray(id->vertex(0), direction);
+        int crossings = 0;
+        for (const auto& tri : object_triangles_)
+          if (CGAL::do_intersect(ray, Triangle(placed[tri[0]], placed[tri[1]], placed[tri[2]]))) ++crossings;
+        odd += crossings % 2;
+      }
+      if (odd >= 2) return true;
+    }
+    return false;
   }
 
   BoundingBox object_bounds(const Pose& pose) const {
@@ -109,6 +184,9 @@ class ReferenceCollider::Impl {
   }
 
   std::vector<Triangle> environment_triangles_;
+  std::vector<std::uint32_t> environment_part_;
+  std::vector<bool> environment_closed_;
+  bool object_closed_ = false;
   Tree environment_tree_;
   BoundingBox environment_bounds_;
   std::vector<Vec3> object_vertices_;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tetrapage/runtime/ShardKind.h"
+#include "tetrapage/preprocess/InteriorClassifier.h"
 
 namespace tetrapage {
 
@@ -39,6 +40,10 @@ struct PreprocessOptions {
   bool progress = false;
   /// Where spill files go; empty: next to the output.
   std::filesystem::path spill_folder;
+  /// The ray-shooting engine that classifies each tet's reference point against the closed
+  /// parts (InteriorClassifier.h); empty: interiors are not stored, and the runtime then
+  /// reports only touching surfaces.
+  InteriorClassifierFactory interior_classifier;
 };
 
 /// Time and peak resident memory of one stage.
@@ -68,6 +73,11 @@ struct PreprocessSummary {
   std::string precision;
   double query_extent = 0;
   std::uint64_t memory_budget_bytes = 0;
+  std::uint64_t closed_parts = 0;          ///< parts whose every edge is used an even number of times
+  /// "stored", "off" (no classifier), "none closed", or "skipped: <why>".
+  std::string interiors = "off";
+  std::uint64_t interior_tets = 0;         ///< tets whose reference point is inside a closed part
+  std::uint64_t interior_undecided = 0;    ///< tets whose reference point could not be classified
   std::uint64_t buckets = 0;               ///< tet buckets processed one at a time
   bool spilled = false;                    ///< whether the stages used spill files
   std::uint64_t peak_resident_bytes = 0;   ///< the whole run

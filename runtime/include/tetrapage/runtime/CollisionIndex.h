@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "tetrapage/formats/IndexReader.h"
@@ -54,7 +55,31 @@ class CollisionIndex {
 
   ShardCache<Shard>& cache() const { return *cache_; }
 
+  /// Whether the index stores the interiors of closed parts (preprocess --interiors on):
+  /// each tet's reference point classified against the closed parts (ObstacleInterior.h).
+  bool has_interiors() const { return !interior_offsets_.empty(); }
+  /// A point strictly inside the tet whose classification is stored (has_interiors()).
+  const geometry::Point& reference_point(std::uint32_t tet) const { return reference_points_[tet]; }
+  /// False when the preprocess could not classify the tet's reference point.
+  bool interior_decided(std::uint32_t tet) const {
+    return interior_offsets_[tet + 1] == interior_offsets_[tet] ||
+           interior_parts_[interior_offsets_[tet]] != kInteriorUndecided;
+  }
+  /// The closed parts whose interior holds the tet's reference point (sorted; empty for an
+  /// undecided tet).
+  std::span<const std::uint32_t> interior_parts(std::uint32_t tet) const {
+    if (!interior_decided(tet)) return {};
+    return std::span<const std::uint32_t>(interior_parts_).subspan(
+        interior_offsets_[tet], interior_offsets_[tet + 1] - interior_offsets_[tet]);
+  }
+  /// Whether part `part` has a closed surface (false for unknown parts or without interiors).
+  bool part_closed(std::uint32_t part) const { return part < part_closed_.size() && part_closed_[part] != 0; }
+  /// The marker of an undecided tet in /tables/interior_parts.
+  static constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
+
  private:
+  void read_interiors(const std::string& where);
+
   IndexReader reader_;
   CollisionIndexOptions options_;
   TetMesh mesh_;
@@ -63,6 +88,10 @@ class CollisionIndex {
   std::vector<std::uint64_t> shard_bytes_;
   std::vector<geometry::Box> shard_bounds_;
   std::uint64_t total_shard_bytes_ = 0;
+  std::vector<std::uint8_t> part_closed_;
+  std::vector<geometry::Point> reference_points_;
+  std::vector<std::uint64_t> interior_offsets_;
+  std::vector<std::uint32_t> interior_parts_;
   std::unique_ptr<ShardCache<Shard>> cache_;
 };
 

@@ -52,10 +52,21 @@ struct StepCounters {
   double search_seconds = 0;
   double shard_seconds = 0;         ///< acquiring shards (page-ins included)
   double test_seconds = 0;          ///< phase I and II
+  double interior_seconds = 0;      ///< the containment checks of a step without contact
+};
+
+/// A collision without touching surfaces: one closed body holds the other.
+enum class Containment : std::uint8_t {
+  none,
+  object_inside_obstacle,  ///< the object lies inside a closed part (the index's interiors)
+  obstacle_inside_object,  ///< an environment triangle lies inside the closed object
 };
 
 struct QueryResult {
+  /// Surfaces touch (contacts), or one body contains the other (containment).
   bool collides = false;
+  Containment containment = Containment::none;
+  std::uint32_t containing_part = 0;  ///< the environment part of a containment
   /// first_hit: the first contact found; all_contacts: every pair (unordered).
   std::vector<Contact> contacts;
   /// The object's box lies entirely outside the model's coarse mesh (nothing to touch).
@@ -88,6 +99,9 @@ class FlyingObject {
 
   const TriangleSoup& object() const { return object_; }
   std::size_t hull_vertex_count() const { return hull_vertices_.size(); }
+  /// Every edge of the object is used an even number of times (EdgeParity): only then can an
+  /// obstacle lie inside it.
+  bool closed() const { return closed_; }
 
  private:
   void place(const Pose& pose);
@@ -97,12 +111,20 @@ class FlyingObject {
   void prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet);
   void release_region();
   const Vec3& world_vertex(std::uint32_t v);
+  // Containment checks of a step whose surfaces do not touch.
+  void check_containment(const geometry::Box& box, QueryResult& result);
+  bool object_holds(const geometry::Point& p, const geometry::Box& box);
   geometry::Triangle world_triangle(std::uint32_t t);
 
   std::shared_ptr<const CollisionIndex> index_;
   TriangleSoup object_;
   geometry::ObjectBVH bvh_;
   double object_radius_ = 0;  ///< largest |x| over the object's vertices (object frame)
+  bool closed_ = false;
+  // Per step: a vertex and the part of each candidate environment triangle whose box lies in
+  // the object's box (only those can lie inside the object).
+  std::vector<std::pair<geometry::Point, std::uint32_t>> enclosed_;
+  std::uint32_t interior_tet_ = 0;  ///< where the last containment walk ended
   // The convex hull as a vertex graph: object vertex ids and neighbour lists (CSR).
   std::vector<std::uint32_t> hull_vertices_;
   std::vector<std::uint32_t> hull_offsets_, hull_neighbours_;  // indices into hull_vertices_

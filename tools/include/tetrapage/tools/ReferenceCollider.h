@@ -7,9 +7,12 @@
 /// Definition of "collides" (the one every tetrapage answer is checked against): the object's
 /// vertices are placed in world space by apply_pose() (formats/Pose.h), in double; the pose
 /// collides when some placed object triangle and some environment triangle intersect as
-/// closed sets (touching counts), decided exactly on those doubles; or when the object lies
-/// inside an obstacle: its first vertex has odd crossing parity along a fixed ray against
-/// the environment (for a terrain, a surface that is not closed, "inside" means below it).
+/// closed sets (touching counts), decided exactly on those doubles; or, when no surfaces
+/// touch, when one body lies inside the other: the object's first vertex has odd crossing
+/// parity with some closed part of the environment (a part whose every edge is used an even
+/// number of times; open parts such as terrains have no inside), or a vertex of an
+/// environment triangle has odd parity with the closed object. Each parity is the majority
+/// of three rays in fixed generic directions.
 
 #include <cstdint>
 #include <memory>
@@ -22,9 +25,10 @@ namespace tetrapage {
 class ReferenceCollider {
  public:
   struct Answer {
-    bool collides = false;        ///< surfaces_touch || object_inside
+    bool collides = false;        ///< surfaces_touch || object_inside || obstacle_inside
     bool surfaces_touch = false;  ///< some triangle pair intersects
-    bool object_inside = false;   ///< no touch, but the object is inside an obstacle
+    bool object_inside = false;   ///< no touch, but the object is inside a closed part
+    bool obstacle_inside = false; ///< no touch, but an environment triangle is inside the object
     std::uint64_t candidates = 0; ///< environment triangles meeting the object's box
   };
 
@@ -38,7 +42,7 @@ class ReferenceCollider {
   /// Answers one pose. Thread-safe (const, no shared scratch).
   Answer query(const Pose& pose) const;
 
-  /// Parity of crossings of the fixed reference ray from p with the environment.
+  /// Whether p is inside a closed part of the environment (crossing parity, see above).
   bool inside_environment(const Vec3& p) const;
 
   /// Bounding box of the object placed at `pose` (from all its placed vertices).

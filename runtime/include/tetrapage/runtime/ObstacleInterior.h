@@ -1,0 +1,38 @@
+#pragma once
+/// @file ObstacleInterior.h
+/// Whether a point lies inside a closed obstacle, from the interiors stored in the index (the
+/// study's footnote 3): locate the point's tet by walking, then count the crossings between
+/// the tet's own triangles and the segment from the tet's reference point (whose closed parts
+/// the preprocess classified) to the point. The tet is convex, so the segment never leaves it
+/// and every triangle it can cross is in the tet's shard: no ray through the whole model.
+/// Crossings are decided exactly on the stored triangles; a segment that meets a triangle's
+/// edge or vertex, or lies in its plane, is bent through another point strictly inside the tet
+/// (parity along a closed surface does not depend on the path).
+#include <cstdint>
+
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/geometry/Shapes.h"
+
+namespace tetrapage {
+
+enum class ObstacleContainment : std::uint8_t {
+  outside,     ///< in no closed part (or outside the coarse mesh, which encloses every obstacle)
+  inside,      ///< inside closed part `part`
+  on_surface,  ///< on a stored triangle of a closed part
+  unknown,     ///< the index has no interiors, or the tet is undecided, or every path was degenerate
+};
+
+struct ObstacleQuery {
+  ObstacleContainment containment = ObstacleContainment::unknown;
+  std::uint32_t part = 0;           ///< when inside: one closed part holding the point
+  std::uint32_t tet = 0;            ///< the tet that holds the point (unless outside the mesh)
+  std::uint32_t paths_tried = 0;    ///< segments from the reference point (1 unless degenerate)
+  std::uint64_t triangle_tests = 0; ///< exact segment/triangle tests
+};
+
+/// Locates p from hint_tet (updated to p's tet, so that the next call walks from there) and
+/// decides whether it is inside a closed obstacle. Pages in the tet's shard when it has one.
+/// @throw InputError for a non-finite p or a hint out of range; what the shard cache throws.
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet, const geometry::Point& p);
+
+}  // namespace tetrapage

@@ -1,0 +1,123 @@
+#include "tetrapage/runtime/ObstacleInterior.h"
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/geometry/PointTetrahedron.h"
+#include "tetrapage/runtime/geometry/SegmentTriangle.h"
+
+namespace tetrapage {
+namespace {
+
+// Barycentric weights of the bend points tried after a degenerate straight path: positive,
+// unequal, far from any face, and from each other.
+constexpr std::array<std::array<double, 4>, 8> kBendWeights{{{0.31, 0.23, 0.27, 0.19},
+                                                             {0.17, 0.37, 0.21, 0.25},
+                                                             {0.29, 0.13, 0.39, 0.19},
+                                                             {0.22, 0.28, 0.11, 0.39},
+                                                             {0.41, 0.19, 0.17, 0.23},
+                                                             {0.14, 0.33, 0.35, 0.18},
+                                                             {0.36, 0.26, 0.15, 0.23},
+                                                             {0.2, 0.16, 0.31, 0.33}}};
+
+void toggle(std::vector<std::uint32_t>& parts, std::uint32_t part) {
+  const auto at = std::find(parts.begin(), parts.end(), part);
+  if (at == parts.end()) parts.push_back(part);
+  else parts.erase(at);
+}
+
+// Toggles the closed parts the open segment crosses; false when some closed-part triangle
+// meets it other than in one interior point away from its ends (the path is degenerate).
+bool count_crossings(const CollisionIndex& index, const Shard& shard, const geometry::Segment& segment,
+                     std::vector<std::uint32_t>& parts, std::uint64_t& tests) {
+  geometry::Box box;
+  box.extend(segment[0]);
+  box.extend(segment[1]);
+  bool generic = true;
+  shard.for_each_candidate(box, [&](std::uint32_t local) {
+    if (!generic) return;
+    const std::uint32_t part = shard.part_id(local);
+    if (!index.part_closed(part)) return;
+    ++tests;
+    const auto hit = geometry::classify_segment_triangle(segment, shard.triangle(local));
+    if (!hit) return;
+    if (hit.contact == geometry::SegmentTriangleContact::interior && !hit.at_endpoint) toggle(parts, part);
+    else generic = false;
+  });
+  return generic;
+}
+
+bool on_closed_surface(const CollisionIndex& index, const Shard& shard, const geometry::Point& p,
+                       std::uint64_t& tests) {
+  geometry::Box box;
+  box.extend(p);
+  bool on = false;
+  shard.for_each_candidate(box, [&](std::uint32_t local) {
+    if (on || !index.part_closed(shard.part_id(local))) return;
+    ++tests;
+    on = geometry::segment_intersects_triangle({p, p}, shard.triangle(local));
+  });
+  return on;
+}
+
+}  // namespace
+
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet, const geometry::Point& p) {
+  ObstacleQuery answer;
+  if (!index.has_interiors()) return answer;
+  const TetMesh& mesh = index.mesh();
+  const WalkResult located = locate_point(mesh, hint_tet, p);
+  if (located.tet == TetMesh::no_neighbour) {
+    answer.containment = ObstacleContainment::outside;
+    return answer;
+  }
+  hint_tet = answer.tet = located.tet;
+  if (!index.interior_decided(located.tet)) return answer;
+  const auto stored = index.interior_parts(located.tet);
+  std::vector<std::uint32_t> parts(stored.begin(), stored.end());
+  const auto finish = [&] {
+    if (parts.empty()) {
+      answer.containment = ObstacleContainment::outside;
+    } else {
+      answer.containment = ObstacleContainment::inside;
+      answer.part = *std::min_element(parts.begin(), parts.end());
+    }
+    return answer;
+  };
+  const std::uint32_t shard_id = index.shard_of_tet(located.tet);
+  const geometry::Point& reference = index.reference_point(located.tet);
+  geometry::Box reach;
+  reach.extend(reference);
+  reach.extend(p);
+  if (shard_id == TetMesh::no_neighbour || !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
+    answer.paths_tried = 1;
+    return finish();  // no stored triangle near the segment: nothing to cross
+  }
+  const auto pin = index.cache().acquire(shard_id);
+  const Shard& shard = *pin;
+  ++answer.paths_tried;
+  if (count_crossings(index, shard, {reference, p}, parts, answer.triangle_tests)) return finish();
+  if (on_closed_surface(index, shard, p, answer.triangle_tests)) {
+    answer.containment = ObstacleContainment::on_surface;
+    return answer;
+  }
+  const auto corners = mesh.corners(located.tet);
+  for (const auto& w : kBendWeights) {
+    geometry::Point bend{};
+    for (int a = 0; a < 3; ++a)
+      bend[a] = w[0] * corners[0][a] + w[1] * corners[1][a] + w[2] * corners[2][a] + w[3] * corners[3][a];
+    // Rounding may move the bend point: it must stay strictly inside for the path to stay in.
+    if (geometry::locate_in_tetrahedron(bend, corners).position != geometry::TetrahedronPosition::inside) continue;
+    parts.assign(stored.begin(), stored.end());
+    ++answer.paths_tried;
+    if (count_crossings(index, shard, {reference, bend}, parts, answer.triangle_tests) &&
+        count_crossings(index, shard, {bend, p}, parts, answer.triangle_tests))
+      return finish();
+  }
+  answer.containment = ObstacleContainment::unknown;
+  return answer;
+}
+
+}  // namespace tetrapage
