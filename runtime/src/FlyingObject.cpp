@@ -333,6 +333,8 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
   }
   // An obstacle inside the object: each enclosed candidate triangle lies wholly inside or
   // wholly outside (its surface does not cross the object's), so one vertex decides.
+  // Neighbouring triangles share vertices: test each vertex once.
+  std::sort(enclosed_.begin(), enclosed_.end());
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
     if (i > 0 && enclosed_[i].first == enclosed_[i - 1].first) continue;
     if (object_holds(enclosed_[i].first, box)) {
@@ -347,16 +349,22 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
 bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& box) {
   // Parity of crossings with the placed object along a segment from p to beyond the object's
   // box; a direction whose segment meets an edge, a vertex or a plane is replaced by the next.
-  static constexpr std::array<std::array<double, 3>, 5> kDirections{{{0.0123457, 0.0345679, 1.0},
-                                                                     {0.9134, -0.2718, 0.3011},
-                                                                     {-0.3141, 0.8660, -0.3890},
-                                                                     {-0.5772, -0.6931, 0.4142},
-                                                                     {0.2236, 0.1414, -0.9643}}};
+  // Directions are nearly along the object's own axes, so that the segment's box in the
+  // object's frame is thin and the BVH offers few triangles; slanted, so that the segment
+  // misses the vertices that generated objects put on their axes.
+  static constexpr std::array<std::array<double, 3>, 6> kDirections{{{0.0123457, 0.0345679, 0.99932},
+                                                                     {0.99932, 0.0123457, 0.0345679},
+                                                                     {0.0345679, 0.99932, 0.0123457},
+                                                                     {-0.0234567, 0.0156789, -0.99960},
+                                                                     {-0.99960, -0.0234567, 0.0156789},
+                                                                     {0.0156789, -0.99960, -0.0234567}}};
+  // |d| = 1, so some coordinate moves by reach / sqrt(3) > the box's largest side.
   const double reach = 2 * std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
-  for (const auto& d : kDirections) {
-    const double largest = std::max({std::fabs(d[0]), std::fabs(d[1]), std::fabs(d[2])});
-    const geometry::Point far{p[0] + d[0] * reach / largest, p[1] + d[1] * reach / largest,
-                              p[2] + d[2] * reach / largest};
+  for (const auto& o : kDirections) {
+    const Vec3 d{rotation_[0] * o[0] + rotation_[1] * o[1] + rotation_[2] * o[2],
+                 rotation_[3] * o[0] + rotation_[4] * o[1] + rotation_[5] * o[2],
+                 rotation_[6] * o[0] + rotation_[7] * o[1] + rotation_[8] * o[2]};
+    const geometry::Point far{p[0] + d[0] * reach, p[1] + d[1] * reach, p[2] + d[2] * reach};
     const geometry::Segment segment{p, far};
     // The segment's box in the object's frame (rounded: it only prunes), as in phase II.
     geometry::Box query;
