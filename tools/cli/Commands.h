@@ -23,6 +23,8 @@ void add_mesh_commands(CLI::App& app);
 void add_index_commands(CLI::App& app);
 /// `fly` (tools/cli/FlyCommand.cpp)
 void add_fly_command(CLI::App& app);
+/// `check-interiors` (tools/cli/InteriorCheckCommand.cpp)
+void add_interior_check_command(CLI::App& app);
 
 /// Writes a JSON report under a temporary name and renames it (never half-written).
 /// @throw IoError on failure.
