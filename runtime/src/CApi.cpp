@@ -303,7 +303,9 @@ tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
     info->candidates = counters.candidates;
     info->triangle_tests = counters.triangle_tests;
     info->seconds = counters.locate_seconds + counters.search_seconds + counters.shard_seconds +
-                    counters.test_seconds;
+                    counters.test_seconds + counters.interior_seconds;
+    info->containment = int(result.containment);
+    info->containing_part = result.containing_part;
   });
 }
 

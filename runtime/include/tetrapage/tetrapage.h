@@ -188,7 +188,12 @@ typedef struct tetrapage_query_info {
   uint32_t shard_misses;   /* shards paged in synchronously */
   uint64_t candidates;     /* environment triangles meeting the object's box */
   uint64_t triangle_tests; /* triangle pair tests */
-  double seconds;          /* locate + search + shards + tests */
+  double seconds;          /* locate + search + shards + tests + containment */
+  /* Why a query collides without touching surfaces: 0 it does not (or surfaces touch),
+     1 the object lies inside a closed obstacle (an index preprocessed with interiors),
+     2 an environment triangle lies inside the closed object. */
+  int containment;
+  uint32_t containing_part; /* the environment part of a containment */
 } tetrapage_query_info;
 
 /* Fills *info for the last successful query (all zero before the first one).
