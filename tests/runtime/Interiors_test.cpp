@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 
 #include "tetrapage/formats/MeshReader.h"
@@ -47,8 +49,14 @@ void write(const TriangleSoup& soup, const fs::path& path) {
 
 struct Model {
   TriangleSoup environment;  // all parts, in the order preprocess reads them
-  fs::path index;
+  fs::path folder, index;
   PreprocessSummary summary;
+  Model() = default;
+  Model(Model&&) = default;
+  ~Model() {
+    std::error_code ignored;
+    if (!folder.empty()) fs::remove_all(folder, ignored);
+  }
 };
 
 // Three parts: a scene of real closed meshes; two nested boxes (inside = the shell between
@@ -56,7 +64,9 @@ struct Model {
 const Model& model() {
   static const Model instance = [] {
     Model m;
-    const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "interiors";
+    // ctest runs each test in its own process, in parallel: one folder per process.
+    const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / ("interiors-" + std::to_string(::getpid()));
+    m.folder = folder;
     fs::remove_all(folder);
     fs::create_directories(folder);
     std::vector<fs::path> inputs{folder / "scene.ply", folder / "boxes.obj", folder / "sheet.obj"};
