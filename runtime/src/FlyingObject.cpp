@@ -40,8 +40,10 @@ constexpr std::size_t kHillClimbMinimum = 32;
 FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
     : index_(std::move(index)), object_(std::move(object)), bvh_(object_) {
   if (!index_) throw InputError("a flying object needs an index");
-  for (const auto& v : object_.vertices)
+  for (const auto& v : object_.vertices) {
     object_radius_ = std::max(object_radius_, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    object_box_.extend(v);
+  }
   EdgeParity parity;
   for (std::size_t t = 0; t < object_.triangle_count(); ++t) parity.add_triangle(object_.corners(t));
   closed_ = parity.closed();
@@ -264,7 +266,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       ++counters.candidates;
       const geometry::Triangle environment = shard.triangle(local);
       if (closed_ && !result.collides && geometry::box_contains(box, environment[0]) &&
-          geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]))
+          geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
+          in_object_box(environment[0]))
         enclosed_.emplace_back(environment[0], shard.part_id(local));
       // The environment triangle in the object's frame (rounded: it only prunes).
       geometry::Box query;
@@ -344,6 +347,21 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
     }
   }
   result.counters.interior_seconds = seconds_since(start);
+}
+
+bool FlyingObject::in_object_box(const geometry::Point& p) const {
+  // p in the object's own frame (rounded back, so the box is grown far beyond the rounding):
+  // outside that box means outside the object. The world box is looser for a rotated object.
+  const Vec3 e{p[0] - translation_[0], p[1] - translation_[1], p[2] - translation_[2]};
+  const Vec3 x{rotation_[0] * e[0] + rotation_[3] * e[1] + rotation_[6] * e[2],
+               rotation_[1] * e[0] + rotation_[4] * e[1] + rotation_[7] * e[2],
+               rotation_[2] * e[0] + rotation_[5] * e[1] + rotation_[8] * e[2]};
+  const double margin = (object_radius_ + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
+                         std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])})) *
+                        0x1p-40;
+  for (int a = 0; a < 3; ++a)
+    if (x[a] < object_box_.lo[a] - margin || x[a] > object_box_.hi[a] + margin) return false;
+  return true;
 }
 
 bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& box) {

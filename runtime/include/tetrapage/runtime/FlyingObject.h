@@ -114,6 +114,7 @@ class FlyingObject {
   // Containment checks of a step whose surfaces do not touch.
   void check_containment(const geometry::Box& box, QueryResult& result);
   bool object_holds(const geometry::Point& p, const geometry::Box& box);
+  bool in_object_box(const geometry::Point& p) const;
   geometry::Triangle world_triangle(std::uint32_t t);
 
   std::shared_ptr<const CollisionIndex> index_;
@@ -121,6 +122,7 @@ class FlyingObject {
   geometry::ObjectBVH bvh_;
   double object_radius_ = 0;  ///< largest |x| over the object's vertices (object frame)
   bool closed_ = false;
+  BoundingBox object_box_;  ///< of the object's vertices, in its own frame
   // Per step: a vertex and the part of each candidate environment triangle whose box lies in
   // the object's box (only those can lie inside the object).
   std::vector<std::pair<geometry::Point, std::uint32_t>> enclosed_;
