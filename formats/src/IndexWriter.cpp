@@ -84,8 +84,6 @@ struct IndexWriter::Impl {
   bool file_created = false;
   bool committed = false;
   bool failed = false;
-  detail::EncodedChunk encoded;
-  std::vector<std::byte> padded;
 
   ~Impl() {
     close_all();
@@ -245,7 +243,6 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   const std::array<hsize_t, 1> chunk{options.chunk_bytes};
   w.shard_data = w.create_dataset(w.shards_group.get(), "data", "dataset /shards/data",
                                   H5T_STD_U8LE, empty, chunk);
-  w.padded.resize(options.chunk_bytes);
 }
 
 IndexWriter::~IndexWriter() = default;
@@ -308,43 +305,71 @@ void IndexWriter::write_table(std::string_view name, std::span<const double> val
   impl_->write_table(name, values);
 }
 
+EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterOptions& options) {
+  if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes || options.deflate_level < 0 ||
+      options.deflate_level > 9)
+    throw InputError("encode_shard: chunk size " + std::to_string(options.chunk_bytes) + " or deflate level " +
+                     std::to_string(options.deflate_level) + " out of range");
+  EncodedShard shard;
+  shard.payload_bytes = payload.size();
+  shard.chunk_bytes = options.chunk_bytes;
+  const std::uint64_t chunk_bytes = options.chunk_bytes;
+  const std::uint64_t chunks = (payload.size() + chunk_bytes - 1) / chunk_bytes;
+  std::vector<std::byte> padded;
+  detail::EncodedChunk encoded;
+  for (std::uint64_t k = 0; k < chunks; ++k) {
+    auto piece = payload.subspan(k * chunk_bytes, std::min<std::uint64_t>(chunk_bytes, payload.size() - k * chunk_bytes));
+    if (piece.size() < chunk_bytes) {
+      // Zero padding up to the chunk boundary: the next shard starts on a fresh chunk.
+      padded.assign(chunk_bytes, std::byte{0});
+      std::copy(piece.begin(), piece.end(), padded.begin());
+      piece = padded;
+    }
+    detail::encode_chunk(piece, options.deflate_level, encoded);
+    shard.chunks.push_back(encoded.bytes);
+    shard.filter_masks.push_back(encoded.filter_mask);
+  }
+  return shard;
+}
+
 std::uint32_t IndexWriter::append_shard(std::span<const std::byte> payload) {
+  return append_encoded_shard(encode_shard(payload, impl_->options));
+}
+
+std::uint32_t IndexWriter::append_encoded_shard(const EncodedShard& encoded) {
   detail::silence_hdf5_errors();
   Impl& w = *impl_;
   w.ensure_writable("append a shard");
   if (w.offsets.size() >= 0xffffffffu)
     throw InputError("index '" + w.path.string() + "' cannot hold more than 2^32 - 1 shards");
-  const auto shard = static_cast<std::uint32_t>(w.offsets.size());
   const std::uint64_t chunk_bytes = w.options.chunk_bytes;
-  const std::uint64_t chunks = (payload.size() + chunk_bytes - 1) / chunk_bytes;
+  if (encoded.chunk_bytes != chunk_bytes || encoded.chunks.size() != encoded.filter_masks.size() ||
+      encoded.chunks.size() != (encoded.payload_bytes + chunk_bytes - 1) / chunk_bytes)
+    throw InputError("index '" + w.path.string() + "': a shard encoded for chunks of " +
+                     std::to_string(encoded.chunk_bytes) + " bytes cannot be appended to chunks of " +
+                     std::to_string(chunk_bytes));
+  const auto shard = static_cast<std::uint32_t>(w.offsets.size());
+  const std::uint64_t chunks = encoded.chunks.size();
   const std::uint64_t offset = w.data_extent;
   if (chunks > 0) {
     const std::string what = "shard " + std::to_string(shard);
     hsize_t extent = w.data_extent + chunks * chunk_bytes;
     w.check(H5Dset_extent(w.shard_data.get(), &extent), "the extent of /shards/data for " + what);
     for (std::uint64_t k = 0; k < chunks; ++k) {
-      auto piece = payload.subspan(k * chunk_bytes,
-                                   std::min<std::uint64_t>(chunk_bytes, payload.size() - k * chunk_bytes));
-      if (piece.size() < chunk_bytes) {
-        // Zero padding up to the chunk boundary: the next shard starts on a fresh chunk.
-        std::fill(std::copy(piece.begin(), piece.end(), w.padded.begin()), w.padded.end(),
-                  std::byte{0});
-        piece = w.padded;
-      }
-      detail::encode_chunk(piece, w.options.deflate_level, w.encoded);
       const hsize_t chunk_offset = offset + k * chunk_bytes;
-      w.check(H5Dwrite_chunk(w.shard_data.get(), H5P_DEFAULT, w.encoded.filter_mask, &chunk_offset,
-                             w.encoded.bytes.size(), w.encoded.bytes.data()),
-              "chunk " + std::to_string(chunk_offset / chunk_bytes) + " of /shards/data (" + what +
-                  ")");
-      w.stored_bytes += w.encoded.bytes.size();
+      w.check(H5Dwrite_chunk(w.shard_data.get(), H5P_DEFAULT, encoded.filter_masks[k], &chunk_offset,
+                             encoded.chunks[k].size(), encoded.chunks[k].data()),
+              "chunk " + std::to_string(chunk_offset / chunk_bytes) + " of /shards/data (" + what + ")");
+      w.stored_bytes += encoded.chunks[k].size();
     }
     w.data_extent = extent;
   }
   w.offsets.push_back(offset);
-  w.sizes.push_back(payload.size());
+  w.sizes.push_back(encoded.payload_bytes);
   return shard;
 }
+
+const IndexWriterOptions& IndexWriter::options() const { return impl_->options; }
 
 std::uint32_t IndexWriter::shard_count() const {
   return static_cast<std::uint32_t>(impl_->offsets.size());

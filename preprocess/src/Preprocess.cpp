@@ -459,6 +459,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
       const std::size_t groups = group_start.size();
       group_start.push_back(records.size());
       std::vector<BuiltShard> built(groups);
+      std::vector<EncodedShard> encoded(groups);
       tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
         const std::size_t first = group_start[g], last = group_start[g + 1];
         std::vector<geometry::Triangle> triangles;
@@ -480,6 +481,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
           built[g] = build_shard(region, options.shard == ShardChoice::grid ? ShardKind::grid : ShardKind::rtree,
                                  options.precision);
         }
+        // Compressed here, in parallel: the writer then only appends.
+        encoded[g] = encode_shard(built[g].payload, writer.options());
       });
       for (std::size_t g = 0; g < groups; ++g) {
         const std::uint32_t tet = records[group_start[g]].tet;
@@ -496,7 +499,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         }
         shard_bounds.insert(shard_bounds.end(), {bounds.lo[0], bounds.lo[1], bounds.lo[2], bounds.hi[0],
                                                  bounds.hi[1], bounds.hi[2]});
-        const std::uint32_t shard = writer.append_shard(built[g].payload);
+        const std::uint32_t shard = writer.append_encoded_shard(encoded[g]);
+        encoded[g] = EncodedShard{};
         tet_shard[tet] = shard;
         shard_tet.push_back(tet);
         shard_kind.push_back(std::uint8_t(built[g].kind));

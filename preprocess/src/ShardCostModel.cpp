@@ -38,14 +38,13 @@ ShardCostEstimate estimate(const ShardTriangles& region, ShardKind kind,
   BuiltShard built = build_shard(region, kind, precision, layout);
   const Shard shard = Shard::decode(built.payload);
   ShardQueryCounters counters;
-  for (const geometry::Box& box : queries) shard.for_each_candidate(box, [](std::uint32_t) {}, counters);
+  for (const geometry::Box& box : queries) shard.count_query(box, counters);
   ShardCostEstimate e;
   e.kind = kind;
   e.layout = layout;
   const double q = double(std::max<std::size_t>(queries.size(), 1));
   e.visited_per_query = double(counters.visited) / q;
   e.references_per_query = double(counters.references) / q;
-  e.candidates_per_query = double(counters.candidates) / q;
   e.payload_bytes = built.payload.size();
   e.query_seconds =
       kind == ShardKind::grid

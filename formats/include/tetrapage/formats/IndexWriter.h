@@ -10,6 +10,7 @@
 #include <memory>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/TetMesh.h"
@@ -23,6 +24,19 @@ struct IndexWriterOptions {
   /// zlib level of every compressed dataset, 0 (store) .. 9.
   int deflate_level = 4;
 };
+
+/// A shard's payload cut into chunks, each compressed and checksummed as the index stores it.
+struct EncodedShard {
+  std::uint64_t payload_bytes = 0;
+  std::uint32_t chunk_bytes = 0;
+  std::vector<std::vector<std::byte>> chunks;
+  std::vector<std::uint32_t> filter_masks;  ///< HDF5's per-chunk filter mask (deflate skipped)
+};
+
+/// Compresses a payload as IndexWriter::append_shard does, without a file: thread-safe, so
+/// that shards can be compressed in parallel and appended in order.
+/// @throw InputError if an option is out of range.
+EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterOptions& options = {});
 
 class IndexWriter {
  public:
@@ -58,6 +72,10 @@ class IndexWriter {
   /// @throw InputError after commit, or past 2^32 - 1 shards.
   /// @throw IoError if HDF5 fails to write.
   std::uint32_t append_shard(std::span<const std::byte> payload);
+  /// Writes a shard compressed by encode_shard with this writer's options.
+  /// @throw InputError if it was encoded for another chunk size, as append_shard otherwise.
+  std::uint32_t append_encoded_shard(const EncodedShard& shard);
+  const IndexWriterOptions& options() const;
 
   /// Shards appended so far.
   std::uint32_t shard_count() const;

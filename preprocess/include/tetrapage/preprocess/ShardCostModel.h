@@ -40,7 +40,6 @@ struct ShardCostEstimate {
   ShardLayout layout;                 ///< the layout the estimate was made with
   double visited_per_query = 0;       ///< cells or nodes
   double references_per_query = 0;    ///< triangle references examined
-  double candidates_per_query = 0;    ///< triangles reported
   std::uint64_t payload_bytes = 0;
   double query_seconds = 0;   ///< per query
   double paging_seconds = 0;  ///< per query: paging cost / queries_per_page_in

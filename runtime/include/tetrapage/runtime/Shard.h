@@ -119,6 +119,12 @@ class Shard {
     return counters.visited - before;
   }
 
+  /// Counts the cells or nodes and the references a query of `box` examines, without deciding
+  /// any triangle (what the cost model measures: the exact tests are the same for every layout).
+  void count_query(const geometry::Box& box, ShardQueryCounters& counters) const {
+    auto ignore = [](std::uint32_t) {};
+    query<false>(box, ignore, counters);
+  }
   // Read-only views of the decoded structure, for inspection, tests and the builder's checks.
   std::array<std::uint32_t, 3> grid_cells() const { return grid_cells_; }
   const geometry::Point& grid_lo() const { return grid_lo_; }
@@ -188,7 +194,7 @@ class Shard {
   }
 
 
-  template <class Visit>
+  template <bool kDecide = true, class Visit>
   void query(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
@@ -201,18 +207,28 @@ class Shard {
       clipped.hi[k] = std::min(box.hi[k], bounds_.hi[k]);
     }
     if (kind_ == ShardKind::grid)
-      query_grid(clipped, visit, counters);
+      query_grid<kDecide>(clipped, visit, counters);
     else
-      query_rtree(clipped, visit, counters);
+      query_rtree<kDecide>(clipped, visit, counters);
   }
 
-  template <class Visit>
+  template <bool kDecide, class Visit>
   void query_grid(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
     std::array<std::uint32_t, 3> first{}, last{};
     for (int k = 0; k < 3; ++k)
       if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k],
                                          box.lo[k], box.hi[k], first[k], last[k]))
         return;
+    if constexpr (!kDecide) {
+      for (std::uint32_t z = first[2]; z <= last[2]; ++z)
+        for (std::uint32_t y = first[1]; y <= last[1]; ++y)
+          for (std::uint32_t x = first[0]; x <= last[0]; ++x) {
+            const std::size_t cell = (std::size_t(z) * grid_cells_[1] + y) * grid_cells_[0] + x;
+            ++counters.visited;
+            counters.references += cell_offsets_[cell + 1] - cell_offsets_[cell];
+          }
+      return;
+    }
     Marks marks(triangle_count_);
     const std::uint32_t nx = grid_cells_[0], ny = grid_cells_[1];
     for (std::uint32_t z = first[2]; z <= last[2]; ++z)
@@ -231,7 +247,7 @@ class Shard {
         }
   }
 
-  template <class Visit>
+  template <bool kDecide, class Visit>
   void query_rtree(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
     // Depth is at most kMaxDepth and each level leaves at most kMaxFanout - 1 siblings
     // pending, which the decoder checked.
@@ -245,6 +261,7 @@ class Shard {
       if (node.count & shard_format::kLeafFlag) {
         const std::uint32_t count = node.count & ~shard_format::kLeafFlag;
         counters.references += count;
+        if constexpr (!kDecide) continue;
         for (std::uint32_t t = node.first; t < node.first + count; ++t) {
           if (!meets(t, box)) continue;
           ++counters.candidates;
