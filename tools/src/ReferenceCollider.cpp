@@ -83,8 +83,10 @@ class ReferenceCollider::Impl {
     environment_tree_.build();  // now, not lazily inside the first (concurrent) query
     object_vertices_ = object.vertices;
     object_triangles_ = object.triangles;
-    for (const auto& v : object_vertices_)
+    for (const auto& v : object_vertices_) {
       object_radius_ = std::max(object_radius_, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+      object_local_box_.extend(v);
+    }
   }
 
   Answer query(const Pose& pose) const {
@@ -105,7 +107,7 @@ class ReferenceCollider::Impl {
     if (!candidates.empty()) answer.surfaces_touch = surfaces_touch(placed, candidates);
     if (!answer.surfaces_touch) answer.object_inside = inside(placed[object_triangles_.front()[0]]);
     if (!answer.surfaces_touch && !answer.object_inside && object_closed_)
-      answer.obstacle_inside = obstacle_inside(placed, box, candidates);
+      answer.obstacle_inside = obstacle_inside(placed, box, candidates, pose);
     answer.collides = answer.surfaces_touch || answer.object_inside || answer.obstacle_inside;
     return answer;
   }
@@ -131,20 +133,41 @@ class ReferenceCollider::Impl {
   // Some environment triangle inside the closed object: only candidates whose box lies in the
   // object's box can be; with no surface contact, one vertex decides for its whole triangle.
   bool obstacle_inside(const std::vector<Point>& placed, const BoundingBox& box,
-                       const std::vector<Tree::Primitive_id>& candidates) const {
+                       const std::vector<Tree::Primitive_id>& candidates, const Pose& pose) const {
+    // Distinct first vertices of the enclosed candidates that also lie in the object's own box
+    // (taken back to its frame with a margin far beyond the rounding: it only prunes).
+    const auto rotation = rotation_matrix(pose.rotation);
+    std::vector<Vec3> points;
     for (const auto& id : candidates) {
       const CGAL::Bbox_3 b = id->bbox();
       if (b.xmin() < box.lo[0] || b.ymin() < box.lo[1] || b.zmin() < box.lo[2] || b.xmax() > box.hi[0] ||
           b.ymax() > box.hi[1] || b.zmax() > box.hi[2])
         continue;
-      int odd = 0;
-      for (const auto& direction : kParityDirections) {
-        const Ray ray(id->vertex(0), direction);
-        int crossings = 0;
-        for (const auto& tri : object_triangles_)
-          if (CGAL::do_intersect(ray, Triangle(placed[tri[0]], placed[tri[1]], placed[tri[2]]))) ++crossings;
-        odd += crossings % 2;
+      const Point& v = id->vertex(0);
+      const Vec3 p{v.x(), v.y(), v.z()};
+      Vec3 local{};
+      double magnitude = object_radius_;
+      for (int a = 0; a < 3; ++a) magnitude += std::fabs(p[a]) + std::fabs(pose.translation[a]);
+      bool near = true;
+      for (int a = 0; a < 3; ++a) {
+        for (int r = 0; r < 3; ++r) local[a] += rotation[3 * r + a] * (p[r] - pose.translation[r]);
+        near = near && local[a] >= object_local_box_.lo[a] - magnitude * 0x1p-30 &&
+               local[a] <= object_local_box_.hi[a] + magnitude * 0x1p-30;
       }
+      if (near) points.push_back(p);
+    }
+    if (points.empty()) return false;
+    std::sort(points.begin(), points.end());
+    points.erase(std::unique(points.begin(), points.end()), points.end());
+    // The placed object's tree, built only for a pose that needs it.
+    std::vector<Triangle> placed_triangles;
+    placed_triangles.reserve(object_triangles_.size());
+    for (const auto& tri : object_triangles_) placed_triangles.emplace_back(placed[tri[0]], placed[tri[1]], placed[tri[2]]);
+    const Tree object_tree(placed_triangles.begin(), placed_triangles.end());
+    for (const auto& p : points) {
+      int odd = 0;
+      for (const auto& direction : kParityDirections)
+        odd += object_tree.number_of_intersected_primitives(Ray(to_point(p), direction)) % 2;
       if (odd >= 2) return true;
     }
     return false;
@@ -187,6 +210,7 @@ class ReferenceCollider::Impl {
   std::vector<std::uint32_t> environment_part_;
   std::vector<bool> environment_closed_;
   bool object_closed_ = false;
+  BoundingBox object_local_box_;  // the object's vertices in its own frame
   Tree environment_tree_;
   BoundingBox environment_bounds_;
   std::vector<Vec3> object_vertices_;
