@@ -136,6 +136,26 @@ bool brute_force_touch(const TriangleSoup& environment, const TriangleSoup& obje
   return false;
 }
 
+// Pairs whose double boxes meet: rtcCollide must hand each of them over exactly once
+// (they are exactly what EmbreeCollider::Answer::exact_tests counts), whatever its trees.
+std::uint64_t brute_force_box_pairs(const TriangleSoup& environment, const TriangleSoup& object, const Pose& pose) {
+  std::vector<Vec3> placed;
+  for (const auto& v : object.vertices) placed.push_back(apply_pose(pose, v));
+  const auto box = [](const Vec3& a, const Vec3& b, const Vec3& c) {
+    return CGAL::Bbox_3(std::min({a[0], b[0], c[0]}), std::min({a[1], b[1], c[1]}), std::min({a[2], b[2], c[2]}),
+                        std::max({a[0], b[0], c[0]}), std::max({a[1], b[1], c[1]}), std::max({a[2], b[2], c[2]}));
+  };
+  std::vector<CGAL::Bbox_3> object_boxes;
+  for (const auto& t : object.triangles) object_boxes.push_back(box(placed[t[0]], placed[t[1]], placed[t[2]]));
+  std::uint64_t pairs = 0;
+  for (std::size_t e = 0; e < environment.triangle_count(); ++e) {
+    const auto c = environment.corners(e);
+    const CGAL::Bbox_3 obstacle = box(c[0], c[1], c[2]);
+    for (const auto& b : object_boxes) pairs += CGAL::do_overlap(obstacle, b);
+  }
+  return pairs;
+}
+
 struct Case {
   Environment environment;
   std::uint64_t object_triangles;
@@ -175,6 +195,10 @@ TEST_P(EmbreeAgainstOracle, SurfacesTouchAgreeOnFlightsAndOnGrazingPoses) {
     ASSERT_EQ(answer.surfaces_touch, answer.touching_pairs > 0) << "pose " << i;
     touching += answer.surfaces_touch;
     candidates += answer.candidate_pairs;
+    const bool small = environment.triangle_count() * object.triangle_count() <= 100000;
+    if (small && (i % 16 == 0 || answer.exact_tests > 0)) {
+      ASSERT_EQ(answer.exact_tests, brute_force_box_pairs(environment, object, flight.poses[i])) << "pose " << i;
+    }
 
     // Each bounce: the last free and the first touching pose along the move into contact,
     // a few ulps apart, where Embree's float boxes cannot tell the two apart.
@@ -188,9 +212,11 @@ TEST_P(EmbreeAgainstOracle, SurfacesTouchAgreeOnFlightsAndOnGrazingPoses) {
     ASSERT_FALSE(free_answer.surfaces_touch) << "grazing pose before bounce " << i;
     ASSERT_TRUE(touch_answer.surfaces_touch) << "grazing pose at bounce " << i;
     ASSERT_GT(free_answer.exact_tests, 0u) << "a pose this close must reach the exact test";
-    if (environment.triangle_count() * object.triangle_count() <= 100000) {
+    if (small) {
       ASSERT_FALSE(brute_force_touch(environment, object, before)) << "bounce " << i;
       ASSERT_TRUE(brute_force_touch(environment, object, at)) << "bounce " << i;
+      ASSERT_EQ(free_answer.exact_tests, brute_force_box_pairs(environment, object, before)) << "bounce " << i;
+      ASSERT_EQ(touch_answer.exact_tests, brute_force_box_pairs(environment, object, at)) << "bounce " << i;
     }
     ++grazing;
   }
@@ -317,6 +343,8 @@ TEST(EmbreeCollider, DiffersFromTheOracleExactlyWhereTheObjectIsInside) {
   EXPECT_GT(touching, 0);
 }
 
+// The trees may take another shape with another thread count (so may candidate_pairs), but
+// the pairs whose double boxes meet, and those that touch, are the same.
 TEST(EmbreeCollider, AnswersDoNotDependOnEmbreesThreads) {
   const TriangleSoup environment = generate_environment(Environment::scene, 3);
   const TriangleSoup object = generate_flying_object(116);
@@ -329,7 +357,6 @@ TEST(EmbreeCollider, AnswersDoNotDependOnEmbreesThreads) {
   for (std::size_t i = 0; i < flight.poses.size(); ++i) {
     const auto a = one.query(flight.poses[i]), b = all.query(flight.poses[i]);
     ASSERT_EQ(a.surfaces_touch, b.surfaces_touch) << "pose " << i;
-    ASSERT_EQ(a.candidate_pairs, b.candidate_pairs) << "pose " << i;
     ASSERT_EQ(a.exact_tests, b.exact_tests) << "pose " << i;
     ASSERT_EQ(a.touching_pairs, b.touching_pairs) << "pose " << i;
   }
