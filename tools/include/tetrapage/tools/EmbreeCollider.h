@@ -12,13 +12,18 @@
 /// decided by CGAL's exact-predicate triangle/triangle test (Epick) on the placed doubles,
 /// so nothing of the runtime's kernel is involved.
 ///
-/// Embree keeps boxes in float. The boxes handed to it are the double boxes rounded outward
-/// (each float box contains its double triangle), and Embree only takes unions of them and
-/// compares them with <=, so a pair of triangles that touch always has overlapping boxes at
-/// every level and is reported: the candidates are a superset of the touching pairs, and
+/// Embree keeps boxes in float. Are its bounds conservative? Yes, given conservative input:
+/// the boxes handed to it are the double boxes rounded outward (each float box contains its
+/// double triangle); Embree's tree nodes are unions of them (min/max, exact in float), a
+/// refit recomputes those unions, and rtcCollide compares boxes with <=, touching included.
+/// Two triangles that meet share a point, which lies in both float boxes at every level, so
+/// the pair is reported: the candidates are a superset of the touching pairs, and
 /// surfaces_touch equals the exact oracle's (ReferenceCollider::Answer::surfaces_touch).
-/// What rtcCollide cannot see is an object lying wholly inside an obstacle (the oracle's
-/// object_inside, decided by ray parity): no surfaces meet there.
+/// (Boxes rounded to nearest would also keep every touching pair, rounding being monotone;
+/// boxes rounded inward would lose contacts in a plane no float holds: the tests show it.)
+/// Embree drops primitives whose box is not finite or reaches about 1.8e18; coordinates
+/// beyond 1e18 are refused. What rtcCollide cannot see is an object lying wholly inside an
+/// obstacle (the oracle's object_inside, decided by ray parity): no surfaces meet there.
 
 #include <cstdint>
 #include <memory>
