@@ -27,7 +27,8 @@ struct ReplayArguments {
 // One reference's answer to one pose, as the replay loop counts it.
 struct StepAnswer {
   bool collides = false;
-  bool object_inside = false;
+  bool object_inside = false;    // the object inside a closed part (the oracle only)
+  bool obstacle_inside = false;  // an environment triangle inside the closed object (idem)
   std::uint64_t candidates = 0;
 };
 
@@ -52,15 +53,15 @@ void run_replay(const ReplayArguments& args) {
   const auto answer_pose = [&](const Pose& pose) {
     if (embree) {
       const auto answer = embree_collider->query(pose);
-      return StepAnswer{answer.surfaces_touch, false, answer.candidate_pairs};
+      return StepAnswer{answer.surfaces_touch, false, false, answer.candidate_pairs};
     }
     const auto answer = oracle->query(pose);
-    return StepAnswer{answer.collides, answer.object_inside, answer.candidates};
+    return StepAnswer{answer.collides, answer.object_inside, answer.obstacle_inside, answer.candidates};
   };
 
   std::vector<std::uint8_t> answers(poses.size());
   std::vector<double> seconds(poses.size());
-  std::uint64_t collisions = 0, inside = 0, candidates = 0;
+  std::uint64_t collisions = 0, inside = 0, swallowed = 0, candidates = 0;
   Progress progress(embree ? "replaying (Embree rtcCollide)" : "replaying (reference)", poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
@@ -69,6 +70,7 @@ void run_replay(const ReplayArguments& args) {
     answers[i] = answer.collides ? 1 : 0;
     collisions += answers[i];
     inside += answer.object_inside ? 1 : 0;
+    swallowed += answer.obstacle_inside ? 1 : 0;
     candidates += answer.candidates;
     check.record(i, answers[i]);
     progress.advance();
@@ -82,16 +84,16 @@ void run_replay(const ReplayArguments& args) {
   if (embree)
     std::printf(
         "replay (Embree rtcCollide, exact pair tests, in core): %zu steps, %llu collisions "
-        "(surfaces touching; an object wholly inside an obstacle is not seen)\n"
+        "(surfaces touching; one body wholly inside the other is not seen)\n"
         "%.1f candidate pairs per step\n",
         poses.size(), static_cast<unsigned long long>(collisions), mean_candidates);
   else
     std::printf(
         "replay (reference oracle, in core): %zu steps, %llu collisions (%llu with the object "
-        "inside an obstacle)\n"
+        "inside an obstacle, %llu with an obstacle inside the object)\n"
         "%.1f candidate triangles per step\n",
         poses.size(), static_cast<unsigned long long>(collisions),
-        static_cast<unsigned long long>(inside), mean_candidates);
+        static_cast<unsigned long long>(inside), static_cast<unsigned long long>(swallowed), mean_candidates);
   std::printf("%.0f steps/s, latency p50 %.1f us, p95 %.1f us, p99 %.1f us, max %.1f us; %s build %.2f s\n",
               steps_per_second, latency.p50_us, latency.p95_us, latency.p99_us, latency.max_us,
               embree ? "Embree scene" : "tree", build_seconds);
@@ -102,6 +104,7 @@ void run_replay(const ReplayArguments& args) {
                                {"steps", poses.size()},
                                {"collisions", collisions},
                                {"object_inside", inside},
+                               {"obstacle_inside", swallowed},
                                {"candidates_per_step", mean_candidates},
                                {"steps_per_second", steps_per_second},
                                {"latency_us", latency.to_json()},
@@ -132,7 +135,7 @@ void add_replay_command(CLI::App& app) {
                       "Compare with these answers; exit non-zero on any disagreement")
       ->check(CLI::ExistingFile);
   command->add_option("--reference", args->reference,
-                      "cgal: the exact oracle (surfaces touch, or the object inside an obstacle);\n"
+                      "cgal: the exact oracle (surfaces touch, or one body inside the other);\n"
                       "embree: rtcCollide candidates decided exactly (surfaces touch only)")
       ->check(CLI::IsMember({"cgal", "embree"}));
   command->add_option("--threads", args->threads, "Embree's threads (0: all; --reference embree)");

@@ -22,8 +22,9 @@
 /// (Boxes rounded to nearest would also keep every touching pair, rounding being monotone;
 /// boxes rounded inward would lose contacts in a plane no float holds: the tests show it.)
 /// Embree drops primitives whose box is not finite or reaches about 1.8e18; coordinates
-/// beyond 1e18 are refused. What rtcCollide cannot see is an object lying wholly inside an
-/// obstacle (the oracle's object_inside, decided by ray parity): no surfaces meet there.
+/// beyond 1e18 are refused. What rtcCollide cannot see is one body lying wholly inside
+/// the other (the oracle's object_inside and obstacle_inside, decided by ray parity): no
+/// surfaces meet there.
 
 #include <cstdint>
 #include <memory>
