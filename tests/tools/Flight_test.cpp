@@ -15,25 +15,14 @@
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
 
+#include "BoxSoup.h"
+
 namespace tetrapage {
 namespace {
 
 using Exact = CGAL::Exact_predicates_exact_constructions_kernel;
 
-// Closed, outward-oriented axis-aligned box as 12 triangles, appended as one part.
-void add_box(TriangleSoup& soup, const Vec3& lo, const Vec3& hi) {
-  const auto base = static_cast<std::uint32_t>(soup.vertices.size());
-  for (int i = 0; i < 8; ++i)
-    soup.vertices.push_back({(i & 1) ? hi[0] : lo[0], (i & 2) ? hi[1] : lo[1], (i & 4) ? hi[2] : lo[2]});
-  const std::uint32_t faces[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                                      {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  const auto part = static_cast<std::uint32_t>(soup.part_names.size());
-  soup.part_names.push_back("box" + std::to_string(part));
-  for (const auto& f : faces) {
-    soup.triangles.push_back({base + f[0], base + f[1], base + f[2]});
-    soup.part_of.push_back(part);
-  }
-}
+using test::add_box;
 
 // A unit-cube workspace (its corners are two tiny boxes) holding a few box obstacles.
 TriangleSoup boxes_environment(std::uint64_t seed, int count) {
