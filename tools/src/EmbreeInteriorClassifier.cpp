@@ -1,6 +1,5 @@
 #include "tetrapage/tools/EmbreeInteriorClassifier.h"
 
-#include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -9,6 +8,7 @@
 #include <string>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/tools/EmbreeHandles.h"
 
 namespace tetrapage {
 namespace {
@@ -20,13 +20,6 @@ constexpr std::array<std::array<float, 3>, 5> kDirections{{{0.0123457f, 0.034567
                                                            {-0.3141f, 0.8660f, -0.3890f},
                                                            {-0.5772f, -0.6931f, 0.4142f},
                                                            {0.2236f, 0.1414f, -0.9643f}}};
-
-struct DeviceDeleter {
-  void operator()(RTCDeviceTy* device) const { rtcReleaseDevice(device); }
-};
-struct SceneDeleter {
-  void operator()(RTCSceneTy* scene) const { rtcReleaseScene(scene); }
-};
 
 // Every hit along one ray: the filter records the primitive and rejects the hit, so that
 // traversal goes on to the next one.
@@ -41,18 +34,6 @@ void record_hit(const RTCFilterFunctionNArguments* args) {
     if (args->valid[i] == 0) continue;
     counting->primitives->push_back(RTCHitN_primID(args->hit, args->N, i));
     args->valid[i] = 0;
-  }
-}
-
-std::string device_error_text(RTCError error) {
-  switch (error) {
-    case RTC_ERROR_NONE: return "no error";
-    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
-    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
-    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
-    case RTC_ERROR_CANCELLED: return "cancelled";
-    default: return "unknown error";
   }
 }
 
@@ -95,38 +76,28 @@ class EmbreeInteriorClassifier::Impl {
 
  private:
   void build() {
-    device_.reset(rtcNewDevice(nullptr));
-    if (!device_) throw Error("Embree: cannot create a device (" + device_error_text(rtcGetDeviceError(nullptr)) + ")");
-    scene_.reset(rtcNewScene(device_.get()));
-    rtcSetSceneFlags(scene_.get(), RTC_SCENE_FLAG_ROBUST);
+    device_ = std::make_unique<EmbreeDevice>();
     // No spatial splits: each triangle sits in one leaf, so a ray meets it at most once.
-    rtcSetSceneBuildQuality(scene_.get(), RTC_BUILD_QUALITY_MEDIUM);
-    RTCGeometry geometry = rtcNewGeometry(device_.get(), RTC_GEOMETRY_TYPE_TRIANGLE);
+    scene_ = device_->new_scene(RTC_SCENE_FLAG_ROBUST, RTC_BUILD_QUALITY_MEDIUM);
+    EmbreeGeometry geometry = device_->new_geometry(RTC_GEOMETRY_TYPE_TRIANGLE);
     const std::size_t n = triangles_.size();
     centre_ = bounds_.center();
-    auto* vertices = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
-    auto* indices = static_cast<unsigned*>(
-        rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n));
-    if (!vertices || !indices) {
-      rtcReleaseGeometry(geometry);
-      throw Error("Embree: cannot allocate buffers for " + std::to_string(n) + " triangles (" +
-                  device_error_text(rtcGetDeviceError(device_.get())) + ")");
-    }
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0,
+                                                                 RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0,
+                                                                   RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n));
+    device_->check("allocating the buffers of " + std::to_string(n) + " closed-part triangles");
     for (std::size_t t = 0; t < n; ++t)
       for (int k = 0; k < 3; ++k) {
         for (int a = 0; a < 3; ++a) vertices[9 * t + 3 * k + a] = float(triangles_[t][k][a] - centre_[a]);
         indices[3 * t + k] = unsigned(3 * t + k);
       }
     std::vector<std::array<Vec3, 3>>().swap(triangles_);  // Embree holds them now
-    rtcSetGeometryIntersectFilterFunction(geometry, record_hit);
-    rtcCommitGeometry(geometry);
-    rtcAttachGeometry(scene_.get(), geometry);
-    rtcReleaseGeometry(geometry);
+    rtcSetGeometryIntersectFilterFunction(geometry.get(), record_hit);
+    rtcCommitGeometry(geometry.get());
+    rtcAttachGeometry(scene_.get(), geometry.get());
     rtcCommitScene(scene_.get());
-    if (const RTCError error = rtcGetDeviceError(device_.get()); error != RTC_ERROR_NONE)
-      throw Error("Embree: building the scene of " + std::to_string(n) + " triangles failed (" +
-                  device_error_text(error) + ")");
+    device_->check("building the scene of " + std::to_string(n) + " closed-part triangles");
   }
 
   // The parts crossed an odd number of times by the ray from p along `direction`, sorted.
@@ -169,8 +140,9 @@ class EmbreeInteriorClassifier::Impl {
   std::vector<std::uint32_t> part_of_;
   BoundingBox bounds_;
   Vec3 centre_{};
-  std::unique_ptr<RTCDeviceTy, DeviceDeleter> device_;
-  std::unique_ptr<RTCSceneTy, SceneDeleter> scene_;
+  // The scene is declared after the device, so it is released first.
+  std::unique_ptr<EmbreeDevice> device_;
+  EmbreeScene scene_;
 };
 
 EmbreeInteriorClassifier::EmbreeInteriorClassifier(unsigned rays) : impl_(std::make_unique<Impl>(rays)) {}
