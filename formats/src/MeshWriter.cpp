@@ -8,6 +8,7 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -432,11 +433,61 @@ class GltfWriter final : public MeshWriter::Impl {
   std::vector<Part> parts_;
 };
 
+// An assembly: each part in its own binary PLY in "<stem>.parts/", listed by a JSON manifest
+// (formats/Manifest.h) that preprocess reads one part at a time. The part files go to a
+// temporary folder that commit() renames before it renames the manifest.
+class ManifestWriter final : public MeshWriter::Impl {
+ public:
+  explicit ManifestWriter(const std::filesystem::path& path)
+      : Impl(path),
+        folder_name_(path.stem().string() + ".parts"),
+        final_folder_(path.parent_path() / folder_name_),
+        temporary_folder_(path.parent_path() / (folder_name_ + ".tmp")) {
+    std::error_code error;
+    std::filesystem::remove_all(temporary_folder_, error);
+    if (!std::filesystem::create_directories(temporary_folder_, error) && error)
+      throw IoError("cannot create the part folder '" + temporary_folder_.string() + "': " + error.message());
+  }
+  ~ManifestWriter() override {
+    std::error_code ignored;
+    if (!committed()) std::filesystem::remove_all(temporary_folder_, ignored);
+  }
+
+  void add_part(std::span<const Vec3> part_vertices, std::span<const TriangleIndices> part_triangles) override {
+    char name[32];
+    std::snprintf(name, sizeof name, "part-%06zu.ply", parts_.size());
+    MeshWriter part(temporary_folder_ / name);
+    part.add_part(part_vertices, part_triangles);
+    part.commit();
+    parts_.push_back(name);
+  }
+
+  void finish() override {
+    nlohmann::ordered_json manifest;
+    manifest["units"] = "m";
+    auto& list = manifest["parts"] = nlohmann::ordered_json::array();
+    for (const auto& name : parts_)
+      list.push_back({{"name", std::filesystem::path(name).stem().string()}, {"file", folder_name_ + "/" + name}});
+    output_.write(manifest.dump(1) + "\n");
+    std::error_code error;
+    std::filesystem::remove_all(final_folder_, error);
+    std::filesystem::rename(temporary_folder_, final_folder_, error);
+    if (error)
+      throw IoError("cannot rename '" + temporary_folder_.string() + "' to '" + final_folder_.string() +
+                    "': " + error.message());
+  }
+
+ private:
+  std::string folder_name_;
+  std::filesystem::path final_folder_, temporary_folder_;
+  std::vector<std::string> parts_;
+};
+
 }  // namespace
 
 bool can_write_mesh(const std::filesystem::path& path) {
   const std::string extension = detail::lower_extension(path);
-  for (const char* writable : {".obj", ".stl", ".ply", ".off", ".gltf", ".glb"}) {
+  for (const char* writable : {".obj", ".stl", ".ply", ".off", ".gltf", ".glb", ".json"}) {
     if (extension == writable) return true;
   }
   return false;
@@ -454,9 +505,11 @@ MeshWriter::MeshWriter(const std::filesystem::path& path) {
     impl_ = std::make_unique<OffWriter>(path);
   } else if (extension == ".gltf" || extension == ".glb") {
     impl_ = std::make_unique<GltfWriter>(path, extension == ".glb");
+  } else if (extension == ".json") {
+    impl_ = std::make_unique<ManifestWriter>(path);
   } else {
     throw InputError("'" + path.string() + "': cannot write meshes with the extension '" +
-                     extension + "' (writable: .obj, .stl, .ply, .off, .gltf, .glb)");
+                     extension + "' (writable: .obj, .stl, .ply, .off, .gltf, .glb, and .json: a manifest of parts)");
   }
 }
 

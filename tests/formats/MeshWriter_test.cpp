@@ -11,6 +11,7 @@
 #include <map>
 
 #include "TestSupport.h"
+#include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshWriter.h"
 
 namespace tetrapage::test {
@@ -146,6 +147,31 @@ TEST(MeshWriter, StreamsPartsWithGlobalIndicesAndCounts) {
     expect_error<InputError>([&] { writer.add_part(lifted, one); }, {path.string(), "commit"});
   }
   EXPECT_EQ(folder_listing(folder), (std::vector<std::string>{"p.obj", "p.off", "p.ply"}));
+}
+
+TEST(MeshWriter, AManifestHoldsOnePlyPerPartAndReadsBackAsTheAssembly) {
+  const auto folder = scratch_folder("manifest");
+  const TriangleSoup first = random_soup(5, 1, 30), second = random_soup(6, 1, 20);
+  const auto path = folder / "assembly.json";
+  {
+    MeshWriter abandoned(path);
+    abandoned.add_part(first.vertices, first.triangles);
+  }
+  EXPECT_TRUE(folder_listing(folder).empty()) << "an abandoned manifest leaves no part file";
+  MeshWriter writer(path);
+  writer.add_part(first.vertices, first.triangles);
+  writer.add_part(second.vertices, second.triangles);
+  EXPECT_FALSE(std::filesystem::exists(path));
+  writer.commit();
+  EXPECT_EQ(folder_listing(folder), (std::vector<std::string>{"assembly.json", "assembly.parts"}));
+  EXPECT_EQ(folder_listing(folder / "assembly.parts"), (std::vector<std::string>{"part-000000.ply", "part-000001.ply"}));
+  const TriangleSoup back = load_assembly(read_manifest(path));
+  ASSERT_EQ(back.part_count(), 2u);
+  ASSERT_EQ(back.triangle_count(), first.triangle_count() + second.triangle_count());
+  for (std::size_t t = 0; t < first.triangle_count(); ++t) EXPECT_EQ(back.corners(t), first.corners(t));
+  for (std::size_t t = 0; t < second.triangle_count(); ++t)
+    EXPECT_EQ(back.corners(first.triangle_count() + t), second.corners(t));
+  EXPECT_EQ(back.part_of.back(), 1u);
 }
 
 TEST(MeshWriter, EmptyFilesAreValidAndReadAsEmpty) {

@@ -16,6 +16,9 @@
 ///   float positions, uint32 indices. These are held in memory until commit(): meant for small
 ///   files (objects, examples), not for multi-million-triangle models. Parts without a
 ///   triangle are left out (glTF accessors cannot be empty).
+/// - .json: an assembly manifest (formats/Manifest.h); each part goes to its own binary PLY in
+///   "<stem>.parts/" next to it (written to "<stem>.parts.tmp" and renamed at commit), so
+///   that preprocess reads one part at a time, whatever the size of the assembly.
 /// Text numbers are the shortest form that reads back as the same double, so OBJ, PLY and
 /// OFF keep coordinates bit for bit; STL, glTF and GLB round them to float. The same input
 /// always gives the same bytes.
