@@ -105,6 +105,8 @@ struct Ingest {
   // Per part: whether its surface is closed, and its triangle count.
   std::vector<EdgeParity> part_parity;
   std::vector<std::uint64_t> part_triangles;
+  std::vector<BoundingBox> part_bounds;
+  std::vector<std::uint64_t> part_first, part_last;  // record indices (contiguous when last - first + 1 == count)
 };
 
 void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
@@ -122,6 +124,9 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     if (soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
     in.part_parity.resize(in.part_names.size());
     in.part_triangles.resize(in.part_names.size());
+    in.part_bounds.resize(in.part_names.size());
+    in.part_first.resize(in.part_names.size(), ~std::uint64_t{0});
+    in.part_last.resize(in.part_names.size(), 0);
     // Records go out in blocks, so that the held records never pass the limit by more than a
     // block before they spill.
     constexpr std::size_t kBlock = 1 << 16;
@@ -140,6 +145,9 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
       record.part = part_offset + (soup.part_of.empty() ? 0 : soup.part_of[t]);
       in.part_parity[record.part].add_triangle(record.triangle);
       ++in.part_triangles[record.part];
+      for (const auto& p : record.triangle) in.part_bounds[record.part].extend(p);
+      if (in.part_first[record.part] == ~std::uint64_t{0}) in.part_first[record.part] = in.seen;
+      in.part_last[record.part] = in.seen;
       for (const auto& p : record.triangle) in.bounds.extend(p);
       const Vec3 c = centroid(record.triangle);
       if (in.sample.size() < sample_capacity) {
@@ -202,38 +210,33 @@ constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
 Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOptions& options,
                              PreprocessSummary& summary) {
   Interiors result;
-  std::uint64_t closed_triangles = 0;
-  result.part_closed.resize(in.part_names.size());
-  for (std::size_t p = 0; p < in.part_names.size(); ++p) {
-    result.part_closed[p] = in.part_parity[p].closed() ? 1 : 0;
-    if (result.part_closed[p]) ++summary.closed_parts, closed_triangles += in.part_triangles[p];
+  const std::size_t parts = in.part_names.size();
+  result.part_closed.assign(parts, 0);
+  std::vector<bool> closed(parts);
+  for (std::size_t p = 0; p < parts; ++p) {
+    closed[p] = in.part_parity[p].closed();
+    summary.closed_parts += closed[p];
   }
   if (!options.interior_classifier) return result;
   if (summary.closed_parts == 0) {
     summary.interiors = "none closed";
     return result;
   }
-  std::unique_ptr<InteriorClassifier> classifier = options.interior_classifier();
-  const std::uint64_t needed = closed_triangles * classifier->bytes_per_triangle();
-  if (needed > options.memory_bytes) {
-    summary.interiors = "skipped: the closed parts' " + std::to_string(closed_triangles) + " triangles need about " +
-                        format_byte_size(needed) + " to classify, over --memory " +
-                        format_byte_size(options.memory_bytes);
-    return result;
-  }
-  Progress progress("classifying interiors", in.seen + mesh.tet_count(), options.progress);
-  std::vector<std::array<Vec3, 3>> run;
-  in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
-    // Runs of one part go to the classifier together.
-    for (std::size_t i = 0; i < block.size();) {
-      std::size_t j = i;
-      run.clear();
-      while (j < block.size() && block[j].part == block[i].part) run.push_back(block[j++].triangle);
-      if (result.part_closed[block[i].part]) classifier->add_triangles(block[i].part, run);
-      i = j;
+  // Parts go to the classifier in batches that fit half the budget, each part whole; a tet's
+  // reference point is classified only against the batch parts whose box holds it (outside a
+  // part's box is outside the part). A part larger than a batch, or whose triangles are not
+  // contiguous in the input, stays unclassified: the index then marks it open.
+  const std::uint64_t per_triangle = options.interior_classifier()->bytes_per_triangle();
+  const std::uint64_t batch_capacity = std::max<std::uint64_t>(1, options.memory_bytes / 2 / std::max<std::uint64_t>(per_triangle, 1));
+  std::uint64_t too_large = 0;
+  for (std::size_t p = 0; p < parts; ++p) {
+    if (!closed[p]) continue;
+    const bool contiguous = in.part_last[p] - in.part_first[p] + 1 == in.part_triangles[p];
+    if (in.part_triangles[p] > batch_capacity || !contiguous) {
+      closed[p] = false;
+      ++too_large;
     }
-    progress.advance(block.size());
-  });
+  }
   const std::size_t tet_count = mesh.tet_count();
   std::vector<Vec3> points(tet_count);
   std::vector<bool> has_point(tet_count);
@@ -245,25 +248,93 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     for (int a = 0; a < 3; ++a)
       result.reference_points[3 * t + a] = reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
   });
+  // Reference points sorted by x, so that a batch finds the points in its parts' boxes quickly.
+  std::vector<std::uint32_t> by_x(tet_count);
+  for (std::size_t t = 0; t < tet_count; ++t) by_x[t] = std::uint32_t(t);
+  std::sort(by_x.begin(), by_x.end(), [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
+
+  std::vector<std::vector<std::uint32_t>> inside(tet_count);
+  std::vector<bool> undecided(tet_count, false);
+  std::unique_ptr<InteriorClassifier> classifier;
+  std::vector<std::uint32_t> batch_parts;
+  std::uint64_t batch_triangles = 0;
+  std::vector<std::array<Vec3, 3>> run;
+  std::vector<Vec3> batch_points;
+  std::vector<std::uint32_t> batch_tets;
   std::vector<PointInterior> answers;
-  classifier->classify(points, answers);
+  std::uint64_t batches = 0;
+  auto classify_batch = [&] {
+    if (batch_parts.empty()) return;
+    ++batches;
+    batch_points.clear();
+    batch_tets.clear();
+    BoundingBox hull;
+    for (const std::uint32_t p : batch_parts) hull.extend(in.part_bounds[p].lo), hull.extend(in.part_bounds[p].hi);
+    auto first = std::lower_bound(by_x.begin(), by_x.end(), hull.lo[0],
+                                  [&](std::uint32_t t, double x) { return points[t][0] < x; });
+    for (auto it = first; it != by_x.end() && points[*it][0] <= hull.hi[0]; ++it) {
+      const Vec3& q = points[*it];
+      for (const std::uint32_t p : batch_parts) {
+        const BoundingBox& b = in.part_bounds[p];
+        if (q[0] >= b.lo[0] && q[0] <= b.hi[0] && q[1] >= b.lo[1] && q[1] <= b.hi[1] && q[2] >= b.lo[2] &&
+            q[2] <= b.hi[2]) {
+          batch_points.push_back(q);
+          batch_tets.push_back(*it);
+          break;
+        }
+      }
+    }
+    classifier->classify(batch_points, answers);
+    for (std::size_t i = 0; i < batch_tets.size(); ++i) {
+      if (!answers[i].decided) undecided[batch_tets[i]] = true;
+      else inside[batch_tets[i]].insert(inside[batch_tets[i]].end(), answers[i].parts.begin(), answers[i].parts.end());
+    }
+    for (const std::uint32_t p : batch_parts) result.part_closed[p] = 1;
+    classifier.reset();
+    batch_parts.clear();
+    batch_triangles = 0;
+  };
+  Progress progress("classifying interiors", in.seen, options.progress);
+  in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+    for (std::size_t i = 0; i < block.size();) {
+      std::size_t j = i;
+      run.clear();
+      const std::uint32_t part = block[i].part;
+      while (j < block.size() && block[j].part == part) run.push_back(block[j++].triangle);
+      i = j;
+      if (!closed[part]) continue;
+      if (batch_parts.empty() || batch_parts.back() != part) {
+        // A new part starts: the batch must hold it whole.
+        if (batch_triangles + in.part_triangles[part] > batch_capacity) classify_batch();
+        batch_parts.push_back(part);
+        batch_triangles += in.part_triangles[part];
+      }
+      if (!classifier) classifier = options.interior_classifier();
+      classifier->add_triangles(part, run);
+    }
+    progress.advance(block.size());
+  });
+  classify_batch();
+  progress.finish();
+
   result.offsets.reserve(tet_count + 1);
   result.offsets.push_back(0);
   for (std::size_t t = 0; t < tet_count; ++t) {
-    if (!has_point[t] || !answers[t].decided) {
+    if (!has_point[t] || undecided[t]) {
       result.parts.push_back(kInteriorUndecided);
       ++summary.interior_undecided;
     } else {
-      std::sort(answers[t].parts.begin(), answers[t].parts.end());
-      result.parts.insert(result.parts.end(), answers[t].parts.begin(), answers[t].parts.end());
-      if (!answers[t].parts.empty()) ++summary.interior_tets;
+      std::sort(inside[t].begin(), inside[t].end());
+      result.parts.insert(result.parts.end(), inside[t].begin(), inside[t].end());
+      if (!inside[t].empty()) ++summary.interior_tets;
     }
     result.offsets.push_back(result.parts.size());
   }
-  progress.advance(tet_count);
-  progress.finish();
   result.stored = true;
-  summary.interiors = "stored";
+  summary.interiors = "stored (" + std::to_string(batches) + (batches == 1 ? " batch" : " batches") + ")";
+  if (too_large > 0)
+    summary.interiors += "; " + std::to_string(too_large) +
+                         " closed parts left open (larger than half --memory can classify, or not contiguous)";
   return result;
 }
 

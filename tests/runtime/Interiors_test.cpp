@@ -10,6 +10,7 @@
 
 #include <filesystem>
 
+#include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
@@ -59,17 +60,35 @@ struct Model {
   }
 };
 
-// Three parts: a scene of real closed meshes; two nested boxes (inside = the shell between
-// them) plus a small box far from the rest; an open sheet that has no inside.
-const Model& model() {
-  static const Model instance = [] {
+// Parts: a scene of real closed meshes (one part per copy, through a manifest); two nested
+// boxes (inside = the shell between them) plus a small box far from the rest; an open sheet
+// that has no inside. `memory` bounds the classifier's batches.
+// Embree's classifier, claiming `bytes` per triangle: a 16 MiB budget then forces batches.
+class HungryClassifier final : public InteriorClassifier {
+ public:
+  explicit HungryClassifier(std::uint64_t bytes) : bytes_(bytes) {}
+  std::uint64_t bytes_per_triangle() const override { return bytes_; }
+  void add_triangles(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) override {
+    inner_.add_triangles(part, triangles);
+  }
+  void classify(std::span<const Vec3> points, std::vector<PointInterior>& out) override { inner_.classify(points, out); }
+
+ private:
+  std::uint64_t bytes_;
+  EmbreeInteriorClassifier inner_;
+};
+
+// batch_triangles > 0: the classifier claims so many bytes per triangle that half of a 16 MiB
+// budget holds about that many triangles at a time.
+Model make_model(const std::string& name, std::uint64_t batch_triangles = 0) {
+  {
     Model m;
     // ctest runs each test in its own process, in parallel: one folder per process.
-    const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / ("interiors-" + std::to_string(::getpid()));
+    const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / (name + "-" + std::to_string(::getpid()));
     m.folder = folder;
     fs::remove_all(folder);
     fs::create_directories(folder);
-    std::vector<fs::path> inputs{folder / "scene.ply", folder / "boxes.obj", folder / "sheet.obj"};
+    std::vector<fs::path> inputs{folder / "scene.json", folder / "boxes.obj", folder / "sheet.obj"};
     {
       MeshWriter writer(inputs[0]);
       SceneOptions options;
@@ -87,15 +106,25 @@ const Model& model() {
     sheet.vertices = {{0.5, 0.0, 0.55}, {1.0, 0.0, 0.55}, {1.0, 0.5, 0.55}, {0.5, 0.5, 0.55}};
     sheet.triangles = {{0, 1, 2}, {0, 2, 3}};
     write(sheet, inputs[2]);
-    for (const auto& input : inputs) m.environment.append(read_mesh(input));
+    m.environment.append(load_assembly(read_manifest(inputs[0])));
+    for (std::size_t i = 1; i < inputs.size(); ++i) m.environment.append(read_mesh(inputs[i]));
     m.index = folder / "model.tpi";
     PreprocessOptions options;
     options.region_triangles = 64;
     options.precision = StoredPrecision::float64;
     options.interior_classifier = embree_interior_classifier();
+    if (batch_triangles > 0) {
+      options.memory_bytes = std::uint64_t(16) << 20;
+      const std::uint64_t bytes = (options.memory_bytes / 2) / batch_triangles;
+      options.interior_classifier = [bytes] { return std::make_unique<HungryClassifier>(bytes); };
+    }
     m.summary = preprocess(inputs, m.index, options);
     return m;
-  }();
+  }
+}
+
+const Model& model() {
+  static const Model instance = make_model("interiors");
   return instance;
 }
 
@@ -110,19 +139,18 @@ TriangleSoup tetra_object(double size) {
 
 TEST(Interiors, PreprocessClassifiesTheClosedParts) {
   const Model& m = model();
-  EXPECT_EQ(m.summary.parts, 3u);
-  EXPECT_EQ(m.summary.closed_parts, 2u) << "the sheet is open, the scene and the boxes are closed";
-  EXPECT_EQ(m.summary.interiors, "stored");
+  const auto parts = std::uint32_t(m.summary.parts);
+  ASSERT_GT(parts, 5u) << "the scene's copies are parts";
+  EXPECT_EQ(m.summary.closed_parts, parts - 1) << "the sheet is open, the copies and the boxes are closed";
+  EXPECT_EQ(m.summary.interiors, "stored (1 batch)");
   EXPECT_GT(m.summary.interior_tets, 0u);
   const CollisionIndex index(m.index);
   ASSERT_TRUE(index.has_interiors());
-  EXPECT_TRUE(index.part_closed(0));
-  EXPECT_TRUE(index.part_closed(1));
-  EXPECT_FALSE(index.part_closed(2));
+  for (std::uint32_t p = 0; p + 1 < parts; ++p) EXPECT_TRUE(index.part_closed(p)) << p;
+  EXPECT_FALSE(index.part_closed(parts - 1));
 }
 
-TEST(Interiors, RandomPointsAgreeWithParityOverWholeClosedMeshes) {
-  const Model& m = model();
+void expect_points_agree(const Model& m) {
   const ReferenceCollider oracle(m.environment, tetra_object(0.01));
   const CollisionIndex index(m.index);
   Random random(11);
@@ -149,6 +177,23 @@ TEST(Interiors, RandomPointsAgreeWithParityOverWholeClosedMeshes) {
   EXPECT_GT(inside, points / 50) << "the points must test interiors, not only free space";
   // Undecided tets (Embree's rays disagreeing) are rare and never answer wrongly.
   EXPECT_LE(unknown, points / 500);
+}
+
+TEST(Interiors, RandomPointsAgreeWithParityOverWholeClosedMeshes) { expect_points_agree(model()); }
+
+TEST(Interiors, ClassifiedInBatchesUnderASmallBudgetTheAnswersAreTheSame) {
+  // Batches of a third of the model, or of the largest part if that is more (parts go whole).
+  const Model& whole = model();
+  std::vector<std::uint64_t> sizes(whole.environment.part_count());
+  for (const auto part : whole.environment.part_of) ++sizes[part];
+  const std::uint64_t batch = std::max(*std::max_element(sizes.begin(), sizes.end()) + 1,
+                                       std::uint64_t(whole.environment.triangle_count() / 3));
+  const Model m = make_model("interiors-batches", batch);
+  ASSERT_GT(m.summary.interiors.size(), 7u);
+  EXPECT_NE(m.summary.interiors, "stored (1 batch)");
+  EXPECT_EQ(m.summary.interiors.rfind("stored (", 0), 0u) << m.summary.interiors;
+  EXPECT_EQ(m.summary.interiors.find("left open"), std::string::npos) << m.summary.interiors;
+  expect_points_agree(m);
 }
 
 // Poses along a line with fixed random rotations.
@@ -227,7 +272,7 @@ TEST(Interiors, AnIndexWithoutInteriorsAnswersUnknown) {
   PreprocessOptions options;
   options.region_triangles = 256;
   options.precision = StoredPrecision::float64;
-  const fs::path boxes = m.index.parent_path() / "boxes.obj";
+  const fs::path boxes = m.folder / "boxes.obj";
   const auto summary = preprocess({boxes}, plain, options);
   EXPECT_EQ(summary.interiors, "off");
   const CollisionIndex index(plain);

@@ -227,8 +227,8 @@ void add_index_commands(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--interiors", pre->interiors,
                       "Classify each region's reference point against the closed parts (Embree ray parity)\n"
-                      "so that the runtime reports an object inside an obstacle; needs the closed parts'\n"
-                      "triangles in memory (about 190 B each), skipped with a note when over --memory")
+                      "so that the runtime reports an object inside an obstacle; parts go in batches that fit\n"
+                      "half of --memory (about 190 B a triangle); a larger single part is left open, with a note")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
   command->add_option("--report", pre->report, "Write the summary as JSON");
