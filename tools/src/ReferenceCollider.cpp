@@ -52,24 +52,14 @@ class ReferenceCollider::Impl {
 
   Answer query(const Pose& pose) const {
     Answer answer;
-    const auto rotation = rotation_matrix(pose.rotation);
-    std::vector<Point> placed;
-    placed.reserve(object_vertices_.size());
-    BoundingBox box;
-    for (const auto& v : object_vertices_) {
-      const Vec3 w = apply_pose(rotation, pose.translation, v);
-      box.extend(w);
-      placed.push_back(to_point(w));
-    }
-    const CGAL::Bbox_3 object_box(box.lo[0], box.lo[1], box.lo[2], box.hi[0], box.hi[1], box.hi[2]);
-    std::vector<Tree::Primitive_id> candidates;
-    environment_tree_.all_intersected_primitives(object_box, std::back_inserter(candidates));
-    answer.candidates = candidates.size();
-    if (!candidates.empty()) answer.surfaces_touch = surfaces_touch(placed, candidates);
+    const std::vector<Point> placed = place(pose);
+    answer.surfaces_touch = placed_surfaces_touch(placed, &answer.candidates);
     if (!answer.surfaces_touch) answer.object_inside = inside(placed.front());
     answer.collides = answer.surfaces_touch || answer.object_inside;
     return answer;
   }
+
+  bool surfaces_touch(const Pose& pose) const { return placed_surfaces_touch(place(pose), nullptr); }
 
   bool inside(const Point& p) const {
     return environment_tree_.number_of_intersected_primitives(Ray(p, kParityDirection)) % 2 == 1;
@@ -86,8 +76,25 @@ class ReferenceCollider::Impl {
   double object_radius() const { return object_radius_; }
 
  private:
-  bool surfaces_touch(const std::vector<Point>& placed,
-                      const std::vector<Tree::Primitive_id>& candidates) const {
+  std::vector<Point> place(const Pose& pose) const {
+    const auto rotation = rotation_matrix(pose.rotation);
+    std::vector<Point> placed;
+    placed.reserve(object_vertices_.size());
+    for (const auto& v : object_vertices_) placed.push_back(to_point(apply_pose(rotation, pose.translation, v)));
+    return placed;
+  }
+
+  bool placed_surfaces_touch(const std::vector<Point>& placed, std::uint64_t* candidate_count) const {
+    CGAL::Bbox_3 object_box;  // exact: the placed coordinates are doubles
+    for (const auto& p : placed) object_box += p.bbox();
+    std::vector<Tree::Primitive_id> candidates;
+    environment_tree_.all_intersected_primitives(object_box, std::back_inserter(candidates));
+    if (candidate_count != nullptr) *candidate_count = candidates.size();
+    return !candidates.empty() && candidates_touch(placed, candidates);
+  }
+
+  bool candidates_touch(const std::vector<Point>& placed,
+                        const std::vector<Tree::Primitive_id>& candidates) const {
     CGAL::Bbox_3 candidates_box;
     std::vector<std::pair<CGAL::Bbox_3, const Triangle*>> near;
     near.reserve(candidates.size());
@@ -125,6 +132,7 @@ ReferenceCollider& ReferenceCollider::operator=(ReferenceCollider&&) noexcept = 
 ReferenceCollider::Answer ReferenceCollider::query(const Pose& pose) const {
   return impl_->query(pose);
 }
+bool ReferenceCollider::surfaces_touch(const Pose& pose) const { return impl_->surfaces_touch(pose); }
 bool ReferenceCollider::inside_environment(const Vec3& p) const {
   return impl_->inside(to_point(p));
 }
