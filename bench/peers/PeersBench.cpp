@@ -291,6 +291,17 @@ void run_all(const Arguments& args) {
                 (unsigned long long)f["page_ins"].get<std::uint64_t>(), format_byte_size(f["bytes_read"].get<std::uint64_t>()).c_str(),
                 f["cache_hit_rate"].get<double>(), format_byte_size(f["peak_resident_shard_bytes"].get<std::uint64_t>()).c_str(),
                 f["page_in_latency_us"]["p50"].get<double>(), f["page_in_latency_us"]["p99"].get<double>());
+    const auto& per_step = f["per_step"];
+    const auto& phase = f["phase_seconds"];
+    const double phases = std::max(1e-12, phase["locate"].get<double>() + phase["search"].get<double>() +
+                                              phase["shards"].get<double>() + phase["tests"].get<double>());
+    std::printf("  per step: searched %.1f %% of steps, %.1f tets visited, %.2f shards, %.1f candidates, %.1f "
+                "triangle tests; time in locate %.0f %%, search %.0f %%, shards %.0f %%, tests %.0f %%\n",
+                100 * per_step["searched"].get<double>(), per_step["tets_visited"].get<double>(),
+                per_step["shards_touched"].get<double>(), per_step["candidates"].get<double>(),
+                per_step["triangle_tests"].get<double>(), 100 * phase["locate"].get<double>() / phases,
+                100 * phase["search"].get<double>() / phases, 100 * phase["shards"].get<double>() / phases,
+                100 * phase["tests"].get<double>() / phases);
   }
 
   // Issue 5's targets: tetrapage in memory against the best peer; paged against in memory.

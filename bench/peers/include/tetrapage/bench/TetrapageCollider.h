@@ -35,7 +35,8 @@ class TetrapageCollider final : public PeerCollider {
   /// The decoded shard bytes resident now (all of them in memory).
   std::uint64_t structure_bytes() const override;
   /// Budget, index shard bytes, the preload's page-ins, and the flight's page-ins, hit rate,
-  /// peak resident shard bytes and page-in latency (counted from the end of the build).
+  /// peak resident shard bytes and page-in latency (counted from the end of the build); the
+  /// step counters per step and the time in each phase.
   nlohmann::json figures() const override;
 
  private:
@@ -45,6 +46,10 @@ class TetrapageCollider final : public PeerCollider {
   QueryOptions query_options_;  // exact, first hit
   QueryResult result_;
   std::uint64_t preload_page_ins_ = 0;
+  // The runtime's per-step counters, summed over the steps answered (they explain the time).
+  std::uint64_t steps_ = 0, searched_steps_ = 0, tets_visited_ = 0, shards_touched_ = 0, candidates_ = 0,
+                triangle_tests_ = 0;
+  double locate_seconds_ = 0, search_seconds_ = 0, shard_seconds_ = 0, test_seconds_ = 0;
 };
 
 }  // namespace tetrapage
