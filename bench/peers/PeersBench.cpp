@@ -252,9 +252,9 @@ void run_all(const Arguments& args) {
               args.flight.string().c_str(), args.object.string().c_str(), args.scene.string().c_str(),
               args.warmup ? "one untimed pass before the timed one (paged runs: none, cold)"
                           : "no warm-up pass: each collider is timed from its first pose after its build");
-  std::printf("| collider | question | build s | build RSS MiB | peak RSS MiB | steps/s | p50 us | p95 us | p99 us | "
-              "max us | collisions | FN / FP vs oracle | FN / FP vs exact, same question |\n");
-  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::printf("| collider | question | build s | build RSS MiB | structures MiB | peak RSS MiB | steps/s | p50 us | "
+              "p95 us | p99 us | max us | collisions | FN / FP vs oracle | FN / FP vs exact, same question |\n");
+  std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
   auto disagreement_text = [](const json& run, const char* key) -> std::string {
     if (!run["disagreements"].contains(key)) return "-";
     const auto& d = run["disagreements"][key];
@@ -263,10 +263,12 @@ void run_all(const Arguments& args) {
   };
   for (const auto& run : runs) {
     const auto& latency = run["latency_us"];
-    std::printf("| %s | %s | %s | %s | %s | %.0f | %s | %s | %s | %s | %llu | %s | %s |\n",
+    const double structures = run["structure_bytes"].get<double>();
+    std::printf("| %s | %s | %s | %s | %s | %s | %.0f | %s | %s | %s | %s | %llu | %s | %s |\n",
                 run["collider"].get<std::string>().c_str(), run["question"].get<std::string>().c_str(),
                 fixed(run["build_seconds"].get<double>(), 2).c_str(),
-                mib(run["build_rss_growth_bytes"].get<double>()).c_str(), mib(run["peak_rss_bytes"].get<double>()).c_str(),
+                mib(run["build_rss_growth_bytes"].get<double>()).c_str(), structures > 0 ? mib(structures).c_str() : "-",
+                mib(run["peak_rss_bytes"].get<double>()).c_str(),
                 run["steps_per_second"].get<double>(), fixed(latency["p50"].get<double>(), 1).c_str(),
                 fixed(latency["p95"].get<double>(), 1).c_str(), fixed(latency["p99"].get<double>(), 1).c_str(),
                 fixed(latency["max"].get<double>(), 0).c_str(), (unsigned long long)run["collisions"].get<std::uint64_t>(),

@@ -38,8 +38,8 @@ done
 python3 - "$OUT" "$REPEATS" "$SIZES" <<'PY'
 import json, statistics, sys
 out, repeats, sizes = sys.argv[1], int(sys.argv[2]), [int(s) for s in sys.argv[3].split()]
-rows = ["| object | collider | build s | build RSS MiB | peak RSS MiB | steps/s (min-max) | p50 us | p95 us | p99 us | max us | collisions | FN / FP vs oracle | FN / FP vs exact, same question |",
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+rows = ["| object | collider | build s | build RSS MiB | structures MiB | peak RSS MiB | steps/s (min-max) | p50 us | p95 us | p99 us | max us | collisions | FN / FP vs oracle | FN / FP vs exact, same question |",
+        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
 ratios = ["| object | tetrapage in memory / best peer: steps/s | p99 | best peer | paged / in memory: steps/s |",
           "|---:|---:|---:|---|---:|"]
 def text(d, key):
@@ -56,7 +56,9 @@ for size in sizes:
         median[name] = {"rate": med(lambda r: r["steps_per_second"]), "p99": med(lambda r: r["latency_us"]["p99"])}
         answers = {(r["collisions"], text(r["disagreements"], "oracle"), text(r["disagreements"], "same_question")) for r in runs}
         collisions, oracle, same = sorted(answers)[0] if len(answers) == 1 else ("varies", "varies", "varies")
-        rows.append(f"| {size} | {name} | {med(lambda r: r['build_seconds']):.2f} | {med(lambda r: r['build_rss_growth_bytes']) / 2**20:.1f} | "
+        structures = med(lambda r: r['structure_bytes'])
+        structures = f"{structures / 2**20:.1f}" if structures > 0 else "-"
+        rows.append(f"| {size} | {name} | {med(lambda r: r['build_seconds']):.2f} | {med(lambda r: r['build_rss_growth_bytes']) / 2**20:.1f} | {structures} | "
                     f"{med(lambda r: r['peak_rss_bytes']) / 2**20:.1f} | {statistics.median(rates):.0f} ({min(rates):.0f}-{max(rates):.0f}) | "
                     f"{med(lambda r: r['latency_us']['p50']):.1f} | {med(lambda r: r['latency_us']['p95']):.1f} | "
                     f"{med(lambda r: r['latency_us']['p99']):.1f} | {med(lambda r: r['latency_us']['max']):.0f} | "

@@ -33,6 +33,14 @@ std::shared_ptr<Model> build_model(const TriangleSoup& soup, const char* what) {
   return model;
 }
 
+// The arrays a built BVHModel holds: BV nodes, triangles with their primitive indices, vertices.
+// (BVHModel::memUsage returns a status code in FCL 0.7 and sums in int, so it cannot say.)
+std::uint64_t model_bytes(const Model& model) {
+  return std::uint64_t(model.getNumBVs()) * sizeof(fcl::BVNode<fcl::OBBRSSd>) +
+         std::uint64_t(model.num_tris) * (sizeof(fcl::Triangle) + sizeof(unsigned int)) +
+         std::uint64_t(model.num_vertices) * sizeof(fcl::Vector3d);
+}
+
 }  // namespace
 
 class FclCollider::Impl {
@@ -57,9 +65,7 @@ class FclCollider::Impl {
     return result_.isCollision();
   }
 
-  std::uint64_t structure_bytes() const {
-    return std::uint64_t(environment_model_->memUsage(0)) + std::uint64_t(object_model_->memUsage(0));
-  }
+  std::uint64_t structure_bytes() const { return model_bytes(*environment_model_) + model_bytes(*object_model_); }
 
  private:
   std::shared_ptr<Model> environment_model_, object_model_;

@@ -27,7 +27,7 @@ class FclCollider final : public PeerCollider {
   std::string description() const override;
   CollisionQuestion question() const override { return CollisionQuestion::surfaces; }
   bool collides(const Pose& pose) override;
-  /// FCL's own count (BVHModel::memUsage) for both models.
+  /// The arrays both built models hold (BV nodes, triangles, primitive indices, vertices).
   std::uint64_t structure_bytes() const override;
 
  private:
