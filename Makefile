@@ -12,9 +12,9 @@ DEMO_DIR  ?= out/demo
 DEB_PACKAGES := cmake make g++ pkg-config \
   libeigen3-dev libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libbenchmark-dev
+  libgtest-dev libbenchmark-dev libfcl-dev
 
-.PHONY: deps configure build test sanitize demo bench clean format
+.PHONY: deps configure build test sanitize demo bench bench-peers clean format
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -68,6 +68,12 @@ bench: build
 	  $(BUILD)/bench/tetrapage_bench_$$b --benchmark_out=$(BUILD)/bench-results/$$b.json \
 	    --benchmark_out_format=json || exit 1; \
 	done
+
+# FCL, CGAL's AABB tree and tetrapage (in memory, and paged under 8 MiB) on the demo's scene,
+# the study's object sizes, 10,000-pose flights, 3 repetitions (docs/BENCHMARKS.md, "Peers").
+bench-peers: build
+	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
+	BUILD=$(BUILD) bench/scripts/peers_series.sh $(DEMO_DIR) $(BUILD)/bench-results/peers 8M 3
 
 format:
 	find formats runtime preprocess tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i

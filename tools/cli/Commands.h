@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <string>
 
-#include <nlohmann/json.hpp>
+#include "tetrapage/tools/ReportFile.h"  // write_report, check_writable: every command uses them
 
 namespace tetrapage::cli {
 
@@ -25,14 +25,5 @@ void add_index_commands(CLI::App& app);
 void add_fly_command(CLI::App& app);
 /// `check-interiors` (tools/cli/InteriorCheckCommand.cpp)
 void add_interior_check_command(CLI::App& app);
-
-/// Writes a JSON report under a temporary name and renames it (never half-written).
-/// @throw IoError on failure.
-void write_report(const std::filesystem::path& path, const nlohmann::json& report);
-
-/// Fails early, before long work, when an output could not be written: creates and
-/// removes `path`.tmp. Empty paths (optional outputs not asked for) are skipped.
-/// @throw IoError naming the path and the reason.
-void check_writable(const std::filesystem::path& path);
 
 }  // namespace tetrapage::cli

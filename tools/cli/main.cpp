@@ -1,46 +1,11 @@
 // The `tetrapage` command: thin subcommands over the libraries. Results go to stdout,
 // logs and progress to stderr; every failure is one line on stderr and a non-zero exit.
 
-#include <cerrno>
 #include <cstdio>
-#include <cstring>
 #include <exception>
-#include <fstream>
 
 #include "Commands.h"
 #include "tetrapage/formats/Error.h"
-
-namespace tetrapage::cli {
-
-void write_report(const std::filesystem::path& path, const nlohmann::json& report) {
-  const auto temporary = std::filesystem::path(path.string() + ".tmp");
-  {
-    std::ofstream out(temporary);
-    if (!out) throw IoError("cannot write report '" + temporary.string() + "'");
-    out << report.dump(2) << '\n';
-    if (!out.flush()) throw IoError("cannot write report '" + temporary.string() + "'");
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    throw IoError("cannot rename report to '" + path.string() + "': " + ec.message());
-  }
-}
-
-void check_writable(const std::filesystem::path& path) {
-  if (path.empty()) return;
-  const auto temporary = std::filesystem::path(path.string() + ".tmp");
-  {
-    std::ofstream probe(temporary);
-    if (!probe)
-      throw IoError("cannot write '" + path.string() + "': " + std::strerror(errno));
-  }
-  std::error_code ec;
-  std::filesystem::remove(temporary, ec);
-}
-
-}  // namespace tetrapage::cli
 
 int main(int argc, char** argv) {
   CLI::App app{

@@ -89,20 +89,34 @@ class ReferenceCollider::Impl {
     }
   }
 
-  Answer query(const Pose& pose) const {
-    Answer answer;
+  // The object placed at `pose`, its box, and the environment triangles that meet the box.
+  void place(const Pose& pose, std::vector<Point>& placed, BoundingBox& box,
+             std::vector<Tree::Primitive_id>& candidates) const {
     const auto rotation = rotation_matrix(pose.rotation);
-    std::vector<Point> placed;
     placed.reserve(object_vertices_.size());
-    BoundingBox box;
     for (const auto& v : object_vertices_) {
       const Vec3 w = apply_pose(rotation, pose.translation, v);
       box.extend(w);
       placed.push_back(to_point(w));
     }
     const CGAL::Bbox_3 object_box(box.lo[0], box.lo[1], box.lo[2], box.hi[0], box.hi[1], box.hi[2]);
-    std::vector<Tree::Primitive_id> candidates;
     environment_tree_.all_intersected_primitives(object_box, std::back_inserter(candidates));
+  }
+
+  bool surfaces_touch(const Pose& pose) const {
+    std::vector<Point> placed;
+    BoundingBox box;
+    std::vector<Tree::Primitive_id> candidates;
+    place(pose, placed, box, candidates);
+    return !candidates.empty() && surfaces_touch(placed, candidates);
+  }
+
+  Answer query(const Pose& pose) const {
+    Answer answer;
+    std::vector<Point> placed;
+    BoundingBox box;
+    std::vector<Tree::Primitive_id> candidates;
+    place(pose, placed, box, candidates);
     answer.candidates = candidates.size();
     if (!candidates.empty()) answer.surfaces_touch = surfaces_touch(placed, candidates);
     if (!answer.surfaces_touch) answer.object_inside = inside(placed[object_triangles_.front()[0]]);
@@ -227,6 +241,7 @@ ReferenceCollider& ReferenceCollider::operator=(ReferenceCollider&&) noexcept = 
 ReferenceCollider::Answer ReferenceCollider::query(const Pose& pose) const {
   return impl_->query(pose);
 }
+bool ReferenceCollider::surfaces_touch(const Pose& pose) const { return impl_->surfaces_touch(pose); }
 bool ReferenceCollider::inside_environment(const Vec3& p) const {
   return impl_->inside(to_point(p));
 }

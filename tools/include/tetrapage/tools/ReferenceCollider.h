@@ -42,6 +42,11 @@ class ReferenceCollider {
   /// Answers one pose. Thread-safe (const, no shared scratch).
   Answer query(const Pose& pose) const;
 
+  /// Only the first half of the question: some placed object triangle and some environment
+  /// triangle intersect (Answer::surfaces_touch, without the containment tests). What a
+  /// mesh/mesh collider such as FCL answers, decided exactly. Thread-safe.
+  bool surfaces_touch(const Pose& pose) const;
+
   /// Whether p is inside a closed part of the environment (crossing parity, see above).
   bool inside_environment(const Vec3& p) const;
 

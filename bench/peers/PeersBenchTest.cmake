@@ -1,0 +1,86 @@
+# The peer benchmark's harness on a tiny generated scene (ctest bench_peers_harness):
+#   cmake -DCLI=tetrapage -DBENCH=tetrapage_bench_peers -DWORK=folder -P PeersBenchTest.cmake
+# Every collider replays a billiard flight and must agree on every pose with the exact answer to
+# its own question (FCL with CGAL's exact surface test; tetrapage with the oracle's answer
+# file); a surfaces-only collider may differ from the oracle only where the object lies inside
+# an obstacle without touching it, and must differ there.
+
+cmake_minimum_required(VERSION 3.22)  # string(JSON), if(IN_LIST)
+
+function(run_checked)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT result EQUAL 0)
+    string(REPLACE ";" " " command "${ARGN}")
+    message(FATAL_ERROR "failed (${result}): ${command}\n${out}\n${err}")
+  endif()
+  set(last_output "${out}" PARENT_SCOPE)
+endfunction()
+
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+# Tetras: dense enough that a short billiard flight collides a few dozen times.
+run_checked(${CLI} generate tetras --triangles 20000 --seed 3 -o ${WORK}/scene.ply)
+run_checked(${CLI} generate object --triangles 300 -o ${WORK}/object.ply)
+run_checked(${CLI} generate flight --env ${WORK}/scene.ply --object ${WORK}/object.ply --steps 1000 --seed 1
+            -o ${WORK}/flight.csv --answers ${WORK}/answers.csv)
+# Stored in double: the index holds the oracle's coordinates exactly.
+run_checked(${CLI} preprocess ${WORK}/scene.ply -o ${WORK}/scene.tpi --precision double --threads 1)
+run_checked(${BENCH} ${WORK}/scene.ply ${WORK}/object.ply ${WORK}/flight.csv ${WORK}/answers.csv ${WORK}/scene.tpi
+            --memory 1M --report ${WORK}/report.json)
+message(STATUS "${last_output}")
+
+file(STRINGS "${WORK}/answers.csv" answer_lines)
+list(REMOVE_AT answer_lines 0)  # header step,collides
+list(LENGTH answer_lines steps)
+set(oracle_collisions 0)
+foreach(line IN LISTS answer_lines)
+  if(line MATCHES ",1$")
+    math(EXPR oracle_collisions "${oracle_collisions} + 1")
+  endif()
+endforeach()
+if(oracle_collisions EQUAL 0)
+  message(FATAL_ERROR "the test flight has no collision: it checks nothing")
+endif()
+
+file(READ "${WORK}/report.json" report)
+string(JSON inside_only GET "${report}" inside_only_poses)
+string(JSON runs LENGTH "${report}" runs)
+set(seen "")
+math(EXPR last "${runs} - 1")
+foreach(i RANGE ${last})
+  string(JSON name GET "${report}" runs ${i} collider)
+  string(JSON question GET "${report}" runs ${i} question)
+  string(JSON run_steps GET "${report}" runs ${i} steps)
+  list(APPEND seen ${name})
+  if(NOT run_steps EQUAL steps)
+    message(FATAL_ERROR "${name} answered ${run_steps} poses of ${steps}")
+  endif()
+  foreach(key same_question oracle)
+    string(JSON fn_${key} GET "${report}" runs ${i} disagreements ${key} false_negatives)
+    string(JSON fp_${key} GET "${report}" runs ${i} disagreements ${key} false_positives)
+  endforeach()
+  if(NOT fn_same_question EQUAL 0 OR NOT fp_same_question EQUAL 0)
+    message(FATAL_ERROR "${name} disagrees with the exact answer to its question (${question}): "
+                        "${fn_same_question} false negatives, ${fp_same_question} false positives")
+  endif()
+  set(expected_fn 0)
+  if(question STREQUAL "surfaces")
+    set(expected_fn ${inside_only})
+  endif()
+  if(NOT fn_oracle EQUAL expected_fn OR NOT fp_oracle EQUAL 0)
+    message(FATAL_ERROR "${name} (${question}) disagrees with the oracle on ${fn_oracle} / ${fp_oracle} poses "
+                        "(FN / FP); only the ${expected_fn} poses with the object inside an obstacle are explained")
+  endif()
+  if(name STREQUAL "cgal")
+    string(JSON collisions GET "${report}" runs ${i} collisions)
+    if(NOT collisions EQUAL oracle_collisions)
+      message(FATAL_ERROR "the oracle run found ${collisions} collisions, its answer file ${oracle_collisions}")
+    endif()
+  endif()
+endforeach()
+foreach(expected fcl cgal-surfaces cgal tetrapage tetrapage-paged)
+  if(NOT expected IN_LIST seen)
+    message(FATAL_ERROR "no ${expected} run in the report (runs: ${seen})")
+  endif()
+endforeach()
+message(STATUS "${runs} colliders, ${steps} poses, ${oracle_collisions} collisions, ${inside_only} inside only: all explained")
