@@ -259,15 +259,36 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // Phase I and II over the region's shards whose bounds meet the box.
   const bool all = options.mode == QueryMode::all_contacts;
   bool stop = false;
+  // The object's own box (grown by the reach), to prune R-tree nodes and triangles in its
+  // frame: for a rotated object it is much tighter than the world box.
+  geometry::Point own_centre, own_half;
+  for (int a = 0; a < 3; ++a) {
+    own_centre[a] = 0.5 * (object_box_.lo[a] + object_box_.hi[a]);
+    own_half[a] = 0.5 * (object_box_.hi[a] - object_box_.lo[a]) + reach;
+  }
+  const double translation_magnitude =
+      std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])});
+  // Does a world box meet the object's own box? Its centre taken to the object's frame and
+  // its half extents through |R| (separating axes of the object's frame); the roundings are
+  // covered by a margin far beyond them. Conservative: it only prunes.
+  auto meets_own_box = [&](const geometry::Box& b) {
+    Vec3 c, h;
+    for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
+    const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
+                                     std::fabs(b.hi[1]), std::fabs(b.hi[2])}) +
+                           translation_magnitude + object_radius_) *
+                          0x1p-40;
+    for (int a = 0; a < 3; ++a) {
+      const double x = rotation_[a] * c[0] + rotation_[3 + a] * c[1] + rotation_[6 + a] * c[2];
+      const double e = std::fabs(rotation_[a]) * h[0] + std::fabs(rotation_[3 + a]) * h[1] +
+                       std::fabs(rotation_[6 + a]) * h[2];
+      if (std::fabs(x - own_centre[a]) > e + own_half[a] + margin) return false;
+    }
+    return true;
+  };
   auto test_shard = [&](const Shard& shard) {
-    shard.for_each_candidate(box, [&](std::uint32_t local) {
+    shard.for_each_box_candidate(box, meets_own_box, [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
-      ++counters.candidates;
-      const geometry::Triangle environment = shard.triangle(local);
-      if (closed_ && !result.collides && geometry::box_contains(box, environment[0]) &&
-          geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
-          in_object_box(environment[0]))
-        enclosed_.emplace_back(environment[0], shard.part_id(local));
       // The environment triangle in the object's frame (rounded: it only prunes).
       geometry::Box query;
       for (const auto& p : environment) {
@@ -282,6 +303,12 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
       const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
+      if (!geometry::boxes_overlap(query, object_box_) || !geometry::triangle_intersects_box(environment, box)) return;
+      ++counters.candidates;
+      if (closed_ && !result.collides && geometry::box_contains(box, environment[0]) &&
+          geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
+          in_object_box(environment[0]))
+        enclosed_.emplace_back(environment[0], shard.part_id(local));
       bvh_.for_each_in_box(query, [&](std::uint32_t object_triangle) {
         ++counters.triangle_tests;
         if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;

@@ -46,7 +46,9 @@ struct StepCounters {
   std::uint32_t tets_overlapping = 0;
   std::uint32_t shards_touched = 0; ///< shards whose bounds met the object's box
   std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
-  std::uint64_t candidates = 0;     ///< phase I: shard triangles meeting the object's box
+  /// phase I: shard triangles that meet the object's world box (exactly) and whose boxes, in
+  /// the object's frame, meet its own box
+  std::uint64_t candidates = 0;
   std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
   double locate_seconds = 0;        ///< the object's box, and the walk when it searched
   double search_seconds = 0;

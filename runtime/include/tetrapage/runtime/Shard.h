@@ -119,6 +119,52 @@ class Shard {
     return counters.visited - before;
   }
 
+  /// Calls visit(local, triangle) once for each stored triangle whose box overlaps `box` (no
+  /// exact triangle/box test: for callers that decide each triangle exactly anyway), pruning
+  /// R-tree nodes whose box `accept(node_box)` rejects as well (a conservative filter of the
+  /// caller's, e.g. an oriented box). No state is shared between concurrent queries.
+  template <class Accept, class Visit>
+  void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
+    for (int k = 0; k < 3; ++k)
+      if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
+    if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_)) return;
+    auto near = [&](std::uint32_t t) {
+      const geometry::Triangle triangle = this->triangle(t);
+      if (geometry::boxes_overlap(geometry::box_of(triangle), box)) visit(t, triangle);
+    };
+    if (kind_ == ShardKind::grid) {
+      std::array<std::uint32_t, 3> first{}, last{};
+      for (int k = 0; k < 3; ++k)
+        if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k], box.lo[k], box.hi[k],
+                                           first[k], last[k]))
+          return;
+      Marks marks(triangle_count_);
+      for (std::uint32_t z = first[2]; z <= last[2]; ++z)
+        for (std::uint32_t y = first[1]; y <= last[1]; ++y)
+          for (std::uint32_t x = first[0]; x <= last[0]; ++x) {
+            const std::size_t cell = (std::size_t(z) * grid_cells_[1] + y) * grid_cells_[0] + x;
+            for (std::uint32_t r = cell_offsets_[cell]; r < cell_offsets_[cell + 1]; ++r) {
+              const std::uint32_t t = references16_.empty() ? references32_[r] : references16_[r];
+              if (marks.first_visit(t)) near(t);
+            }
+          }
+      return;
+    }
+    std::array<std::uint32_t, shard_format::kMaxDepth * shard_format::kMaxFanout + 1> stack;
+    std::size_t size = 0;
+    stack[size++] = 0;
+    while (size > 0) {
+      const Node& node = nodes_[stack[--size]];
+      if (!geometry::boxes_overlap(node.box, box) || !accept(node.box)) continue;
+      if (node.count & shard_format::kLeafFlag) {
+        const std::uint32_t count = node.count & ~shard_format::kLeafFlag;
+        for (std::uint32_t t = node.first; t < node.first + count; ++t) near(t);
+      } else {
+        for (std::uint32_t c = node.count; c-- > 0;) stack[size++] = node.first + c;
+      }
+    }
+  }
+
   /// Counts the cells or nodes and the references a query of `box` examines, without deciding
   /// any triangle (what the cost model measures: the exact tests are the same for every layout).
   void count_query(const geometry::Box& box, ShardQueryCounters& counters) const {
