@@ -123,22 +123,28 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
     for (const auto v : hull_vertices_) box.extend(world_vertex(v));
   } else {
     // Per axis and side, climb from the last extreme to a vertex no neighbour beats: on a
-    // convex polytope a local extreme of a linear function is the global one.
+    // convex polytope a local extreme of a linear function is the global one. Only the
+    // axis's coordinate is computed (apply_pose's row, the same operations).
     for (int k = 0; k < 6; ++k) {
       const int axis = k / 2;
       const double sign = k % 2 == 0 ? -1.0 : 1.0;
+      const double r0 = rotation_[3 * axis], r1 = rotation_[3 * axis + 1], r2 = rotation_[3 * axis + 2];
+      const auto coordinate = [&](std::uint32_t hull_vertex) {
+        const Vec3& x = object_.vertices[hull_vertices_[hull_vertex]];
+        return r0 * x[0] + r1 * x[1] + r2 * x[2] + translation_[axis];
+      };
       std::uint32_t at = extreme_[k];
-      double best = sign * world_vertex(hull_vertices_[at])[axis];
+      double best = sign * coordinate(at);
       for (bool moved = true; moved;) {
         moved = false;
         for (std::uint32_t i = hull_offsets_[at]; i < hull_offsets_[at + 1]; ++i) {
           const std::uint32_t next = hull_neighbours_[i];
-          const double value = sign * world_vertex(hull_vertices_[next])[axis];
+          const double value = sign * coordinate(next);
           if (value > best) best = value, at = next, moved = true;
         }
       }
       extreme_[k] = at;
-      box.extend(world_vertex(hull_vertices_[at]));
+      (k % 2 == 0 ? box.lo[axis] : box.hi[axis]) = sign * best;
     }
   }
   // The placement rounds each coordinate; rounded values can make a near-tie climb stop one
