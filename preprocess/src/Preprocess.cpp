@@ -31,6 +31,7 @@
 #include "tetrapage/preprocess/ShardCostModel.h"
 #include "tetrapage/preprocess/TriangleBinning.h"
 #include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/geometry/PointTetrahedron.h"
 
 namespace tetrapage {
 namespace {
@@ -248,11 +249,7 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     for (int a = 0; a < 3; ++a)
       result.reference_points[3 * t + a] = reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
   });
-  // Reference points sorted by x, so that a batch finds the points in its parts' boxes quickly.
-  std::vector<std::uint32_t> by_x(tet_count);
-  for (std::size_t t = 0; t < tet_count; ++t) by_x[t] = std::uint32_t(t);
-  std::sort(by_x.begin(), by_x.end(), [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
-
+  std::vector<std::uint32_t> by_x;  // the tets of a pass, by their reference point's x
   std::vector<std::vector<std::uint32_t>> inside(tet_count);
   std::vector<bool> undecided(tet_count, false);
   std::unique_ptr<InteriorClassifier> classifier;
@@ -294,7 +291,12 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     batch_parts.clear();
     batch_triangles = 0;
   };
-  Progress progress("classifying interiors", in.seen, options.progress);
+  // One pass over the records classifies the given tets' reference points against every part.
+  auto classify_pass = [&](std::vector<std::uint32_t> tets, bool show_progress) {
+  by_x = std::move(tets);
+  std::sort(by_x.begin(), by_x.end(), [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
+  for (const std::uint32_t t : by_x) inside[t].clear(), undecided[t] = false;
+  Progress progress("classifying interiors", in.seen, options.progress && show_progress);
   in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
     for (std::size_t i = 0; i < block.size();) {
       std::size_t j = i;
@@ -316,6 +318,34 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   });
   classify_batch();
   progress.finish();
+  };
+  std::vector<std::uint32_t> all(tet_count);
+  for (std::size_t t = 0; t < tet_count; ++t) all[t] = std::uint32_t(t);
+  classify_pass(std::move(all), true);
+  const std::uint64_t first_pass_batches = batches;
+  // An undecided point (rays through edges) is replaced by another point strictly inside its
+  // tet and classified again, in a pass of its own over the records (a tet's point must be
+  // the same for every batch).
+  constexpr std::array<std::array<double, 4>, 3> kOtherPoints{
+      {{0.31, 0.23, 0.27, 0.19}, {0.17, 0.37, 0.21, 0.25}, {0.29, 0.13, 0.39, 0.19}}};
+  std::uint64_t moved = 0;
+  for (const auto& w : kOtherPoints) {
+    std::vector<std::uint32_t> retry;
+    for (std::size_t t = 0; t < tet_count; ++t) {
+      if (!undecided[t]) continue;
+      const auto c = mesh.corners(t);
+      Vec3 q;
+      for (int a = 0; a < 3; ++a) q[a] = w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a] + w[3] * c[3][a];
+      if (geometry::locate_in_tetrahedron(q, c).position != geometry::TetrahedronPosition::inside) continue;
+      points[t] = q;
+      for (int a = 0; a < 3; ++a) result.reference_points[3 * t + a] = q[a];
+      retry.push_back(std::uint32_t(t));
+      ++moved;
+    }
+    if (retry.empty()) break;
+    classify_pass(std::move(retry), false);
+  }
+  batches = first_pass_batches;
 
   result.offsets.reserve(tet_count + 1);
   result.offsets.push_back(0);
@@ -332,6 +362,7 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   }
   result.stored = true;
   summary.interiors = "stored (" + std::to_string(batches) + (batches == 1 ? " batch" : " batches") + ")";
+  if (moved > 0) summary.interiors += "; " + std::to_string(moved) + " reference points moved and classified again";
   if (too_large > 0)
     summary.interiors += "; " + std::to_string(too_large) +
                          " closed parts left open (larger than half --memory can classify, or not contiguous)";

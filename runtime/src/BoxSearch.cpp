@@ -106,47 +106,99 @@ std::string format_box(const geometry::Box& box) {
 
 }  // namespace
 
-BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_tet,
-                                     const geometry::Box& box, BoxSearchScratch& scratch) {
+namespace {
+
+// No face plane of the tet puts the whole box strictly outside, in double with a margin far
+// beyond the roundings: a cheap conservative stand-in for the exact test (it keeps some tets
+// that only an edge-axis plane would separate, never drops one that meets the box).
+bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box) {
+  double scale = 0;
+  for (const auto& p : t)
+    for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(p[a]));
+  for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(box.lo[a]), std::fabs(box.hi[a])});
+  for (int k = 0; k < 4; ++k) {
+    const auto& f = geometry::kTetrahedronFaces[k];
+    const geometry::Point& a = t[f[0]];
+    const geometry::Point u{t[f[1]][0] - a[0], t[f[1]][1] - a[1], t[f[1]][2] - a[2]};
+    const geometry::Point v{t[f[2]][0] - a[0], t[f[2]][1] - a[1], t[f[2]][2] - a[2]};
+    geometry::Point n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const geometry::Point& opposite = t[k];
+    const double inside = n[0] * (opposite[0] - a[0]) + n[1] * (opposite[1] - a[1]) + n[2] * (opposite[2] - a[2]);
+    if (inside < 0) n = {-n[0], -n[1], -n[2]};
+    // The box corner farthest into the tet's side of the plane.
+    double reach = 0;
+    for (int axis = 0; axis < 3; ++axis) reach += n[axis] * ((n[axis] > 0 ? box.hi[axis] : box.lo[axis]) - a[axis]);
+    // The normal's rounding is relative to |u| |v|, not to |n| (tiny for a sliver face).
+    const double size = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
+                        (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]));
+    if (reach < -size * scale * 0x1p-40) return false;
+  }
+  return true;
+}
+
+// Breadth-first from start_tet through the tets `meets` accepts; those form a connected set
+// when `meets` is exact (the tets meeting a convex box) or a superset of it (box overlaps).
+template <bool kExact>
+BoxSearchResult search(const TetMesh& mesh, std::uint32_t start_tet, const geometry::Box& box,
+                       std::vector<std::uint32_t>& stamps, std::uint32_t& stamp_counter,
+                       std::vector<std::uint32_t>& found) {
   if (start_tet >= mesh.tet_count())
     throw InputError("box search: start tet " + std::to_string(start_tet) +
                      " is out of range (" + std::to_string(mesh.tet_count()) + " tets)");
   if (!geometry::is_finite(box.lo) || !geometry::is_finite(box.hi))
     throw InputError("box search: the box " + format_box(box) + " is not finite");
-  scratch.found_.clear();
+  found.clear();
   BoxSearchResult result;
   if (geometry::inverted(box)) return result;
-  if (!geometry::tetrahedron_intersects_box(mesh.corners(start_tet), box))
+  const auto meets = [&](std::uint32_t tet) {
+    if constexpr (kExact) return geometry::tetrahedron_intersects_box(mesh.corners(tet), box);
+    else return geometry::boxes_overlap(mesh.bounds(tet), box) && no_face_separates(mesh.corners(tet), box);
+  };
+  if (!meets(start_tet))
     throw InputError("box search: start tet " + std::to_string(start_tet) +
                      " does not meet the box " + format_box(box));
 
-  if (scratch.stamps_.size() < mesh.tet_count()) {
-    scratch.stamps_.assign(mesh.tet_count(), 0);
-    scratch.stamp_ = 0;
+  if (stamps.size() < mesh.tet_count()) {
+    stamps.assign(mesh.tet_count(), 0);
+    stamp_counter = 0;
   }
-  if (++scratch.stamp_ == 0) {  // wrapped around: old stamps could collide
-    std::fill(scratch.stamps_.begin(), scratch.stamps_.end(), 0u);
-    scratch.stamp_ = 1;
+  if (++stamp_counter == 0) {  // wrapped around: old stamps could collide
+    std::fill(stamps.begin(), stamps.end(), 0u);
+    stamp_counter = 1;
   }
-  const std::uint32_t stamp = scratch.stamp_;
-  auto& found = scratch.found_;
-  scratch.stamps_[start_tet] = stamp;
+  const std::uint32_t stamp = stamp_counter;
+  stamps[start_tet] = stamp;
   found.push_back(start_tet);
   result.tets_visited = 1;
-  result.exact_tests = 1;
+  result.exact_tests = kExact ? 1 : 0;
   // Only tets that meet the box expand: the ones meeting it are connected through faces.
   for (std::size_t head = 0; head < found.size(); ++head) {
     for (const std::uint32_t next : mesh.neighbours[found[head]]) {
-      if (next == TetMesh::no_neighbour || scratch.stamps_[next] == stamp) continue;
-      scratch.stamps_[next] = stamp;
+      if (next == TetMesh::no_neighbour || stamps[next] == stamp) continue;
+      stamps[next] = stamp;
       ++result.tets_visited;
       if (!geometry::boxes_overlap(mesh.bounds(next), box)) continue;
-      ++result.exact_tests;
-      if (geometry::tetrahedron_intersects_box(mesh.corners(next), box)) found.push_back(next);
+      if constexpr (kExact) {
+        ++result.exact_tests;
+        if (!geometry::tetrahedron_intersects_box(mesh.corners(next), box)) continue;
+      }
+      found.push_back(next);
     }
   }
   result.tets = found;
   return result;
+}
+
+}  // namespace
+
+BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_tet,
+                                     const geometry::Box& box, BoxSearchScratch& scratch) {
+  return search<true>(mesh, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
+}
+
+BoxSearchResult tets_near_box(const TetMesh& mesh, std::uint32_t start_tet, const geometry::Box& box,
+                              BoxSearchScratch& scratch) {
+  return search<false>(mesh, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
 }
 
 }  // namespace tetrapage

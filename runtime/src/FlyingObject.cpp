@@ -173,13 +173,29 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   last_tet_ = located.tet;
 
   start = Clock::now();
-  const BoxSearchResult found = tets_overlapping_box(mesh, located.tet, region, search_);
+  // Bounding boxes are enough here: the region only has to cover the steps' boxes, and each
+  // step skips the shards whose stored bounds miss its box.
+  const BoxSearchResult found = tets_near_box(mesh, located.tet, region, search_);
   counters.tets_visited = found.tets_visited;
   counters.tets_overlapping = std::uint32_t(found.tets.size());
   shards_.clear();
+  shard_reach_.clear();
   for (const std::uint32_t tet : found.tets) {
     const std::uint32_t shard = index.shard_of_tet(tet);
-    if (shard != TetMesh::no_neighbour) shards_.push_back(shard);
+    if (shard == TetMesh::no_neighbour) continue;
+    // A shard's triangles that meet a step's box there meet it inside the shard's tet, or
+    // inside another tet of the region (whose shard holds them too): a step needs the shard
+    // only when its box meets both the tet's box and the stored bounds.
+    const geometry::Box tet_box = mesh.bounds(tet);
+    const geometry::Box& stored = index.shard_bounds(shard);
+    geometry::Box reach;
+    for (int a = 0; a < 3; ++a) {
+      reach.lo[a] = std::max(tet_box.lo[a], stored.lo[a]);
+      reach.hi[a] = std::min(tet_box.hi[a], stored.hi[a]);
+    }
+    if (!geometry::boxes_overlap(region, reach)) continue;
+    shards_.push_back(shard);
+    shard_reach_.push_back(reach);
   }
   counters.search_seconds = seconds_since(start);
 
@@ -214,9 +230,11 @@ void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_
   const WalkResult ahead = locate_point(mesh, from_tet, centre_in_mesh_box(next_region, index));
   if (ahead.tet == TetMesh::no_neighbour || !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet))) return;
   hints_.clear();
-  for (const std::uint32_t tet : tets_overlapping_box(mesh, ahead.tet, next_region, prefetch_search_).tets) {
+  for (const std::uint32_t tet : tets_near_box(mesh, ahead.tet, next_region, prefetch_search_).tets) {
     const std::uint32_t shard = index.shard_of_tet(tet);
-    if (shard != TetMesh::no_neighbour && !index.cache().contains(shard)) hints_.push_back(shard);
+    if (shard != TetMesh::no_neighbour && geometry::boxes_overlap(next_region, index.shard_bounds(shard)) &&
+        !index.cache().contains(shard))
+      hints_.push_back(shard);
   }
   if (!hints_.empty()) index.cache().prefetch(hints_);
 }
@@ -225,6 +243,7 @@ void FlyingObject::release_region() {
   // Outside the model nothing needs the region's shards: give their budget back.
   pins_.clear();
   shards_.clear();
+  shard_reach_.clear();
   searched_valid_ = false;
 }
 
@@ -332,7 +351,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   for (std::size_t k = 0; k < shards_.size() && !stop; ++k) {
     const std::uint32_t shard_id = shards_[k];
     // Shards whose stored triangles cannot meet the box are neither read nor pinned.
-    if (!geometry::boxes_overlap(box, index.shard_bounds(shard_id))) continue;
+    if (!geometry::boxes_overlap(box, shard_reach_[k])) continue;
     ++counters.shards_touched;
     ShardCache<Shard>::Pin local_pin;
     ShardCache<Shard>::Pin& pin = keep_pins_ ? pins_[k] : local_pin;

@@ -41,7 +41,7 @@ void record_hit(const RTCFilterFunctionNArguments* args) {
 
 class EmbreeInteriorClassifier::Impl {
  public:
-  explicit Impl(unsigned rays) : rays_(std::clamp(rays, 2u, unsigned(kDirections.size()))) {}
+  explicit Impl(unsigned rays) : rays_(std::clamp(rays, 3u, unsigned(kDirections.size()))) {}
 
   void add(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) {
     for (const auto& t : triangles) {
@@ -57,19 +57,26 @@ class EmbreeInteriorClassifier::Impl {
     build();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, points.size(), 64),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                        std::vector<std::uint32_t> hits;
-                        std::vector<std::uint32_t> odd, first_odd;
+                        std::vector<std::uint32_t> hits, odd;
+                        std::vector<std::vector<std::uint32_t>> answers(rays_);
                         for (std::size_t i = range.begin(); i < range.end(); ++i) {
                           for (unsigned r = 0; r < rays_; ++r) {
                             odd_parts(points[i], kDirections[r], hits, odd);
-                            if (r == 0) {
-                              first_odd = odd;
-                            } else if (odd != first_odd) {
-                              out[i].decided = false;
-                              break;
+                            answers[r] = odd;
+                          }
+                          // The parts are closed, so only a ray through an edge or a vertex (or
+                          // a point within float precision of a surface) can be wrong: decided
+                          // when all rays but at most one agree.
+                          bool decided = false;
+                          for (unsigned r = 0; r < 2 && !decided; ++r) {
+                            unsigned agree = 0;
+                            for (unsigned q = 0; q < rays_; ++q) agree += answers[q] == answers[r];
+                            if (agree + 1 >= rays_) {
+                              decided = true;
+                              out[i].parts = answers[r];
                             }
                           }
-                          if (out[i].decided) out[i].parts = first_odd;
+                          out[i].decided = decided;
                         }
                       });
   }

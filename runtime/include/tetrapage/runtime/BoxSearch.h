@@ -51,6 +51,7 @@ class BoxSearchScratch {
  private:
   friend BoxSearchResult tets_overlapping_box(const TetMesh&, std::uint32_t, const geometry::Box&,
                                               BoxSearchScratch&);
+  friend BoxSearchResult tets_near_box(const TetMesh&, std::uint32_t, const geometry::Box&, BoxSearchScratch&);
   std::vector<std::uint32_t> stamps_;  ///< stamps_[tet] == stamp_: reached in this query
   std::uint32_t stamp_ = 0;
   std::vector<std::uint32_t> found_;  ///< the answer, which is also the breadth-first queue
@@ -63,5 +64,13 @@ class BoxSearchScratch {
 ///        not meet a non-empty box.
 BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_tet,
                                      const geometry::Box& box, BoxSearchScratch& scratch);
+
+/// The same breadth-first search with a cheap conservative test instead of the exact one (the
+/// bounding boxes overlap and no face plane separates, in double with a wide margin): a
+/// superset of tets_overlapping_box's answer (exact_tests stays 0), for callers that only need
+/// to cover the box (the flying object's searched region).
+/// @throw InputError as tets_overlapping_box (the start tet's bounding box must meet the box).
+BoxSearchResult tets_near_box(const TetMesh& mesh, std::uint32_t start_tet, const geometry::Box& box,
+                              BoxSearchScratch& scratch);
 
 }  // namespace tetrapage

@@ -149,6 +149,7 @@ class FlyingObject {
   bool searched_valid_ = false;
   Vec3 searched_centre_{};
   std::vector<std::uint32_t> shards_;
+  std::vector<geometry::Box> shard_reach_;  ///< parallel to shards_: tet box and stored bounds, intersected
   std::vector<ShardCache<Shard>::Pin> pins_;  ///< parallel to shards_; empty until needed
   bool keep_pins_ = false;
   std::vector<std::uint32_t> hints_;

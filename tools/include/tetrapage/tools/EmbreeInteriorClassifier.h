@@ -2,9 +2,10 @@
 /// @file EmbreeInteriorClassifier.h
 /// Classifies points against closed parts by Embree ray parity (issue 6, "interiors"): from each
 /// point, rays in several fixed directions count their crossings with each part's surface;
-/// a part holds the point when the count is odd. When the rays disagree (an open or
-/// overlapping surface, a ray through an edge, or a point within float precision of a
-/// surface) the point is undecided and never used. Embree works in float: coordinates are
+/// a part holds the point when the count is odd. The parts given are closed (EdgeParity), so a
+/// ray can only be wrong where it passes through an edge or a vertex (Embree may count both
+/// triangles there) or starts within float precision of a surface: the answer is the one all
+/// rays but at most one agree on, and the point is undecided (never used) otherwise. Embree works in float: coordinates are
 /// taken relative to the centre of the triangles' box before rounding.
 #include <memory>
 
@@ -14,8 +15,8 @@ namespace tetrapage {
 
 class EmbreeInteriorClassifier final : public InteriorClassifier {
  public:
-  /// @param rays the directions per point (at least 2, so that disagreement can be seen).
-  explicit EmbreeInteriorClassifier(unsigned rays = 3);
+  /// @param rays the directions per point (3 to 5; one may disagree).
+  explicit EmbreeInteriorClassifier(unsigned rays = 5);
   ~EmbreeInteriorClassifier() override;
   std::uint64_t bytes_per_triangle() const override;
   void add_triangles(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) override;
@@ -29,6 +30,6 @@ class EmbreeInteriorClassifier final : public InteriorClassifier {
 };
 
 /// A factory for PreprocessOptions::interior_classifier.
-InteriorClassifierFactory embree_interior_classifier(unsigned rays = 3);
+InteriorClassifierFactory embree_interior_classifier(unsigned rays = 5);
 
 }  // namespace tetrapage
