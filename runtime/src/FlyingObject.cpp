@@ -318,12 +318,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       // The environment triangle in the object's frame (rounded: it only prunes).
       geometry::Box query;
-      for (const auto& p : environment) {
-        const Vec3 d{p[0] - translation_[0], p[1] - translation_[1], p[2] - translation_[2]};
-        query.extend(Vec3{rotation_[0] * d[0] + rotation_[3] * d[1] + rotation_[6] * d[2],
-                          rotation_[1] * d[0] + rotation_[4] * d[1] + rotation_[7] * d[2],
-                          rotation_[2] * d[0] + rotation_[5] * d[1] + rotation_[8] * d[2]});
-      }
+      for (const auto& p : environment) query.extend(to_object_frame(p));
       // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
       double magnitude = object_radius_;
       for (const auto& p : environment)
@@ -405,13 +400,17 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
   result.counters.interior_seconds = seconds_since(start);
 }
 
+Vec3 FlyingObject::to_object_frame(const geometry::Point& p) const {
+  const Vec3 e{p[0] - translation_[0], p[1] - translation_[1], p[2] - translation_[2]};
+  return {rotation_[0] * e[0] + rotation_[3] * e[1] + rotation_[6] * e[2],
+          rotation_[1] * e[0] + rotation_[4] * e[1] + rotation_[7] * e[2],
+          rotation_[2] * e[0] + rotation_[5] * e[1] + rotation_[8] * e[2]};
+}
+
 bool FlyingObject::in_object_box(const geometry::Point& p) const {
   // p in the object's own frame (rounded back, so the box is grown far beyond the rounding):
   // outside that box means outside the object. The world box is looser for a rotated object.
-  const Vec3 e{p[0] - translation_[0], p[1] - translation_[1], p[2] - translation_[2]};
-  const Vec3 x{rotation_[0] * e[0] + rotation_[3] * e[1] + rotation_[6] * e[2],
-               rotation_[1] * e[0] + rotation_[4] * e[1] + rotation_[7] * e[2],
-               rotation_[2] * e[0] + rotation_[5] * e[1] + rotation_[8] * e[2]};
+  const Vec3 x = to_object_frame(p);
   const double margin = (object_radius_ + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
                          std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])})) *
                         0x1p-40;
@@ -444,10 +443,7 @@ bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& b
     geometry::Box query;
     double magnitude = object_radius_;
     for (const auto& q : segment) {
-      const Vec3 e{q[0] - translation_[0], q[1] - translation_[1], q[2] - translation_[2]};
-      query.extend(Vec3{rotation_[0] * e[0] + rotation_[3] * e[1] + rotation_[6] * e[2],
-                        rotation_[1] * e[0] + rotation_[4] * e[1] + rotation_[7] * e[2],
-                        rotation_[2] * e[0] + rotation_[5] * e[1] + rotation_[8] * e[2]});
+      query.extend(to_object_frame(q));
       for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(q[a]) + std::fabs(translation_[a]));
     }
     const double grow = magnitude * 0x1p-40;

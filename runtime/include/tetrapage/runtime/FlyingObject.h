@@ -117,6 +117,9 @@ class FlyingObject {
   void check_containment(const geometry::Box& box, QueryResult& result);
   bool object_holds(const geometry::Point& p, const geometry::Box& box);
   bool in_object_box(const geometry::Point& p) const;
+  // A world point taken back to the object's frame at the current pose (rounded: callers
+  // only prune with it, with margins far beyond the rounding).
+  Vec3 to_object_frame(const geometry::Point& p) const;
   geometry::Triangle world_triangle(std::uint32_t t);
 
   std::shared_ptr<const CollisionIndex> index_;
