@@ -1,0 +1,358 @@
+#include "tetrapage/tools/LocationCheck.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/geometry/PointTetrahedron.h"
+#include "tetrapage/runtime/geometry/Predicates.h"
+#include "tetrapage/tools/Random.h"
+
+namespace tetrapage {
+namespace {
+
+using geometry::Point;
+using geometry::TetrahedronPosition;
+
+constexpr std::uint32_t kOutside = TetMesh::no_neighbour;
+
+// Dyadic weights (numerators over 2^shift): their combinations of a face's or an edge's
+// corners are often exact doubles; the exact predicates keep only those that are.
+struct Weights {
+  std::array<double, 3> w;
+  double scale;
+};
+constexpr Weights kFaceWeights[] = {
+    {{1, 1, 2}, 0.25},  {{1, 2, 1}, 0.25},  {{2, 1, 1}, 0.25},  {{1, 1, 6}, 0.125},
+    {{1, 6, 1}, 0.125}, {{6, 1, 1}, 0.125}, {{3, 3, 2}, 0.125}, {{3, 2, 3}, 0.125},
+    {{2, 3, 3}, 0.125}, {{1, 3, 4}, 0.125}, {{3, 1, 4}, 0.125}, {{4, 3, 1}, 0.125},
+};
+constexpr Weights kEdgeWeights[] = {
+    {{1, 1, 0}, 0.5},   {{1, 3, 0}, 0.25},  {{3, 1, 0}, 0.25},
+    {{1, 7, 0}, 0.125}, {{7, 1, 0}, 0.125}, {{3, 5, 0}, 0.125}, {{5, 3, 0}, 0.125},
+};
+constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+
+// x * y and x + y, true when the rounded result is the exact one (fma gives the product's
+// rounding error, Knuth's TwoSum the sum's).
+bool exact_product(double x, double y, double& out) {
+  out = x * y;
+  return std::fma(x, y, -out) == 0;
+}
+bool exact_sum(double x, double y, double& out) {
+  out = x + y;
+  const double y_part = out - x;
+  return (x - (out - y_part)) + (y - y_part) == 0;
+}
+
+// The combination of the corners with these weights when every operation is exact (a cheap
+// filter before the exact predicates confirm where the point lies).
+std::optional<Point> combine(const Weights& weights, const Point& a, const Point& b,
+                             const Point& c) {
+  Point p;
+  for (int k = 0; k < 3; ++k) {
+    double wa, wb, wc, ab, sum;
+    if (!exact_product(weights.w[0], a[k], wa) || !exact_product(weights.w[1], b[k], wb) ||
+        !exact_product(weights.w[2], c[k], wc) || !exact_sum(wa, wb, ab) ||
+        !exact_sum(ab, wc, sum) || !exact_product(sum, weights.scale, p[k]))
+      return std::nullopt;
+  }
+  return p;
+}
+
+std::string format_answer(const std::vector<std::uint32_t>& tets, bool outside) {
+  std::string text;
+  for (std::uint32_t t : tets) text += (text.empty() ? "tet " : ", tet ") + std::to_string(t);
+  if (outside) text += text.empty() ? "outside" : ", outside";
+  return text.empty() ? "nothing" : text;
+}
+
+enum class Outcome : std::uint8_t { same_tet, exact_tie, outside, disagreement };
+
+struct PointResult {
+  Outcome outcome = Outcome::same_tet;
+  std::uint32_t faces_hit = 0;
+  std::uint32_t resyncs = 0;
+  bool ambiguous = false;
+  std::optional<LocationDisagreement> disagreement;
+};
+
+// The mesh, its vertex stars, and the verdict rule of LocationCheck.h.
+class Judge {
+ public:
+  Judge(const EmbreeMeshFaces& faces, const PointLocator& locator)
+      : faces_(faces), mesh_(faces.mesh()), locator_(locator) {
+    star_begin_.assign(mesh_.vertices.size() + 1, 0);
+    for (const auto& tet : mesh_.tets)
+      for (std::uint32_t v : tet) ++star_begin_[v + 1];
+    for (std::size_t v = 0; v < mesh_.vertices.size(); ++v) star_begin_[v + 1] += star_begin_[v];
+    star_.resize(star_begin_.back());
+    std::vector<std::uint32_t> fill(star_begin_.begin(), star_begin_.end() - 1);
+    for (std::uint32_t t = 0; t < mesh_.tet_count(); ++t)
+      for (std::uint32_t v : mesh_.tets[t]) star_[fill[v]++] = t;
+  }
+
+  PointResult judge(const LocationPoint& point) const {
+    if (point.embree_start >= mesh_.tet_count())
+      throw InputError("location check: start tet " + std::to_string(point.embree_start) +
+                       " is out of range (" + std::to_string(mesh_.tet_count()) + " tets)");
+    const auto reference = walk_reference_point(mesh_, point.embree_start);
+    if (!reference)
+      throw InputError("location check: start tet " + std::to_string(point.embree_start) +
+                       " has no point strictly inside it");
+    const FaceTrace trace = faces_.trace(point.embree_start, *reference, point.point);
+    const std::uint32_t located = locator_(point.point, point.locator_start);
+
+    PointResult result;
+    result.faces_hit = trace.faces_hit;
+    result.resyncs = trace.resyncs;
+    result.ambiguous = trace.end_tets.size() + (trace.outside ? 1 : 0) > 1;
+    std::vector<std::uint32_t> around = trace.end_tets;
+    for (std::uint32_t t : trace.exit_tets)
+      if (std::find(around.begin(), around.end(), t) == around.end()) around.push_back(t);
+
+    auto disagree = [&](std::string reason) {
+      result.outcome = Outcome::disagreement;
+      result.disagreement = LocationDisagreement{point.point, point.kind,       located,
+                                                 trace.end_tets, trace.outside, std::move(reason)};
+      return result;
+    };
+    if (located == kOutside) {
+      if (proven_outside(point.point, around)) {
+        result.outcome = Outcome::outside;
+        return result;
+      }
+      return disagree("located outside, but no hull face around Embree's answer (" +
+                      format_answer(trace.end_tets, trace.outside) +
+                      ") has the point strictly beyond it");
+    }
+    if (located >= mesh_.tet_count())
+      return disagree("located tet " + std::to_string(located) + " is not a tet of the mesh");
+    if (geometry::locate_in_tetrahedron(point.point, mesh_.corners(located)).position ==
+        TetrahedronPosition::outside)
+      return disagree("tet " + std::to_string(located) +
+                      " does not hold the point (exact predicate); Embree says " +
+                      format_answer(trace.end_tets, trace.outside));
+    if (!trace.outside && trace.end_tets.size() == 1 && trace.end_tets[0] == located) {
+      result.outcome = Outcome::same_tet;
+      return result;
+    }
+    for (std::uint32_t t : around)
+      if (shares_vertex(t, located)) {
+        result.outcome = Outcome::exact_tie;
+        return result;
+      }
+    return disagree("tet " + std::to_string(located) +
+                    " holds the point, but Embree's trace ends far from it (" +
+                    format_answer(trace.end_tets, trace.outside) + ")");
+  }
+
+ private:
+  bool shares_vertex(std::uint32_t a, std::uint32_t b) const {
+    for (std::uint32_t u : mesh_.tets[a])
+      for (std::uint32_t v : mesh_.tets[b])
+        if (u == v) return true;
+    return false;
+  }
+
+  // Exact: p strictly beyond the plane of a hull face of a tet sharing a vertex with one of
+  // `around`. The mesh is convex, so that plane separates p from the whole mesh.
+  bool proven_outside(const Point& p, const std::vector<std::uint32_t>& around) const {
+    for (std::uint32_t t : around)
+      for (std::uint32_t v : mesh_.tets[t])
+        for (std::uint32_t i = star_begin_[v]; i < star_begin_[v + 1]; ++i) {
+          const std::uint32_t s = star_[i];
+          for (int k = 0; k < 4; ++k) {
+            if (mesh_.neighbours[s][k] != kOutside) continue;
+            const auto& f = geometry::kTetrahedronFaces[k];
+            const auto& c = mesh_.tets[s];
+            // orient3d(face, own vertex) > 0 for a positive tet: negative is the far side.
+            if (geometry::orient3d(mesh_.vertices[c[f[0]]], mesh_.vertices[c[f[1]]],
+                                   mesh_.vertices[c[f[2]]], p) == geometry::Sign::negative)
+              return true;
+          }
+        }
+    return false;
+  }
+
+  const EmbreeMeshFaces& faces_;
+  const TetMesh& mesh_;
+  const PointLocator& locator_;
+  std::vector<std::uint32_t> star_begin_, star_;
+};
+
+}  // namespace
+
+const char* to_string(LocationPointKind kind) {
+  switch (kind) {
+    case LocationPointKind::random: return "random";
+    case LocationPointKind::on_face: return "on face";
+    case LocationPointKind::on_edge: return "on edge";
+    case LocationPointKind::on_vertex: return "on vertex";
+  }
+  return "unknown";
+}
+
+LocationPointSet make_location_points(const TetMesh& mesh, const LocationPointOptions& options) {
+  if (mesh.tets.empty()) throw InputError("location points: the mesh has no tet");
+  for (double share : {options.random_share, options.face_share, options.edge_share})
+    if (!(share >= 0 && share <= 1))
+      throw InputError("location points: share " + std::to_string(share) + " is not in [0, 1]");
+  if (options.random_share + options.face_share + options.edge_share > 1 + 1e-12)
+    throw InputError("location points: the random, face and edge shares sum above 1");
+  if (!(options.outside_margin >= 0))
+    throw InputError("location points: negative outside margin " +
+                     std::to_string(options.outside_margin));
+  std::vector<std::uint32_t> startable;
+  for (std::uint32_t t = 0; t < mesh.tet_count(); ++t)
+    if (walk_reference_point(mesh, t)) startable.push_back(t);
+  if (startable.empty())
+    throw InputError("location points: no tet of the mesh has a point strictly inside it");
+
+  Random random(options.seed);
+  const auto share = [&](double s) { return std::uint64_t(std::llround(double(options.points) * s)); };
+  std::array<std::uint64_t, kLocationPointKinds> wanted{};
+  wanted[0] = std::min(options.points, share(options.random_share));
+  wanted[1] = std::min(options.points - wanted[0], share(options.face_share));
+  wanted[2] = std::min(options.points - wanted[0] - wanted[1], share(options.edge_share));
+  wanted[3] = options.points - wanted[0] - wanted[1] - wanted[2];
+
+  LocationPointSet set;
+  set.points.reserve(options.points);
+  auto add = [&](const Point& p, LocationPointKind kind) {
+    LocationPoint point;
+    point.point = p;
+    point.kind = kind;
+    point.embree_start = startable[random.below(startable.size())];
+    point.locator_start = startable[random.below(startable.size())];
+    set.points.push_back(point);
+    ++set.count[std::size_t(kind)];
+  };
+
+  BoundingBox box;
+  for (const auto& v : mesh.vertices) box.extend(v);
+  const Vec3 size = box.size();
+  for (std::uint64_t i = 0; i < wanted[0]; ++i) {
+    Point p;
+    for (int k = 0; k < 3; ++k) {
+      const double grow = options.outside_margin * size[k];
+      p[k] = random.uniform(box.lo[k] - grow, box.hi[k] + grow);
+    }
+    add(p, LocationPointKind::random);
+    ++set.attempts[0];
+  }
+  // Stop looking after many misses (a mesh whose coordinates seldom combine exactly): the
+  // counts then show the shortfall. An attempt costs a few nanoseconds.
+  const auto attempt_cap = [](std::uint64_t wanted_points) {
+    return 2000 * wanted_points + 1'000'000;
+  };
+  for (std::uint64_t found = 0; found < wanted[1] && set.attempts[1] < attempt_cap(wanted[1]);) {
+    ++set.attempts[1];
+    const std::uint32_t t = std::uint32_t(random.below(mesh.tet_count()));
+    const int k = int(random.below(4));
+    const auto c = mesh.corners(t);
+    const auto& f = geometry::kTetrahedronFaces[k];
+    const auto p = combine(kFaceWeights[random.below(std::size(kFaceWeights))], c[f[0]],
+                           c[f[1]], c[f[2]]);
+    if (!p) continue;
+    const auto location = geometry::locate_in_tetrahedron(*p, c);
+    if (location.position != TetrahedronPosition::on_face || location.face() != k) continue;
+    add(*p, LocationPointKind::on_face);
+    ++found;
+  }
+  for (std::uint64_t found = 0; found < wanted[2] && set.attempts[2] < attempt_cap(wanted[2]);) {
+    ++set.attempts[2];
+    const std::uint32_t t = std::uint32_t(random.below(mesh.tet_count()));
+    const auto& e = kTetEdges[random.below(6)];
+    const auto c = mesh.corners(t);
+    const auto p = combine(kEdgeWeights[random.below(std::size(kEdgeWeights))], c[e[0]],
+                           c[e[1]], c[e[0]]);
+    if (!p) continue;
+    const auto location = geometry::locate_in_tetrahedron(*p, c);
+    if (location.position != TetrahedronPosition::on_edge ||
+        location.vertices != ((1u << e[0]) | (1u << e[1])))
+      continue;
+    add(*p, LocationPointKind::on_edge);
+    ++found;
+  }
+  for (std::uint64_t i = 0; i < wanted[3]; ++i) {
+    ++set.attempts[3];
+    const std::uint32_t t = std::uint32_t(random.below(mesh.tet_count()));
+    add(mesh.vertices[mesh.tets[t][random.below(4)]], LocationPointKind::on_vertex);
+  }
+  std::array<std::vector<Point>, kLocationPointKinds> by_kind;
+  for (const LocationPoint& p : set.points) by_kind[std::size_t(p.kind)].push_back(p.point);
+  for (std::size_t k = 0; k < kLocationPointKinds; ++k) {
+    std::sort(by_kind[k].begin(), by_kind[k].end());
+    set.distinct[k] = std::uint64_t(std::unique(by_kind[k].begin(), by_kind[k].end()) - by_kind[k].begin());
+  }
+  return set;
+}
+
+PointLocator runtime_locator(const TetMesh& mesh) {
+  return [&mesh](const Point& p, std::uint32_t start_tet) {
+    return locate_point(mesh, start_tet, p).tet;
+  };
+}
+
+LocationCheckSummary check_locations(const EmbreeMeshFaces& faces,
+                                     std::span<const LocationPoint> points,
+                                     const PointLocator& locator,
+                                     const LocationCheckOptions& options) {
+  const auto started = std::chrono::steady_clock::now();
+  const Judge judge(faces, locator);
+  LocationCheckSummary summary;
+  summary.points = points.size();
+  Progress progress("checking point location", points.size(), options.progress);
+  tbb::task_arena arena(options.threads > 0 ? int(options.threads) : tbb::task_arena::automatic);
+  constexpr std::size_t kBlock = 1 << 14;
+  std::vector<PointResult> results;
+  for (std::size_t begin = 0; begin < points.size(); begin += kBlock) {
+    const std::size_t end = std::min(points.size(), begin + kBlock);
+    results.assign(end - begin, PointResult{});
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, end, 64),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i < range.end(); ++i)
+                            results[i - begin] = judge.judge(points[i]);
+                        });
+    });
+    // Reduced in point order, so the summary does not depend on the threads.
+    for (std::size_t i = begin; i < end; ++i) {
+      PointResult& r = results[i - begin];
+      LocationOutcomes& kind = summary.by_kind[std::size_t(points[i].kind)];
+      ++kind.points;
+      summary.faces_hit += r.faces_hit;
+      kind.resynced_traces += r.resyncs > 0 ? 1 : 0;
+      kind.ambiguous_ends += r.ambiguous ? 1 : 0;
+      summary.resynced_traces += r.resyncs > 0 ? 1 : 0;
+      summary.ambiguous_ends += r.ambiguous ? 1 : 0;
+      switch (r.outcome) {
+        case Outcome::same_tet: ++kind.same_tet; break;
+        case Outcome::exact_tie: ++kind.exact_ties; break;
+        case Outcome::outside: ++kind.outside; break;
+        case Outcome::disagreement:
+          ++kind.disagreements;
+          ++summary.disagreements;
+          if (summary.listed.size() < options.max_listed)
+            summary.listed.push_back(std::move(*r.disagreement));
+          break;
+      }
+    }
+    progress.advance(end - begin);
+  }
+  progress.finish();
+  summary.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return summary;
+}
+
+}  // namespace tetrapage
