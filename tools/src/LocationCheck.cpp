@@ -24,48 +24,124 @@ using geometry::TetrahedronPosition;
 
 constexpr std::uint32_t kOutside = TetMesh::no_neighbour;
 
-// Dyadic weights (numerators over 2^shift): their combinations of a face's or an edge's
-// corners are often exact doubles; the exact predicates keep only those that are.
-struct Weights {
-  std::array<double, 3> w;
-  double scale;
-};
-constexpr Weights kFaceWeights[] = {
-    {{1, 1, 2}, 0.25},  {{1, 2, 1}, 0.25},  {{2, 1, 1}, 0.25},  {{1, 1, 6}, 0.125},
-    {{1, 6, 1}, 0.125}, {{6, 1, 1}, 0.125}, {{3, 3, 2}, 0.125}, {{3, 2, 3}, 0.125},
-    {{2, 3, 3}, 0.125}, {{1, 3, 4}, 0.125}, {{3, 1, 4}, 0.125}, {{4, 3, 1}, 0.125},
-};
-constexpr Weights kEdgeWeights[] = {
-    {{1, 1, 0}, 0.5},   {{1, 3, 0}, 0.25},  {{3, 1, 0}, 0.25},
-    {{1, 7, 0}, 0.125}, {{7, 1, 0}, 0.125}, {{3, 5, 0}, 0.125}, {{5, 3, 0}, 0.125},
-};
+// On-face and on-edge points are dyadic combinations (i a + j b + k c) / 2^m of the corners,
+// kept when computed without rounding: a face whose corners carry all 53 bits holds about one
+// exact double point in its interior (the double points of its plane form a lattice whose cell
+// is about as large as the face), so small denominators find most of the few there are.
+constexpr int kFaceLevels = 5;  // m <= 5: 594 weight triples per face
+constexpr int kEdgeLevels = 8;  // m <= 8: 255 weight pairs per edge
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
 
-// x * y and x + y, true when the rounded result is the exact one (fma gives the product's
-// rounding error, Knuth's TwoSum the sum's).
-bool exact_product(double x, double y, double& out) {
-  out = x * y;
-  return std::fma(x, y, -out) == 0;
-}
-bool exact_sum(double x, double y, double& out) {
-  out = x + y;
-  const double y_part = out - x;
-  return (x - (out - y_part)) + (y - y_part) == 0;
+// Knuth's TwoSum: x + y == sum + error exactly.
+void two_sum(double x, double y, double& sum, double& error) {
+  sum = x + y;
+  const double y_part = sum - x;
+  error = (x - (sum - y_part)) + (y - y_part);
 }
 
-// The combination of the corners with these weights when every operation is exact (a cheap
+// i a + j b + k c (one coordinate) as six doubles whose exact sum it is (fma gives each
+// product's rounding error), distilled by repeated error-free summation (Rump's VecSum);
+// true, with the sum, when every error vanished, i.e. the exact value is a double.
+bool exact_combination(double i, double a, double j, double b, double k, double c,
+                       double& out) {
+  std::array<double, 6> terms;
+  terms[0] = i * a;
+  terms[1] = std::fma(i, a, -terms[0]);
+  terms[2] = j * b;
+  terms[3] = std::fma(j, b, -terms[2]);
+  terms[4] = k * c;
+  terms[5] = std::fma(k, c, -terms[4]);
+  for (int pass = 0; pass < 4; ++pass) {
+    for (std::size_t n = 1; n < terms.size(); ++n) two_sum(terms[n - 1], terms[n], terms[n], terms[n - 1]);
+    bool exact = true;
+    for (std::size_t n = 0; n + 1 < terms.size(); ++n) exact &= terms[n] == 0;
+    if (exact) {
+      out = terms.back();
+      return true;
+    }
+  }
+  return false;
+}
+
+// (i a + j b + k c) * scale, scale a power of two, when its exact value is a double (a cheap
 // filter before the exact predicates confirm where the point lies).
-std::optional<Point> combine(const Weights& weights, const Point& a, const Point& b,
-                             const Point& c) {
+std::optional<Point> combine(double i, double j, double k, double scale, const Point& a,
+                             const Point& b, const Point& c) {
   Point p;
-  for (int k = 0; k < 3; ++k) {
-    double wa, wb, wc, ab, sum;
-    if (!exact_product(weights.w[0], a[k], wa) || !exact_product(weights.w[1], b[k], wb) ||
-        !exact_product(weights.w[2], c[k], wc) || !exact_sum(wa, wb, ab) ||
-        !exact_sum(ab, wc, sum) || !exact_product(sum, weights.scale, p[k]))
-      return std::nullopt;
+  for (int axis = 0; axis < 3; ++axis) {
+    double sum;
+    if (!exact_combination(i, a[axis], j, b[axis], k, c[axis], sum)) return std::nullopt;
+    p[axis] = sum * scale;
+    if (p[axis] / scale != sum) return std::nullopt;  // underflow
   }
   return p;
+}
+
+// Every exact dyadic point in the relative interior of each face (each face once).
+std::vector<Point> exact_face_points(const TetMesh& mesh, std::uint64_t& tried) {
+  std::vector<Point> out;
+  for (std::uint32_t t = 0; t < mesh.tet_count(); ++t) {
+    const auto c = mesh.corners(t);
+    for (int face = 0; face < 4; ++face) {
+      const std::uint32_t n = mesh.neighbours[t][face];
+      if (n != kOutside && n < t) continue;
+      const auto& f = geometry::kTetrahedronFaces[face];
+      for (int m = 2; m <= kFaceLevels; ++m) {
+        const int whole = 1 << m;
+        const double scale = std::ldexp(1.0, -m);
+        for (int i = 1; i < whole - 1; ++i)
+          for (int j = 1; i + j < whole; ++j) {
+            const int k = whole - i - j;
+            if (i % 2 == 0 && j % 2 == 0 && k % 2 == 0) continue;  // found at level m - 1
+            ++tried;
+            const auto p = combine(i, j, k, scale, c[f[0]], c[f[1]], c[f[2]]);
+            if (!p) continue;
+            const auto location = geometry::locate_in_tetrahedron(*p, c);
+            if (location.position == TetrahedronPosition::on_face && location.face() == face)
+              out.push_back(*p);
+          }
+      }
+    }
+  }
+  return out;
+}
+
+// Every exact dyadic point in the relative interior of each edge (each edge once).
+std::vector<Point> exact_edge_points(const TetMesh& mesh, std::uint64_t& tried) {
+  struct Edge {
+    std::uint32_t u, v, tet;
+    int i, j;
+  };
+  std::vector<Edge> edges;
+  edges.reserve(6 * mesh.tet_count());
+  for (std::uint32_t t = 0; t < mesh.tet_count(); ++t)
+    for (const auto& e : kTetEdges) {
+      const std::uint32_t a = mesh.tets[t][e[0]], b = mesh.tets[t][e[1]];
+      edges.push_back({std::min(a, b), std::max(a, b), t, e[0], e[1]});
+    }
+  std::sort(edges.begin(), edges.end(),
+            [](const Edge& x, const Edge& y) { return x.u != y.u ? x.u < y.u : x.v < y.v; });
+  edges.erase(std::unique(edges.begin(), edges.end(),
+                          [](const Edge& x, const Edge& y) { return x.u == y.u && x.v == y.v; }),
+              edges.end());
+  std::vector<Point> out;
+  for (const Edge& e : edges) {
+    const auto c = mesh.corners(e.tet);
+    for (int m = 1; m <= kEdgeLevels; ++m) {
+      const int whole = 1 << m;
+      const double scale = std::ldexp(1.0, -m);
+      for (int i = 1; i < whole; i += 2) {  // odd: even numerators were found at level m - 1
+        ++tried;
+        const auto p = combine(i, whole - i, 0, scale, c[e.i], c[e.j], c[e.i]);
+        if (!p) continue;
+        const auto location = geometry::locate_in_tetrahedron(*p, c);
+        if (location.position == TetrahedronPosition::on_edge &&
+            location.vertices == ((1u << e.i) | (1u << e.j)))
+          out.push_back(*p);
+      }
+    }
+  }
+  return out;
 }
 
 std::string format_answer(const std::vector<std::uint32_t>& tets, bool outside) {
@@ -249,40 +325,16 @@ LocationPointSet make_location_points(const TetMesh& mesh, const LocationPointOp
     add(p, LocationPointKind::random);
     ++set.attempts[0];
   }
-  // Stop looking after many misses (a mesh whose coordinates seldom combine exactly): the
-  // counts then show the shortfall. An attempt costs a few nanoseconds.
-  const auto attempt_cap = [](std::uint64_t wanted_points) {
-    return 2000 * wanted_points + 1'000'000;
-  };
-  for (std::uint64_t found = 0; found < wanted[1] && set.attempts[1] < attempt_cap(wanted[1]);) {
-    ++set.attempts[1];
-    const std::uint32_t t = std::uint32_t(random.below(mesh.tet_count()));
-    const int k = int(random.below(4));
-    const auto c = mesh.corners(t);
-    const auto& f = geometry::kTetrahedronFaces[k];
-    const auto p = combine(kFaceWeights[random.below(std::size(kFaceWeights))], c[f[0]],
-                           c[f[1]], c[f[2]]);
-    if (!p) continue;
-    const auto location = geometry::locate_in_tetrahedron(*p, c);
-    if (location.position != TetrahedronPosition::on_face || location.face() != k) continue;
-    add(*p, LocationPointKind::on_face);
-    ++found;
-  }
-  for (std::uint64_t found = 0; found < wanted[2] && set.attempts[2] < attempt_cap(wanted[2]);) {
-    ++set.attempts[2];
-    const std::uint32_t t = std::uint32_t(random.below(mesh.tet_count()));
-    const auto& e = kTetEdges[random.below(6)];
-    const auto c = mesh.corners(t);
-    const auto p = combine(kEdgeWeights[random.below(std::size(kEdgeWeights))], c[e[0]],
-                           c[e[1]], c[e[0]]);
-    if (!p) continue;
-    const auto location = geometry::locate_in_tetrahedron(*p, c);
-    if (location.position != TetrahedronPosition::on_edge ||
-        location.vertices != ((1u << e[0]) | (1u << e[1])))
-      continue;
-    add(*p, LocationPointKind::on_edge);
-    ++found;
-  }
+  // Exact points on faces and edges are few (see kFaceLevels): draw from all of them, so
+  // that they repeat (with other start tets) when more are wanted than there are.
+  const std::vector<Point> face_points = exact_face_points(mesh, set.attempts[1]);
+  const std::vector<Point> edge_points = exact_edge_points(mesh, set.attempts[2]);
+  if (!face_points.empty())
+    for (std::uint64_t i = 0; i < wanted[1]; ++i)
+      add(face_points[random.below(face_points.size())], LocationPointKind::on_face);
+  if (!edge_points.empty())
+    for (std::uint64_t i = 0; i < wanted[2]; ++i)
+      add(edge_points[random.below(edge_points.size())], LocationPointKind::on_edge);
   for (std::uint64_t i = 0; i < wanted[3]; ++i) {
     ++set.attempts[3];
     const std::uint32_t t = std::uint32_t(random.below(mesh.tet_count()));

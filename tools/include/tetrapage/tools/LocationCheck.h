@@ -55,19 +55,20 @@ struct LocationPointOptions {
 struct LocationPointSet {
   std::vector<LocationPoint> points;
   std::array<std::uint64_t, kLocationPointKinds> count{};
-  /// Distinct points per kind: a mesh whose vertices carry all 53 bits has few exact points
-  /// on each face or edge, so these repeat (from other start tets each time).
+  /// Distinct points per kind: a mesh whose vertices carry all 53 bits has about one exact
+  /// double point inside each face, so these repeat (from other start tets each time).
   std::array<std::uint64_t, kLocationPointKinds> distinct{};
-  /// Candidate points constructed per kind (dyadic combinations of a face's or an edge's
-  /// vertices); only those the exact predicates put on the face or edge are kept.
+  /// Candidates constructed per kind (for faces and edges, every dyadic combination of the
+  /// corners up to a denominator of 32 and 256); only those computed without rounding that the
+  /// exact predicates put on the face or edge are kept.
   std::array<std::uint64_t, kLocationPointKinds> attempts{};
 };
 
-/// Draws the points (deterministic for a seed). On-face and on-edge points are dyadic
-/// combinations of the corners computed without rounding (checked with fma and TwoSum), kept
-/// only when locate_in_tetrahedron says, exactly, that they lie in the relative interior of
-/// that face or edge; vertices are exact as they are. When exact points are too rare (after
-/// 2000 attempts per point wanted, plus a million), fewer are returned: see `count`.
+/// Draws the points (deterministic for a seed). On-face and on-edge points are drawn from all
+/// the dyadic combinations of each face's or edge's corners that are computed without rounding
+/// (checked with fma and TwoSum) and that locate_in_tetrahedron puts, exactly, in the relative
+/// interior of that face or edge; vertices are exact as they are. A mesh with no such point on
+/// any face (or edge) gets none of that kind: see `count`.
 /// @throw InputError if the mesh has no tet, the shares are not in [0, 1] or sum above 1, or
 ///        no tet has a walk reference point.
 LocationPointSet make_location_points(const TetMesh& mesh, const LocationPointOptions& options);
