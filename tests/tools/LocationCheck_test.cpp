@@ -273,7 +273,9 @@ TEST_P(LocationCheckTest, RuntimeWalkAgreesWithEmbreeOnRandomAndBoundaryPoints) 
   for (const auto& d : summary.listed)
     ADD_FAILURE() << to_string(d.kind) << " point (" << d.point[0] << ", " << d.point[1] << ", "
                   << d.point[2] << "): " << d.reason;
-  EXPECT_EQ(summary.by_kind[0].outside, outside[0]);
+  // Outside for both, or (within float error of the hull) a tie the exact predicates decided.
+  EXPECT_LE(summary.by_kind[0].outside, outside[0]);
+  EXPECT_GE(summary.by_kind[0].outside + summary.by_kind[0].exact_ties, outside[0]);
   // Points on vertices and edges are held by several tets: the exact tie rule decides.
   EXPECT_GT(summary.by_kind[std::size_t(LocationPointKind::on_vertex)].exact_ties, 0u);
   // The same result from one thread.

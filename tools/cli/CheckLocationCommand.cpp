@@ -66,8 +66,8 @@ void run_check_location(const CheckLocationArguments& args) {
                 (unsigned long long)(args.points - set.points.size()));
   for (std::size_t k = 0; k < kLocationPointKinds; ++k) {
     const LocationOutcomes& o = summary.by_kind[k];
-    std::printf("  %-9s %9llu points: same tet %llu, tie decided by the exact predicate %llu, "
-                "outside (proven by a hull face) %llu, disagreements %llu; "
+    std::printf("  %-9s %9llu points: same tet %llu, ties decided by the exact predicates %llu, "
+                "outside for both (proven by a hull face) %llu, disagreements %llu; "
                 "Embree traces resynced %llu, ending with a choice %llu\n",
                 to_string(LocationPointKind(k)), (unsigned long long)o.points,
                 (unsigned long long)o.same_tet, (unsigned long long)o.exact_ties,

@@ -12,11 +12,14 @@ namespace tetrapage {
 
 StabbingNumbers measure_stabbing_numbers(const EmbreeMeshFaces& faces, const BoundingBox& box,
                                          const StabbingOptions& options) {
+  // A flat model (a zero side) still gets segments, in its plane.
   for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(box.lo[k]) || !std::isfinite(box.hi[k]) || !(box.lo[k] < box.hi[k]))
+    if (!std::isfinite(box.lo[k]) || !std::isfinite(box.hi[k]) || !(box.lo[k] <= box.hi[k]))
       throw InputError("stabbing numbers: the box [" + std::to_string(box.lo[k]) + ", " +
                        std::to_string(box.hi[k]) + "] on axis " + std::to_string(k) +
                        " is empty or not finite");
+  if (box.lo == box.hi)
+    throw InputError("stabbing numbers: the box is a single point, segments have no length");
   const auto started = std::chrono::steady_clock::now();
   const TetMesh& mesh = faces.mesh();
   Random random(options.seed);

@@ -95,9 +95,10 @@ struct LocationOutcomes {
   std::uint64_t points = 0;
   /// The located tet is the one tet Embree's trace ended in (and holds the point, exactly).
   std::uint64_t same_tet = 0;
-  /// Another tet around Embree's answer, which the exact predicate says holds the point.
+  /// Ties decided by the exact predicates: another tet around Embree's answer that holds
+  /// the point, or "outside" (proven by a hull face) where Embree's trace ended inside.
   std::uint64_t exact_ties = 0;
-  /// Outside for the locator, proven outside by a hull face.
+  /// Outside for the locator and for Embree, proven outside by a hull face.
   std::uint64_t outside = 0;
   std::uint64_t disagreements = 0;
   /// Embree traces that had to start again after an inconsistent hit (FaceTrace::resyncs),

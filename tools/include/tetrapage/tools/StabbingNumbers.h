@@ -47,7 +47,7 @@ struct StabbingNumbers {
 
 /// Measures the stabbing numbers of faces.mesh() over segments in `box` (deterministic for a
 /// seed; each walk starts from the tet where the previous one ended).
-/// @throw InputError if the box is empty or not finite.
+/// @throw InputError if the box is empty, a single point, or not finite.
 /// @throw Error as walk_segment, or if Embree fails.
 StabbingNumbers measure_stabbing_numbers(const EmbreeMeshFaces& faces, const BoundingBox& box,
                                          const StabbingOptions& options = {});
