@@ -42,16 +42,18 @@ void two_sum(double x, double y, double& sum, double& error) {
 // i a + j b + k c (one coordinate) as six doubles whose exact sum it is (fma gives each
 // product's rounding error), distilled by repeated error-free summation (Rump's VecSum);
 // true, with the sum, when every error vanished, i.e. the exact value is a double.
-bool exact_combination(double i, double a, double j, double b, double k, double c,
-                       double& out) {
+bool exact_combination(int i, double a, int j, double b, int k, double c, double& out) {
+  // A product by zero or a power of two is exact (short of overflow): skip the fma, a library
+  // call without -mfma.
+  const auto product = [](int w, double x, double& value, double& error) {
+    value = w * x;
+    error = (w & (w - 1)) == 0 ? 0.0 : std::fma(double(w), x, -value);
+  };
   std::array<double, 6> terms;
-  terms[0] = i * a;
-  terms[1] = std::fma(i, a, -terms[0]);
-  terms[2] = j * b;
-  terms[3] = std::fma(j, b, -terms[2]);
-  terms[4] = k * c;
-  terms[5] = std::fma(k, c, -terms[4]);
-  for (int pass = 0; pass < 4; ++pass) {
+  product(i, a, terms[0], terms[1]);
+  product(j, b, terms[2], terms[3]);
+  product(k, c, terms[4], terms[5]);
+  for (int pass = 0; pass < 2; ++pass) {  // more passes find next to nothing more
     for (std::size_t n = 1; n < terms.size(); ++n) two_sum(terms[n - 1], terms[n], terms[n], terms[n - 1]);
     bool exact = true;
     for (std::size_t n = 0; n + 1 < terms.size(); ++n) exact &= terms[n] == 0;
@@ -65,8 +67,8 @@ bool exact_combination(double i, double a, double j, double b, double k, double 
 
 // (i a + j b + k c) * scale, scale a power of two, when its exact value is a double (a cheap
 // filter before the exact predicates confirm where the point lies).
-std::optional<Point> combine(double i, double j, double k, double scale, const Point& a,
-                             const Point& b, const Point& c) {
+std::optional<Point> combine(int i, int j, int k, double scale, const Point& a, const Point& b,
+                             const Point& c) {
   Point p;
   for (int axis = 0; axis < 3; ++axis) {
     double sum;
