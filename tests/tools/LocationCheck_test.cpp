@@ -20,6 +20,7 @@
 #include <sstream>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
@@ -62,7 +63,16 @@ const Indexed& indexed(Model model) {
   if (auto it = cache.find(model); it != cache.end()) return it->second;
   const std::string name =
       model == Model::scene ? "scene" : (model == Model::tetras ? "tetras" : "far_tetras");
-  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "location" / name;
+  // One folder per process (ctest runs test cases in parallel processes), removed at exit.
+  struct Folder {
+    fs::path path;
+    ~Folder() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Folder root{fs::path(TETRAPAGE_TEST_TMP) / "location" / std::to_string(getpid())};
+  const fs::path folder = root.path / name;
   fs::remove_all(folder);
   fs::create_directories(folder);
   const fs::path input = folder / (name + ".ply");
