@@ -4,47 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <mutex>
+#include <optional>
 #include <string>
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
+#include "tetrapage/tools/EmbreeHandles.h"
 
 namespace tetrapage {
 namespace {
 
 constexpr std::uint32_t kOutside = TetMesh::no_neighbour;
-
-struct EmbreeRelease {
-  void operator()(RTCDevice device) const { rtcReleaseDevice(device); }
-  void operator()(RTCScene scene) const { rtcReleaseScene(scene); }
-  void operator()(RTCGeometry geometry) const { rtcReleaseGeometry(geometry); }
-};
-
-const char* error_name(RTCError code) {
-  switch (code) {
-    case RTC_ERROR_NONE: return "no error";
-    case RTC_ERROR_UNKNOWN: return "unknown error";
-    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
-    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
-    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
-    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
-    case RTC_ERROR_CANCELLED: return "cancelled";
-  }
-  return "unrecognised error code";
-}
-
-// Embree gives the message to a callback and the code to rtcGetDeviceError; keep the first.
-struct EmbreeErrors {
-  std::mutex mutex;
-  std::string message;
-  static void record(void* self, RTCError code, const char* text) {
-    auto* errors = static_cast<EmbreeErrors*>(self);
-    const std::lock_guard lock(errors->mutex);
-    if (errors->message.empty())
-      errors->message = std::string(error_name(code)) + ": " + (text ? text : "");
-  }
-};
 
 // The filter sees the context Embree was given; the hits travel in the same object.
 struct HitCollector {
@@ -85,21 +55,8 @@ struct EmbreeMeshFaces::Impl {
   std::vector<MeshFace> faces;
   Vec3 centre{0, 0, 0};
   double tie_distance = 0;
-  std::unique_ptr<EmbreeErrors> errors = std::make_unique<EmbreeErrors>();
-  std::unique_ptr<RTCDeviceTy, EmbreeRelease> device;
-  std::unique_ptr<RTCSceneTy, EmbreeRelease> scene;
-
-  void check(const char* what) const {
-    const RTCError code = rtcGetDeviceError(device.get());
-    std::string message;
-    {
-      const std::lock_guard lock(errors->mutex);
-      message.swap(errors->message);
-    }
-    if (code != RTC_ERROR_NONE || !message.empty())
-      throw Error(std::string("Embree: ") + what + " failed: " +
-                  (message.empty() ? error_name(code) : message));
-  }
+  std::optional<EmbreeDevice> device;  // declared before the scene: released after it
+  EmbreeScene scene;
 };
 
 EmbreeMeshFaces::EmbreeMeshFaces(const TetMesh& mesh, unsigned threads)
@@ -144,27 +101,17 @@ EmbreeMeshFaces::EmbreeMeshFaces(const TetMesh& mesh, unsigned threads)
   // a few ulps except at grazing angles, and tets thinner than this are grouped, not missed.
   impl_->tie_distance = std::ldexp(extent, -18) + std::ldexp(offset, -45);
 
-  const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
-  impl_->device.reset(rtcNewDevice(config.c_str()));
-  if (!impl_->device)
-    throw Error("Embree: cannot create a device (" +
-                std::string(error_name(rtcGetDeviceError(nullptr))) + ")");
-  rtcSetDeviceErrorFunction(impl_->device.get(), &EmbreeErrors::record, impl_->errors.get());
-
-  impl_->scene.reset(rtcNewScene(impl_->device.get()));
-  impl_->check("rtcNewScene");
-  rtcSetSceneFlags(impl_->scene.get(), RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(impl_->scene.get(), RTC_BUILD_QUALITY_MEDIUM);
-  std::unique_ptr<RTCGeometryTy, EmbreeRelease> geometry(
-      rtcNewGeometry(impl_->device.get(), RTC_GEOMETRY_TYPE_TRIANGLE));
-  impl_->check("rtcNewGeometry");
+  impl_->device.emplace(threads);
+  const EmbreeDevice& device = *impl_->device;
+  impl_->scene = device.new_scene(RTC_SCENE_FLAG_ROBUST, RTC_BUILD_QUALITY_MEDIUM);
+  const EmbreeGeometry geometry = device.new_geometry(RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
       geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
       mesh.vertices.size()));
   auto* indices = static_cast<unsigned*>(
       rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                               3 * sizeof(unsigned), impl_->faces.size()));
-  impl_->check("rtcSetNewGeometryBuffer");
+  device.check("rtcSetNewGeometryBuffer");
   for (std::size_t v = 0; v < mesh.vertices.size(); ++v)
     for (int a = 0; a < 3; ++a)
       vertices[3 * v + a] = static_cast<float>(mesh.vertices[v][a] - impl_->centre[a]);
@@ -174,7 +121,7 @@ EmbreeMeshFaces::EmbreeMeshFaces(const TetMesh& mesh, unsigned threads)
   rtcCommitGeometry(geometry.get());
   rtcAttachGeometry(impl_->scene.get(), geometry.get());
   rtcCommitScene(impl_->scene.get());
-  impl_->check("building the scene of mesh faces");
+  device.check("building the scene of mesh faces");
 }
 
 EmbreeMeshFaces::~EmbreeMeshFaces() = default;
