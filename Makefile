@@ -58,6 +58,7 @@ demo: build
 	  --report $(DEMO_DIR)/preprocess.json
 	$(TETRAPAGE) validate $(DEMO_DIR)/scene.tpi
 	$(TETRAPAGE) inspect $(DEMO_DIR)/scene.tpi
+	$(TETRAPAGE) check-location $(DEMO_DIR)/scene.tpi --points 200000 --report $(DEMO_DIR)/location.json
 	@echo "--- paged flight: a shard budget of 8 MiB, well under the index's shards ---"
 	$(TETRAPAGE) fly $(DEMO_DIR)/scene.tpi --object $(DEMO_DIR)/object.ply --path $(DEMO_DIR)/flight.csv \
 	  --memory 8M --check $(DEMO_DIR)/answers.csv --report $(DEMO_DIR)/fly.json

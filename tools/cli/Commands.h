@@ -25,5 +25,7 @@ void add_index_commands(CLI::App& app);
 void add_fly_command(CLI::App& app);
 /// `check-interiors` (tools/cli/InteriorCheckCommand.cpp)
 void add_interior_check_command(CLI::App& app);
+/// `check-location` (tools/cli/CheckLocationCommand.cpp)
+void add_check_location_command(CLI::App& app);
 
 }  // namespace tetrapage::cli

@@ -1,10 +1,11 @@
-// `tetrapage preprocess`, `inspect` and `validate`: build an index, show where its bytes go,
-// and check it from end to end.
+// `tetrapage preprocess`, `inspect` and `validate`: build an index, show where its bytes go
+// (and its mesh's stabbing number, by the walk and by Embree), and check it from end to end.
 
 #include <algorithm>
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "Commands.h"
@@ -15,6 +16,8 @@
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/tools/EmbreeInteriorClassifier.h"
+#include "tetrapage/tools/EmbreeMeshFaces.h"
+#include "tetrapage/tools/StabbingNumbers.h"
 
 namespace tetrapage::cli {
 namespace {
@@ -51,6 +54,8 @@ void run_preprocess(const PreprocessArguments& args) {
 struct InspectArguments {
   std::filesystem::path index;
   std::filesystem::path report;
+  std::uint64_t stabbing_segments = 10'000;
+  std::uint64_t stabbing_seed = 1;
 };
 
 struct InteriorFigures {
@@ -116,6 +121,26 @@ void run_inspect(const InspectArguments& args) {
               double(decoded) / triangles);
   const InteriorFigures interiors = interior_figures(reader, mesh.tet_count());
   std::printf("%s\n", interiors.text.c_str());
+  std::optional<StabbingNumbers> stabbing;
+  if (args.stabbing_segments > 0) {
+    // The study's section 4.2.1 "unit cube" is the model's own box.
+    const EmbreeMeshFaces faces(mesh);
+    StabbingOptions options;
+    options.segments = args.stabbing_segments;
+    options.seed = args.stabbing_seed;
+    stabbing = measure_stabbing_numbers(faces, header.bounds, options);
+    std::printf("stabbing number (study 4.2.1: %llu random segments in the model box, tets met per unit length): "
+                "walk %.3f, Embree %.3f; %.2f tets per segment of mean length %.4g; %llu segments differ (%.2f s)\n",
+                (unsigned long long)stabbing->segments, stabbing->walk, stabbing->embree,
+                stabbing->walk_tets_per_segment, stabbing->mean_length,
+                (unsigned long long)stabbing->differing, stabbing->seconds);
+    for (const StabbingDifference& d : stabbing->differences)
+      std::printf("stabbing difference: (%.17g, %.17g, %.17g) -> (%.17g, %.17g, %.17g): walk %llu tets, Embree %llu\n",
+                  d.a[0], d.a[1], d.a[2], d.b[0], d.b[1], d.b[2], (unsigned long long)d.walk_tets,
+                  (unsigned long long)d.embree_tets);
+    if (stabbing->incomplete_walks > 0)
+      std::printf("stabbing: %llu segments left the mesh\n", (unsigned long long)stabbing->incomplete_walks);
+  }
   if (!args.report.empty()) {
     nlohmann::json report{{"index", args.index.string()},
                           {"version", header.version},
@@ -131,6 +156,15 @@ void run_inspect(const InspectArguments& args) {
                           {"shard_decoded_bytes", decoded},
                           {"max_rounding_distance", header.max_rounding_distance},
                           {"interiors", interiors.json}};
+    if (stabbing) {
+      report["stabbing_segments"] = stabbing->segments;
+      report["stabbing_number_walk"] = stabbing->walk;
+      report["stabbing_number_embree"] = stabbing->embree;
+      report["stabbing_segments_differing"] = stabbing->differing;
+      report["stabbing_tets_per_segment"] = stabbing->walk_tets_per_segment;
+      report["stabbing_mean_length"] = stabbing->mean_length;
+      report["stabbing_seconds"] = stabbing->seconds;
+    }
     write_report(args.report, report);
   }
 }
@@ -238,6 +272,12 @@ void add_index_commands(CLI::App& app) {
   auto* inspect_command = app.add_subcommand("inspect", "Show what an index holds and where its bytes go");
   inspect_command->add_option("index", inspect->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
   inspect_command->add_option("--report", inspect->report, "Write the figures as JSON");
+  inspect_command
+      ->add_option("--stabbing-segments", inspect->stabbing_segments,
+                   "Random segments for the stabbing number, counted by the walk and by Embree (0: skip)")
+      ->capture_default_str();
+  inspect_command->add_option("--stabbing-seed", inspect->stabbing_seed, "Seed of those segments")
+      ->capture_default_str();
   inspect_command->callback([inspect] { run_inspect(*inspect); });
 
   auto index = std::make_shared<std::filesystem::path>();
