@@ -59,6 +59,7 @@ demo: build
 	$(TETRAPAGE) validate $(DEMO_DIR)/scene.tpi
 	$(TETRAPAGE) inspect $(DEMO_DIR)/scene.tpi
 	$(TETRAPAGE) check-location $(DEMO_DIR)/scene.tpi --points 200000 --report $(DEMO_DIR)/location.json
+	$(TETRAPAGE) check-interiors $(DEMO_DIR)/scene.tpi $(DEMO_DIR)/scene.ply --points 100000 --report $(DEMO_DIR)/interiors.json
 	@echo "--- paged flight: a shard budget of 8 MiB, well under the index's shards ---"
 	$(TETRAPAGE) fly $(DEMO_DIR)/scene.tpi --object $(DEMO_DIR)/object.ply --path $(DEMO_DIR)/flight.csv \
 	  --memory 8M --check $(DEMO_DIR)/answers.csv --report $(DEMO_DIR)/fly.json
