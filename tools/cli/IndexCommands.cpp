@@ -2,6 +2,7 @@
 // (and its mesh's stabbing number, by the walk and by Embree), and check it from end to end.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -13,7 +14,9 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
@@ -214,6 +217,23 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
                   std::to_string(a));
     } catch (const Error& error) {
       problem("shard " + std::to_string(s) + ": " + error.what());
+    }
+  }
+  // Interiors: the runtime's checks at open (all four tables, consistent), and every reference
+  // point strictly inside its tet (the crossings are counted within the tet).
+  const auto names = reader.table_names();
+  if (std::find(names.begin(), names.end(), "interior_offsets") != names.end()) {
+    const auto points = reader.read_table_double("reference_points");
+    for (std::size_t t = 0; t < mesh.tet_count() && 3 * t + 2 < points.size(); ++t) {
+      const geometry::Point p{points[3 * t], points[3 * t + 1], points[3 * t + 2]};
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;  // undecided
+      if (geometry::locate_in_tetrahedron(p, mesh.corners(t)).position != geometry::TetrahedronPosition::inside)
+        problem("the reference point of tet " + std::to_string(t) + " is not strictly inside it");
+    }
+    try {
+      CollisionIndex opened(reader.path(), {});
+    } catch (const Error& error) {
+      problem(std::string("interiors: ") + error.what());
     }
   }
   return problems;
