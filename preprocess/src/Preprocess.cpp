@@ -228,7 +228,8 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   // part's box is outside the part). A part larger than a batch, or whose triangles are not
   // contiguous in the input, stays unclassified: the index then marks it open.
   const std::uint64_t per_triangle = options.interior_classifier()->bytes_per_triangle();
-  const std::uint64_t batch_capacity = std::max<std::uint64_t>(1, options.memory_bytes / 2 / std::max<std::uint64_t>(per_triangle, 1));
+  const std::uint64_t batch_capacity = std::max<std::uint64_t>(
+      1, options.memory_bytes / 2 / std::max<std::uint64_t>(per_triangle, 1));
   std::uint64_t too_large = 0;
   for (std::size_t p = 0; p < parts; ++p) {
     if (!closed[p]) continue;
@@ -247,7 +248,8 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     has_point[t] = reference.has_value();
     points[t] = reference ? *reference : mesh.vertices[mesh.tets[t][0]];
     for (int a = 0; a < 3; ++a)
-      result.reference_points[3 * t + a] = reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
+      result.reference_points[3 * t + a] =
+          reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
   });
   std::vector<std::uint32_t> by_x;  // the tets of a pass, by their reference point's x
   std::vector<std::vector<std::uint32_t>> inside(tet_count);
@@ -266,15 +268,16 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     batch_points.clear();
     batch_tets.clear();
     BoundingBox hull;
-    for (const std::uint32_t p : batch_parts) hull.extend(in.part_bounds[p].lo), hull.extend(in.part_bounds[p].hi);
+    for (const std::uint32_t p : batch_parts)
+      hull.extend(in.part_bounds[p].lo), hull.extend(in.part_bounds[p].hi);
     auto first = std::lower_bound(by_x.begin(), by_x.end(), hull.lo[0],
                                   [&](std::uint32_t t, double x) { return points[t][0] < x; });
     for (auto it = first; it != by_x.end() && points[*it][0] <= hull.hi[0]; ++it) {
       const Vec3& q = points[*it];
       for (const std::uint32_t p : batch_parts) {
         const BoundingBox& b = in.part_bounds[p];
-        if (q[0] >= b.lo[0] && q[0] <= b.hi[0] && q[1] >= b.lo[1] && q[1] <= b.hi[1] && q[2] >= b.lo[2] &&
-            q[2] <= b.hi[2]) {
+        if (q[0] >= b.lo[0] && q[0] <= b.hi[0] && q[1] >= b.lo[1] && q[1] <= b.hi[1] &&
+            q[2] >= b.lo[2] && q[2] <= b.hi[2]) {
           batch_points.push_back(q);
           batch_tets.push_back(*it);
           break;
@@ -283,8 +286,11 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     }
     classifier->classify(batch_points, answers);
     for (std::size_t i = 0; i < batch_tets.size(); ++i) {
-      if (!answers[i].decided) undecided[batch_tets[i]] = true;
-      else inside[batch_tets[i]].insert(inside[batch_tets[i]].end(), answers[i].parts.begin(), answers[i].parts.end());
+      if (!answers[i].decided)
+        undecided[batch_tets[i]] = true;
+      else
+        inside[batch_tets[i]].insert(inside[batch_tets[i]].end(), answers[i].parts.begin(),
+                                     answers[i].parts.end());
     }
     for (const std::uint32_t p : batch_parts) result.part_closed[p] = 1;
     classifier.reset();
@@ -293,31 +299,32 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   };
   // One pass over the records classifies the given tets' reference points against every part.
   auto classify_pass = [&](std::vector<std::uint32_t> tets, bool show_progress) {
-  by_x = std::move(tets);
-  std::sort(by_x.begin(), by_x.end(), [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
-  for (const std::uint32_t t : by_x) inside[t].clear(), undecided[t] = false;
-  Progress progress("classifying interiors", in.seen, options.progress && show_progress);
-  in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
-    for (std::size_t i = 0; i < block.size();) {
-      std::size_t j = i;
-      run.clear();
-      const std::uint32_t part = block[i].part;
-      while (j < block.size() && block[j].part == part) run.push_back(block[j++].triangle);
-      i = j;
-      if (!closed[part]) continue;
-      if (batch_parts.empty() || batch_parts.back() != part) {
-        // A new part starts: the batch must hold it whole.
-        if (batch_triangles + in.part_triangles[part] > batch_capacity) classify_batch();
-        batch_parts.push_back(part);
-        batch_triangles += in.part_triangles[part];
+    by_x = std::move(tets);
+    std::sort(by_x.begin(), by_x.end(),
+              [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
+    for (const std::uint32_t t : by_x) inside[t].clear(), undecided[t] = false;
+    Progress progress("classifying interiors", in.seen, options.progress && show_progress);
+    in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+      for (std::size_t i = 0; i < block.size();) {
+        std::size_t j = i;
+        run.clear();
+        const std::uint32_t part = block[i].part;
+        while (j < block.size() && block[j].part == part) run.push_back(block[j++].triangle);
+        i = j;
+        if (!closed[part]) continue;
+        if (batch_parts.empty() || batch_parts.back() != part) {
+          // A new part starts: the batch must hold it whole.
+          if (batch_triangles + in.part_triangles[part] > batch_capacity) classify_batch();
+          batch_parts.push_back(part);
+          batch_triangles += in.part_triangles[part];
+        }
+        if (!classifier) classifier = options.interior_classifier();
+        classifier->add_triangles(part, run);
       }
-      if (!classifier) classifier = options.interior_classifier();
-      classifier->add_triangles(part, run);
-    }
-    progress.advance(block.size());
-  });
-  classify_batch();
-  progress.finish();
+      progress.advance(block.size());
+    });
+    classify_batch();
+    progress.finish();
   };
   std::vector<std::uint32_t> all(tet_count);
   for (std::size_t t = 0; t < tet_count; ++t) all[t] = std::uint32_t(t);
@@ -335,8 +342,10 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       if (!undecided[t]) continue;
       const auto c = mesh.corners(t);
       Vec3 q;
-      for (int a = 0; a < 3; ++a) q[a] = w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a] + w[3] * c[3][a];
-      if (geometry::locate_in_tetrahedron(q, c).position != geometry::TetrahedronPosition::inside) continue;
+      for (int a = 0; a < 3; ++a)
+        q[a] = w[0] * c[0][a] + w[1] * c[1][a] + w[2] * c[2][a] + w[3] * c[3][a];
+      if (geometry::locate_in_tetrahedron(q, c).position != geometry::TetrahedronPosition::inside)
+        continue;
       points[t] = q;
       for (int a = 0; a < 3; ++a) result.reference_points[3 * t + a] = q[a];
       retry.push_back(std::uint32_t(t));
@@ -361,11 +370,15 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     result.offsets.push_back(result.parts.size());
   }
   result.stored = true;
-  summary.interiors = "stored (" + std::to_string(batches) + (batches == 1 ? " batch" : " batches") + ")";
-  if (moved > 0) summary.interiors += "; " + std::to_string(moved) + " reference points moved and classified again";
+  summary.interiors =
+      "stored (" + std::to_string(batches) + (batches == 1 ? " batch" : " batches") + ")";
+  if (moved > 0)
+    summary.interiors +=
+        "; " + std::to_string(moved) + " reference points moved and classified again";
   if (too_large > 0)
-    summary.interiors += "; " + std::to_string(too_large) +
-                         " closed parts left open (larger than half --memory can classify, or not contiguous)";
+    summary.interiors +=
+        "; " + std::to_string(too_large) +
+        " closed parts left open (larger than half --memory can classify, or not contiguous)";
   return result;
 }
 

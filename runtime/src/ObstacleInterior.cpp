@@ -24,14 +24,17 @@ constexpr std::array<std::array<double, 4>, 8> kBendWeights{{{0.31, 0.23, 0.27, 
 
 void toggle(std::vector<std::uint32_t>& parts, std::uint32_t part) {
   const auto at = std::find(parts.begin(), parts.end(), part);
-  if (at == parts.end()) parts.push_back(part);
-  else parts.erase(at);
+  if (at == parts.end())
+    parts.push_back(part);
+  else
+    parts.erase(at);
 }
 
 // Toggles the closed parts the open segment crosses; false when some closed-part triangle
 // meets it other than in one interior point away from its ends (the path is degenerate).
-bool count_crossings(const CollisionIndex& index, const Shard& shard, const geometry::Segment& segment,
-                     std::vector<std::uint32_t>& parts, std::uint64_t& tests) {
+bool count_crossings(const CollisionIndex& index, const Shard& shard,
+                     const geometry::Segment& segment, std::vector<std::uint32_t>& parts,
+                     std::uint64_t& tests) {
   geometry::Box box;
   box.extend(segment[0]);
   box.extend(segment[1]);
@@ -43,8 +46,10 @@ bool count_crossings(const CollisionIndex& index, const Shard& shard, const geom
     ++tests;
     const auto hit = geometry::classify_segment_triangle(segment, shard.triangle(local));
     if (!hit) return;
-    if (hit.contact == geometry::SegmentTriangleContact::interior && !hit.at_endpoint) toggle(parts, part);
-    else generic = false;
+    if (hit.contact == geometry::SegmentTriangleContact::interior && !hit.at_endpoint)
+      toggle(parts, part);
+    else
+      generic = false;
   });
   return generic;
 }
@@ -64,7 +69,8 @@ bool on_closed_surface(const CollisionIndex& index, const Shard& shard, const ge
 
 }  // namespace
 
-ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet, const geometry::Point& p) {
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
+                                  const geometry::Point& p) {
   ObstacleQuery answer;
   if (!index.has_interiors()) return answer;
   const TetMesh& mesh = index.mesh();
@@ -91,7 +97,8 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
   geometry::Box reach;
   reach.extend(reference);
   reach.extend(p);
-  if (shard_id == TetMesh::no_neighbour || !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
+  if (shard_id == TetMesh::no_neighbour ||
+      !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
     answer.paths_tried = 1;
     return finish();  // no stored triangle near the segment: nothing to cross
   }
@@ -107,9 +114,12 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
   for (const auto& w : kBendWeights) {
     geometry::Point bend{};
     for (int a = 0; a < 3; ++a)
-      bend[a] = w[0] * corners[0][a] + w[1] * corners[1][a] + w[2] * corners[2][a] + w[3] * corners[3][a];
+      bend[a] =
+          w[0] * corners[0][a] + w[1] * corners[1][a] + w[2] * corners[2][a] + w[3] * corners[3][a];
     // Rounding may move the bend point: it must stay strictly inside for the path to stay in.
-    if (geometry::locate_in_tetrahedron(bend, corners).position != geometry::TetrahedronPosition::inside) continue;
+    if (geometry::locate_in_tetrahedron(bend, corners).position !=
+        geometry::TetrahedronPosition::inside)
+      continue;
     parts.assign(stored.begin(), stored.end());
     ++answer.paths_tried;
     if (count_crossings(index, shard, {reference, bend}, parts, answer.triangle_tests) &&

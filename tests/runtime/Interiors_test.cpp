@@ -31,7 +31,8 @@ namespace fs = std::filesystem;
 void add_box(TriangleSoup& soup, const Vec3& lo, const Vec3& hi) {
   const auto base = std::uint32_t(soup.vertices.size());
   for (int i = 0; i < 8; ++i)
-    soup.vertices.push_back({(i & 1) ? hi[0] : lo[0], (i & 2) ? hi[1] : lo[1], (i & 4) ? hi[2] : lo[2]});
+    soup.vertices.push_back(
+        {(i & 1) ? hi[0] : lo[0], (i & 2) ? hi[1] : lo[1], (i & 4) ? hi[2] : lo[2]});
   const std::array<std::array<std::uint32_t, 4>, 6> faces{
       {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}}};
   for (const auto& f : faces) {
@@ -71,7 +72,9 @@ class HungryClassifier final : public InteriorClassifier {
   void add_triangles(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) override {
     inner_.add_triangles(part, triangles);
   }
-  void classify(std::span<const Vec3> points, std::vector<PointInterior>& out) override { inner_.classify(points, out); }
+  void classify(std::span<const Vec3> points, std::vector<PointInterior>& out) override {
+    inner_.classify(points, out);
+  }
 
  private:
   std::uint64_t bytes_;
@@ -84,7 +87,8 @@ Model make_model(const std::string& name, std::uint64_t batch_triangles = 0) {
   {
     Model m;
     // ctest runs each test in its own process, in parallel: one folder per process.
-    const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / (name + "-" + std::to_string(::getpid()));
+    const fs::path folder =
+        fs::path(TETRAPAGE_TEST_TMP) / (name + "-" + std::to_string(::getpid()));
     m.folder = folder;
     fs::remove_all(folder);
     fs::create_directories(folder);
@@ -141,7 +145,8 @@ TEST(Interiors, PreprocessClassifiesTheClosedParts) {
   const Model& m = model();
   const auto parts = std::uint32_t(m.summary.parts);
   ASSERT_GT(parts, 5u) << "the scene's copies are parts";
-  EXPECT_EQ(m.summary.closed_parts, parts - 1) << "the sheet is open, the copies and the boxes are closed";
+  EXPECT_EQ(m.summary.closed_parts, parts - 1)
+      << "the sheet is open, the copies and the boxes are closed";
   EXPECT_EQ(m.summary.interiors.rfind("stored (1 batch)", 0), 0u) << m.summary.interiors;
   // Undecided points are moved and classified again: none is left.
   EXPECT_EQ(m.summary.interior_undecided, 0u) << m.summary.interiors;
@@ -164,7 +169,8 @@ void expect_points_agree(const Model& m) {
     geometry::Point p;
     for (int a = 0; a < 3; ++a) p[a] = random.uniform(box.lo[a] - 0.05, box.hi[a] + 0.05);
     const ObstacleQuery answer = locate_in_obstacles(index, hint, p);
-    if (answer.containment == ObstacleContainment::unknown || answer.containment == ObstacleContainment::on_surface) {
+    if (answer.containment == ObstacleContainment::unknown ||
+        answer.containment == ObstacleContainment::on_surface) {
       ++unknown;
       continue;
     }
@@ -172,8 +178,8 @@ void expect_points_agree(const Model& m) {
     const bool oracle_inside = oracle.inside_environment(p);
     inside += oracle_inside;
     if (runtime_inside != oracle_inside && ++wrong <= 5)
-      ADD_FAILURE() << "point (" << p[0] << ", " << p[1] << ", " << p[2] << "): runtime " << runtime_inside
-                    << ", oracle " << oracle_inside;
+      ADD_FAILURE() << "point (" << p[0] << ", " << p[1] << ", " << p[2] << "): runtime "
+                    << runtime_inside << ", oracle " << oracle_inside;
   }
   EXPECT_EQ(wrong, 0);
   EXPECT_GT(inside, points / 50) << "the points must test interiors, not only free space";
@@ -181,7 +187,9 @@ void expect_points_agree(const Model& m) {
   EXPECT_LE(unknown, points / 500);
 }
 
-TEST(Interiors, RandomPointsAgreeWithParityOverWholeClosedMeshes) { expect_points_agree(model()); }
+TEST(Interiors, RandomPointsAgreeWithParityOverWholeClosedMeshes) {
+  expect_points_agree(model());
+}
 
 TEST(Interiors, ClassifiedInBatchesUnderASmallBudgetTheAnswersAreTheSame) {
   // Batches of a third of the model, or of the largest part if that is more (parts go whole).
@@ -237,7 +245,8 @@ TEST(Interiors, AFlightEndingInsideAnObstacleCollidesAsTheOracleSays) {
       EXPECT_EQ(got.containment, Containment::object_inside_obstacle) << "pose " << i;
     }
     if (got.collides != expected.collides && ++wrong <= 5)
-      ADD_FAILURE() << "pose " << i << ": runtime " << got.collides << ", oracle " << expected.collides;
+      ADD_FAILURE() << "pose " << i << ": runtime " << got.collides << ", oracle "
+                    << expected.collides;
   }
   EXPECT_EQ(wrong, 0);
   EXPECT_GT(inside_poses, 100) << "the flight must end inside obstacles";
@@ -262,7 +271,8 @@ TEST(Interiors, AnObstacleInsideAClosedObjectCollides) {
       EXPECT_EQ(got.containment, Containment::obstacle_inside_object) << "pose " << i;
     }
     if (got.collides != expected.collides && ++wrong <= 5)
-      ADD_FAILURE() << "pose " << i << ": runtime " << got.collides << ", oracle " << expected.collides;
+      ADD_FAILURE() << "pose " << i << ": runtime " << got.collides << ", oracle "
+                    << expected.collides;
   }
   EXPECT_EQ(wrong, 0);
   EXPECT_GT(swallowed, 20);
@@ -280,7 +290,8 @@ TEST(Interiors, AnIndexWithoutInteriorsAnswersUnknown) {
   const CollisionIndex index(plain);
   EXPECT_FALSE(index.has_interiors());
   std::uint32_t hint = 0;
-  EXPECT_EQ(locate_in_obstacles(index, hint, {0.15, 0.6, 0.15}).containment, ObstacleContainment::unknown);
+  EXPECT_EQ(locate_in_obstacles(index, hint, {0.15, 0.6, 0.15}).containment,
+            ObstacleContainment::unknown);
 }
 
 }  // namespace

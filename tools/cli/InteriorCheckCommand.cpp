@@ -30,7 +30,8 @@ void run_check_interiors(const InteriorCheckArguments& args) {
   check_writable(args.report);
   auto index = std::make_shared<const CollisionIndex>(args.index);
   if (!index->has_interiors())
-    throw InputError(args.index.string() + ": the index stores no interiors (preprocess it with --interiors on)");
+    throw InputError(args.index.string() +
+                     ": the index stores no interiors (preprocess it with --interiors on)");
   std::vector<std::filesystem::path> inputs = args.inputs;
   if (inputs.empty()) {
     // The inputs preprocess read, in its order (so that part ids match).
@@ -40,10 +41,12 @@ void run_check_interiors(const InteriorCheckArguments& args) {
   }
   TriangleSoup environment;
   for (const auto& input : inputs)
-    environment.append(is_manifest_path(input) ? load_assembly(read_manifest(input)) : read_mesh(input));
+    environment.append(is_manifest_path(input) ? load_assembly(read_manifest(input))
+                                               : read_mesh(input));
   if (environment.triangle_count() != index->header().input_triangles)
-    throw InputError("the inputs hold " + std::to_string(environment.triangle_count()) + " triangles, the index " +
-                     std::to_string(index->header().input_triangles) + ": not the model of " + args.index.string());
+    throw InputError("the inputs hold " + std::to_string(environment.triangle_count()) +
+                     " triangles, the index " + std::to_string(index->header().input_triangles) +
+                     ": not the model of " + args.index.string());
   TriangleSoup probe;  // the oracle wants an object; only its parity query is used
   probe.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
   probe.triangles = {{0, 1, 2}};
@@ -61,24 +64,31 @@ void run_check_interiors(const InteriorCheckArguments& args) {
     for (int a = 0; a < 3; ++a) p[a] = random.uniform(box.lo[a], box.hi[a]);
     const auto start = std::chrono::steady_clock::now();
     const ObstacleQuery answer = locate_in_obstacles(*index, hint, p);
-    runtime_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (answer.containment == ObstacleContainment::unknown) ++unknown;
-    else if (answer.containment == ObstacleContainment::on_surface) ++on_surface;
+    runtime_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (answer.containment == ObstacleContainment::unknown)
+      ++unknown;
+    else if (answer.containment == ObstacleContainment::on_surface)
+      ++on_surface;
     else {
       const bool runtime_inside = answer.containment == ObstacleContainment::inside;
       const bool oracle_inside = oracle.inside_environment(p);
       inside += oracle_inside;
       if (runtime_inside != oracle_inside && ++disagreements <= 20)
-        std::printf("disagreement at (%.17g, %.17g, %.17g): runtime %s, oracle %s\n", p[0], p[1], p[2],
-                    runtime_inside ? "inside" : "outside", oracle_inside ? "inside" : "outside");
+        std::printf("disagreement at (%.17g, %.17g, %.17g): runtime %s, oracle %s\n", p[0], p[1],
+                    p[2], runtime_inside ? "inside" : "outside",
+                    oracle_inside ? "inside" : "outside");
     }
     if (i % 4096 == 0) progress.advance(std::min<std::uint64_t>(4096, args.points - i));
   }
   progress.finish();
-  std::printf("points %llu: inside %llu, unknown %llu (undecided tets or degenerate paths), on a surface %llu; "
-              "runtime %.2f us/point\n",
-              (unsigned long long)args.points, (unsigned long long)inside, (unsigned long long)unknown,
-              (unsigned long long)on_surface, args.points ? runtime_seconds / double(args.points) * 1e6 : 0.0);
+  std::printf(
+      "points %llu: inside %llu, unknown %llu (undecided tets or degenerate paths), on a surface "
+      "%llu; "
+      "runtime %.2f us/point\n",
+      (unsigned long long)args.points, (unsigned long long)inside, (unsigned long long)unknown,
+      (unsigned long long)on_surface,
+      args.points ? runtime_seconds / double(args.points) * 1e6 : 0.0);
   std::printf("disagreements: %llu\n", (unsigned long long)disagreements);
   if (!args.report.empty())
     write_report(args.report, {{"index", args.index.string()},
@@ -87,9 +97,11 @@ void run_check_interiors(const InteriorCheckArguments& args) {
                                {"unknown", unknown},
                                {"on_surface", on_surface},
                                {"disagreements", disagreements},
-                               {"runtime_us_per_point", args.points ? runtime_seconds / double(args.points) * 1e6 : 0.0}});
+                               {"runtime_us_per_point",
+                                args.points ? runtime_seconds / double(args.points) * 1e6 : 0.0}});
   if (disagreements > 0)
-    throw Error(std::to_string(disagreements) + " points where the runtime and the oracle disagree");
+    throw Error(std::to_string(disagreements) +
+                " points where the runtime and the oracle disagree");
 }
 
 }  // namespace
@@ -98,13 +110,17 @@ void add_interior_check_command(CLI::App& app) {
   auto args = std::make_shared<InteriorCheckArguments>();
   auto* command = app.add_subcommand(
       "check-interiors",
-      "Check the index's interiors: for random points in the model's box, the runtime's inside/outside\n"
-      "answer (stored reference points + crossings within one tet) against parity over the whole closed\n"
+      "Check the index's interiors: for random points in the model's box, the runtime's "
+      "inside/outside\n"
+      "answer (stored reference points + crossings within one tet) against parity over the whole "
+      "closed\n"
       "meshes (CGAL, exact predicates). Prints `disagreements: K`; exits 0 only when K is 0.");
   command->add_option("index", args->index, "Index file (.tpi), preprocessed with --interiors on")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("inputs", args->inputs, "The model's mesh files or manifests (default: those preprocess read)")
+  command
+      ->add_option("inputs", args->inputs,
+                   "The model's mesh files or manifests (default: those preprocess read)")
       ->check(CLI::ExistingFile);
   command->add_option("--points", args->points, "Random points")->capture_default_str();
   command->add_option("--seed", args->seed, "Seed of the points")->capture_default_str();

@@ -89,14 +89,15 @@ class EmbreeInteriorClassifier::Impl {
     EmbreeGeometry geometry = device_->new_geometry(RTC_GEOMETRY_TYPE_TRIANGLE);
     const std::size_t n = triangles_.size();
     centre_ = bounds_.center();
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0,
-                                                                 RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
-    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geometry.get(), RTC_BUFFER_TYPE_INDEX, 0,
-                                                                   RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n));
+    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
+        geometry.get(), RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
+    auto* indices = static_cast<unsigned*>(rtcSetNewGeometryBuffer(
+        geometry.get(), RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), n));
     device_->check("allocating the buffers of " + std::to_string(n) + " closed-part triangles");
     for (std::size_t t = 0; t < n; ++t)
       for (int k = 0; k < 3; ++k) {
-        for (int a = 0; a < 3; ++a) vertices[9 * t + 3 * k + a] = float(triangles_[t][k][a] - centre_[a]);
+        for (int a = 0; a < 3; ++a)
+          vertices[9 * t + 3 * k + a] = float(triangles_[t][k][a] - centre_[a]);
         indices[3 * t + k] = unsigned(3 * t + k);
       }
     std::vector<std::array<Vec3, 3>>().swap(triangles_);  // Embree holds them now
@@ -108,8 +109,8 @@ class EmbreeInteriorClassifier::Impl {
   }
 
   // The parts crossed an odd number of times by the ray from p along `direction`, sorted.
-  void odd_parts(const Vec3& p, const std::array<float, 3>& direction, std::vector<std::uint32_t>& hits,
-                 std::vector<std::uint32_t>& odd) const {
+  void odd_parts(const Vec3& p, const std::array<float, 3>& direction,
+                 std::vector<std::uint32_t>& hits, std::vector<std::uint32_t>& odd) const {
     hits.clear();
     CountingContext counting{};
     rtcInitIntersectContext(&counting.context);
@@ -152,7 +153,8 @@ class EmbreeInteriorClassifier::Impl {
   EmbreeScene scene_;
 };
 
-EmbreeInteriorClassifier::EmbreeInteriorClassifier(unsigned rays) : impl_(std::make_unique<Impl>(rays)) {}
+EmbreeInteriorClassifier::EmbreeInteriorClassifier(unsigned rays)
+    : impl_(std::make_unique<Impl>(rays)) {}
 EmbreeInteriorClassifier::~EmbreeInteriorClassifier() = default;
 
 std::uint64_t EmbreeInteriorClassifier::bytes_per_triangle() const {
@@ -161,11 +163,13 @@ std::uint64_t EmbreeInteriorClassifier::bytes_per_triangle() const {
   return 76 + 36 + 12 + 64;
 }
 
-void EmbreeInteriorClassifier::add_triangles(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) {
+void EmbreeInteriorClassifier::add_triangles(std::uint32_t part,
+                                             std::span<const std::array<Vec3, 3>> triangles) {
   impl_->add(part, triangles);
 }
 
-void EmbreeInteriorClassifier::classify(std::span<const Vec3> points, std::vector<PointInterior>& out) {
+void EmbreeInteriorClassifier::classify(std::span<const Vec3> points,
+                                        std::vector<PointInterior>& out) {
   impl_->classify(points, out);
 }
 

@@ -31,7 +31,8 @@ class InteriorClassifier {
   /// Bytes held per added triangle (to decide whether the closed parts fit the --memory budget).
   virtual std::uint64_t bytes_per_triangle() const = 0;
   /// Adds triangles of closed part `part` (any number of calls, any part order).
-  virtual void add_triangles(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) = 0;
+  virtual void add_triangles(std::uint32_t part,
+                             std::span<const std::array<Vec3, 3>> triangles) = 0;
   /// Classifies the points (after all triangles were added); out[i] answers points[i].
   virtual void classify(std::span<const Vec3> points, std::vector<PointInterior>& out) = 0;
 };

@@ -19,20 +19,21 @@ enum class ObstacleContainment : std::uint8_t {
   outside,     ///< in no closed part (or outside the coarse mesh, which encloses every obstacle)
   inside,      ///< inside closed part `part`
   on_surface,  ///< on a stored triangle of a closed part
-  unknown,     ///< the index has no interiors, or the tet is undecided, or every path was degenerate
+  unknown,  ///< the index has no interiors, or the tet is undecided, or every path was degenerate
 };
 
 struct ObstacleQuery {
   ObstacleContainment containment = ObstacleContainment::unknown;
-  std::uint32_t part = 0;           ///< when inside: one closed part holding the point
-  std::uint32_t tet = 0;            ///< the tet that holds the point (unless outside the mesh)
-  std::uint32_t paths_tried = 0;    ///< segments from the reference point (1 unless degenerate)
-  std::uint64_t triangle_tests = 0; ///< exact segment/triangle tests
+  std::uint32_t part = 0;            ///< when inside: one closed part holding the point
+  std::uint32_t tet = 0;             ///< the tet that holds the point (unless outside the mesh)
+  std::uint32_t paths_tried = 0;     ///< segments from the reference point (1 unless degenerate)
+  std::uint64_t triangle_tests = 0;  ///< exact segment/triangle tests
 };
 
 /// Locates p from hint_tet (updated to p's tet, so that the next call walks from there) and
 /// decides whether it is inside a closed obstacle. Pages in the tet's shard when it has one.
 /// @throw InputError for a non-finite p or a hint out of range; what the shard cache throws.
-ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet, const geometry::Point& p);
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
+                                  const geometry::Point& p);
 
 }  // namespace tetrapage

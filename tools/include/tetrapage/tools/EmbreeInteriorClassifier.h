@@ -5,8 +5,8 @@
 /// a part holds the point when the count is odd. The parts given are closed (EdgeParity), so a
 /// ray can only be wrong where it passes through an edge or a vertex (Embree may count both
 /// triangles there) or starts within float precision of a surface: the answer is the one all
-/// rays but at most one agree on, and the point is undecided (never used) otherwise. Embree works in float: coordinates are
-/// taken relative to the centre of the triangles' box before rounding.
+/// rays but at most one agree on, and the point is undecided (never used) otherwise. Embree works
+/// in float: coordinates are taken relative to the centre of the triangles' box before rounding.
 #include <memory>
 
 #include "tetrapage/preprocess/InteriorClassifier.h"
