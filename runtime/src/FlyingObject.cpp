@@ -210,6 +210,15 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   keep_pins_ = region_bytes <= index.options().memory_budget_bytes / 8;
   if (keep_pins_) pins_.resize(shards_.size());
 
+  if (index.options().prefetch) {
+    // The region's shards the box does not meet yet: it will within a few steps, so load them
+    // in the background now rather than synchronously then.
+    hints_.clear();
+    for (std::size_t k = 0; k < shards_.size(); ++k)
+      if (!geometry::boxes_overlap(box, shard_reach_[k]) && !index.cache().contains(shards_[k]))
+        hints_.push_back(shards_[k]);
+    if (!hints_.empty()) index.cache().prefetch(hints_);
+  }
   if (index.options().prefetch && searched_valid_) {
     // The next region, if the motion since the last search goes on.
     geometry::Box next = region;
