@@ -41,7 +41,7 @@ void record_hit(const RTCFilterFunctionNArguments* args) {
 
 class EmbreeInteriorClassifier::Impl {
  public:
-  explicit Impl(unsigned rays) : rays_(std::clamp(rays, 3u, unsigned(kDirections.size()))) {}
+  explicit Impl(unsigned rays) : rays_(std::clamp(rays, 2u, unsigned(kDirections.size()))) {}
 
   void add(std::uint32_t part, std::span<const std::array<Vec3, 3>> triangles) {
     for (const auto& t : triangles) {
@@ -66,16 +66,11 @@ class EmbreeInteriorClassifier::Impl {
                           }
                           // The parts are closed, so only a ray through an edge or a vertex (or
                           // a point within float precision of a surface) can be wrong: decided
-                          // when all rays but at most one agree.
-                          bool decided = false;
-                          for (unsigned r = 0; r < 2 && !decided; ++r) {
-                            unsigned agree = 0;
-                            for (unsigned q = 0; q < rays_; ++q) agree += answers[q] == answers[r];
-                            if (agree + 1 >= rays_) {
-                              decided = true;
-                              out[i].parts = answers[r];
-                            }
-                          }
+                          // when every ray agrees (preprocess moves an undecided point and asks
+                          // again).
+                          bool decided = true;
+                          for (unsigned q = 1; q < rays_; ++q) decided = decided && answers[q] == answers[0];
+                          if (decided) out[i].parts = answers[0];
                           out[i].decided = decided;
                         }
                       });
