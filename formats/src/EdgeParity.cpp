@@ -45,13 +45,4 @@ void EdgeParity::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
   }
 }
 
-std::vector<bool> closed_parts(const TriangleSoup& soup) {
-  std::vector<EdgeParity> parity(std::max<std::size_t>(soup.part_count(), 1));
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
-    parity[soup.part_of.empty() ? 0 : soup.part_of[t]].add_triangle(soup.corners(t));
-  std::vector<bool> closed(parity.size());
-  for (std::size_t p = 0; p < parity.size(); ++p) closed[p] = parity[p].closed();
-  return closed;
-}
-
 }  // namespace tetrapage

@@ -5,13 +5,7 @@
 #   STEP=run:   -DEXAMPLES=a,b -DWORK=folder    runs each example on the flight and requires its
 #               answers to equal the oracle's; also the default poses and a missing index.
 
-function(run_checked)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT result EQUAL 0)
-    string(REPLACE ";" " " command "${ARGN}")
-    message(FATAL_ERROR "failed (${result}): ${command}\n${out}\n${err}")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/../../cmake/RunChecked.cmake)
 
 if(STEP STREQUAL "index")
   file(REMOVE_RECURSE "${WORK}")

@@ -3,14 +3,7 @@
 #   -DBUILD_DIR -DWORK -DCONSUMER (source folder) -DINDEX (an index to open) -DGENERATOR
 #   -DC_COMPILER -DCXX_COMPILER
 
-function(run_checked)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT result EQUAL 0)
-    string(REPLACE ";" " " command "${ARGN}")
-    message(FATAL_ERROR "failed (${result}): ${command}\n${out}\n${err}")
-  endif()
-  set(last_output "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/../../cmake/RunChecked.cmake)
 
 file(REMOVE_RECURSE "${WORK}")
 set(prefix "${WORK}/prefix")

@@ -31,7 +31,4 @@ class EdgeParity {
   std::array<std::uint64_t, 2> state_{};
 };
 
-/// Whether each part of the soup is closed (EdgeParity over the part's triangles).
-std::vector<bool> closed_parts(const TriangleSoup& soup);
-
 }  // namespace tetrapage

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -107,7 +108,7 @@ class Shard {
   template <class Visit>
   std::size_t for_each_candidate(const geometry::Box& box, Visit&& visit) const {
     ShardQueryCounters counters;
-    query(box, visit, counters);
+    query<QueryMode::decide>(box, always, visit, counters);
     return counters.visited;
   }
   /// The same, adding what the query did to `counters`.
@@ -115,7 +116,7 @@ class Shard {
   std::size_t for_each_candidate(const geometry::Box& box, Visit&& visit,
                                  ShardQueryCounters& counters) const {
     const std::uint64_t before = counters.visited;
-    query(box, visit, counters);
+    query<QueryMode::decide>(box, always, visit, counters);
     return counters.visited - before;
   }
 
@@ -125,51 +126,15 @@ class Shard {
   /// caller's, e.g. an oriented box). No state is shared between concurrent queries.
   template <class Accept, class Visit>
   void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
-    for (int k = 0; k < 3; ++k)
-      if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
-    if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_)) return;
-    auto near = [&](std::uint32_t t) {
-      const geometry::Triangle triangle = this->triangle(t);
-      if (geometry::boxes_overlap(geometry::box_of(triangle), box)) visit(t, triangle);
-    };
-    if (kind_ == ShardKind::grid) {
-      std::array<std::uint32_t, 3> first{}, last{};
-      for (int k = 0; k < 3; ++k)
-        if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k], box.lo[k], box.hi[k],
-                                           first[k], last[k]))
-          return;
-      Marks marks(triangle_count_);
-      for (std::uint32_t z = first[2]; z <= last[2]; ++z)
-        for (std::uint32_t y = first[1]; y <= last[1]; ++y)
-          for (std::uint32_t x = first[0]; x <= last[0]; ++x) {
-            const std::size_t cell = (std::size_t(z) * grid_cells_[1] + y) * grid_cells_[0] + x;
-            for (std::uint32_t r = cell_offsets_[cell]; r < cell_offsets_[cell + 1]; ++r) {
-              const std::uint32_t t = references16_.empty() ? references32_[r] : references16_[r];
-              if (marks.first_visit(t)) near(t);
-            }
-          }
-      return;
-    }
-    std::array<std::uint32_t, shard_format::kMaxDepth * shard_format::kMaxFanout + 1> stack;
-    std::size_t size = 0;
-    stack[size++] = 0;
-    while (size > 0) {
-      const Node& node = nodes_[stack[--size]];
-      if (!geometry::boxes_overlap(node.box, box) || !accept(node.box)) continue;
-      if (node.count & shard_format::kLeafFlag) {
-        const std::uint32_t count = node.count & ~shard_format::kLeafFlag;
-        for (std::uint32_t t = node.first; t < node.first + count; ++t) near(t);
-      } else {
-        for (std::uint32_t c = node.count; c-- > 0;) stack[size++] = node.first + c;
-      }
-    }
+    ShardQueryCounters counters;
+    query<QueryMode::boxes>(box, accept, visit, counters);
   }
 
   /// Counts the cells or nodes and the references a query of `box` examines, without deciding
   /// any triangle (what the cost model measures: the exact tests are the same for every layout).
   void count_query(const geometry::Box& box, ShardQueryCounters& counters) const {
     auto ignore = [](std::uint32_t) {};
-    query<false>(box, ignore, counters);
+    query<QueryMode::count>(box, always, ignore, counters);
   }
   // Read-only views of the decoded structure, for inspection, tests and the builder's checks.
   std::array<std::uint32_t, 3> grid_cells() const { return grid_cells_; }
@@ -240,11 +205,20 @@ class Shard {
   }
 
 
-  template <bool kDecide = true, class Visit>
-  void query(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
+  // What a traversal does with each triangle reference it reaches.
+  enum class QueryMode {
+    decide,  ///< visit(local) for each triangle that meets the box (exact), once
+    count,   ///< count cells or nodes and references only (the cost model's measure)
+    boxes,   ///< visit(local, triangle) for each triangle whose box overlaps the box, once
+  };
+  static constexpr auto always = [](const geometry::Box&) { return true; };
+
+  // The one traversal of both kinds; `accept` may prune R-tree nodes (and the whole shard).
+  template <QueryMode kMode, class Accept, class Visit>
+  void query(const geometry::Box& box, const Accept& accept, Visit& visit, ShardQueryCounters& counters) const {
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
-    if (!geometry::boxes_overlap(box, bounds_)) return;
+    if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_)) return;
     // A triangle meets the box iff it meets the box clipped to the shard's bounds, which is
     // finite even when the query is not.
     geometry::Box clipped;
@@ -252,30 +226,32 @@ class Shard {
       clipped.lo[k] = std::max(box.lo[k], bounds_.lo[k]);
       clipped.hi[k] = std::min(box.hi[k], bounds_.hi[k]);
     }
+    auto reach = [&](std::uint32_t t) {
+      if constexpr (kMode == QueryMode::decide) {
+        if (!meets(t, clipped)) return;
+        ++counters.candidates;
+        visit(t);
+      } else if constexpr (kMode == QueryMode::boxes) {
+        const geometry::Triangle triangle = this->triangle(t);
+        if (geometry::boxes_overlap(geometry::box_of(triangle), clipped)) visit(t, triangle);
+      }
+    };
     if (kind_ == ShardKind::grid)
-      query_grid<kDecide>(clipped, visit, counters);
+      query_grid<kMode>(clipped, reach, counters);
     else
-      query_rtree<kDecide>(clipped, visit, counters);
+      query_rtree<kMode>(clipped, accept, reach, counters);
   }
 
-  template <bool kDecide, class Visit>
-  void query_grid(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
+  template <QueryMode kMode, class Reach>
+  void query_grid(const geometry::Box& box, Reach& reach, ShardQueryCounters& counters) const {
     std::array<std::uint32_t, 3> first{}, last{};
     for (int k = 0; k < 3; ++k)
       if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k],
                                          box.lo[k], box.hi[k], first[k], last[k]))
         return;
-    if constexpr (!kDecide) {
-      for (std::uint32_t z = first[2]; z <= last[2]; ++z)
-        for (std::uint32_t y = first[1]; y <= last[1]; ++y)
-          for (std::uint32_t x = first[0]; x <= last[0]; ++x) {
-            const std::size_t cell = (std::size_t(z) * grid_cells_[1] + y) * grid_cells_[0] + x;
-            ++counters.visited;
-            counters.references += cell_offsets_[cell + 1] - cell_offsets_[cell];
-          }
-      return;
-    }
-    Marks marks(triangle_count_);
+    // Marks report a triangle referenced by several cells once (not needed to count).
+    std::optional<Marks> marks;
+    if constexpr (kMode != QueryMode::count) marks.emplace(triangle_count_);
     const std::uint32_t nx = grid_cells_[0], ny = grid_cells_[1];
     for (std::uint32_t z = first[2]; z <= last[2]; ++z)
       for (std::uint32_t y = first[1]; y <= last[1]; ++y)
@@ -284,17 +260,16 @@ class Shard {
           ++counters.visited;
           const std::uint32_t begin = cell_offsets_[cell], end = cell_offsets_[cell + 1];
           counters.references += end - begin;
+          if constexpr (kMode == QueryMode::count) continue;
           for (std::uint32_t r = begin; r < end; ++r) {
             const std::uint32_t t = references16_.empty() ? references32_[r] : references16_[r];
-            if (!marks.first_visit(t) || !meets(t, box)) continue;
-            ++counters.candidates;
-            visit(t);
+            if (marks->first_visit(t)) reach(t);
           }
         }
   }
 
-  template <bool kDecide, class Visit>
-  void query_rtree(const geometry::Box& box, Visit& visit, ShardQueryCounters& counters) const {
+  template <QueryMode kMode, class Accept, class Reach>
+  void query_rtree(const geometry::Box& box, const Accept& accept, Reach& reach, ShardQueryCounters& counters) const {
     // Depth is at most kMaxDepth and each level leaves at most kMaxFanout - 1 siblings
     // pending, which the decoder checked.
     std::array<std::uint32_t, shard_format::kMaxDepth * shard_format::kMaxFanout + 1> stack;
@@ -303,16 +278,12 @@ class Shard {
     while (size > 0) {
       const Node& node = nodes_[stack[--size]];
       ++counters.visited;
-      if (!geometry::boxes_overlap(node.box, box)) continue;
+      if (!geometry::boxes_overlap(node.box, box) || !accept(node.box)) continue;
       if (node.count & shard_format::kLeafFlag) {
         const std::uint32_t count = node.count & ~shard_format::kLeafFlag;
         counters.references += count;
-        if constexpr (!kDecide) continue;
-        for (std::uint32_t t = node.first; t < node.first + count; ++t) {
-          if (!meets(t, box)) continue;
-          ++counters.candidates;
-          visit(t);
-        }
+        if constexpr (kMode == QueryMode::count) continue;
+        for (std::uint32_t t = node.first; t < node.first + count; ++t) reach(t);
       } else {
         for (std::uint32_t c = node.count; c-- > 0;) stack[size++] = node.first + c;
       }
