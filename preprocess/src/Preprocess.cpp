@@ -241,7 +241,8 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   }
   const std::size_t tet_count = mesh.tet_count();
   std::vector<Vec3> points(tet_count);
-  std::vector<bool> has_point(tet_count);
+  // Bytes, not vector<bool>: the parallel loop writes neighbouring entries.
+  std::vector<std::uint8_t> has_point(tet_count, 0);
   result.reference_points.resize(3 * tet_count);
   tbb::parallel_for(std::size_t(0), tet_count, [&](std::size_t t) {
     const auto reference = walk_reference_point(mesh, std::uint32_t(t));

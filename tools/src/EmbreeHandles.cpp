@@ -1,5 +1,6 @@
 #include "tetrapage/tools/EmbreeHandles.h"
 
+#include <cstdlib>
 #include <mutex>
 
 #include "tetrapage/formats/Error.h"
@@ -36,7 +37,13 @@ struct EmbreeDevice::ErrorLog {
 };
 
 EmbreeDevice::EmbreeDevice(unsigned threads) : errors_(std::make_shared<ErrorLog>()) {
-  const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+  std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
+  // TETRAPAGE_EMBREE_CONFIG (e.g. "isa=avx2") reproduces another machine's Embree kernels.
+  if (const char* extra = std::getenv("TETRAPAGE_EMBREE_CONFIG"); extra && *extra)
+  {
+    if (!config.empty()) config += ',';
+    config += extra;
+  }
   device_.reset(rtcNewDevice(config.c_str()));
   if (!device_)
     throw Error("Embree: cannot create a device (" + std::string(error_name(rtcGetDeviceError(nullptr))) +
