@@ -2,6 +2,7 @@
 // Private to study/: the obstacle triangles every method is built over, with their boxes, and
 // the one phase II primitive they all share (box pretest, then the kernel's exact test).
 
+#include <algorithm>
 #include <span>
 #include <string>
 #include <vector>
@@ -32,6 +33,31 @@ struct Obstacles {
     ++counters.triangle_tests;
     return geometry::triangles_intersect(t, triangles[o]);
   }
+};
+
+/// Marks the obstacles already looked at for one object triangle, so that a triangle stored
+/// in several cells or leaves is tested once: a stamp per obstacle, no clearing between rounds.
+class VisitStamps {
+ public:
+  explicit VisitStamps(std::size_t obstacles) : stamps_(obstacles, 0) {}
+  /// Starts a new round: nothing is marked.
+  void next_round() {
+    if (++round_ == 0) {  // wrapped: clear once every 2^32 rounds
+      std::fill(stamps_.begin(), stamps_.end(), 0);
+      round_ = 1;
+    }
+  }
+  /// True the first time `obstacle` is seen in this round.
+  bool first_visit(std::uint32_t obstacle) {
+    if (stamps_[obstacle] == round_) return false;
+    stamps_[obstacle] = round_;
+    return true;
+  }
+  std::uint64_t bytes() const { return stamps_.capacity() * sizeof(std::uint32_t); }
+
+ private:
+  std::vector<std::uint32_t> stamps_;
+  std::uint32_t round_ = 0;
 };
 
 }  // namespace tetrapage::study
