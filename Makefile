@@ -12,9 +12,9 @@ DEMO_DIR  ?= out/demo
 DEB_PACKAGES := cmake make g++ pkg-config \
   libeigen3-dev libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libbenchmark-dev libfcl-dev
+  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox
 
-.PHONY: deps configure build test sanitize demo bench bench-peers clean format
+.PHONY: deps configure build test sanitize demo bench bench-study bench-peers clean format
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -70,6 +70,13 @@ bench: build
 	  $(BUILD)/bench/tetrapage_bench_$$b --benchmark_out=$(BUILD)/bench-results/$$b.json \
 	    --benchmark_out_format=json || exit 1; \
 	done
+	$(MAKE) --no-print-directory bench-study
+
+# The study's flight benchmark: its environment groups x its six objects, the four methods, the
+# hybrid (in memory and paged under 1 MiB) and the peers; tables and plots for docs/BENCHMARKS.md.
+# Long (an hour or more); STUDY_FLAGS=--quick for a short run.
+bench-study: build
+	$(BUILD)/bench/tetrapage_bench_study --out $(BUILD)/bench-results/study --memory 1M $(STUDY_FLAGS)
 
 # FCL, CGAL's AABB tree and tetrapage (in memory, and paged under 8 MiB) on the demo's scene,
 # the study's object sizes, 10,000-pose flights, 3 repetitions (docs/BENCHMARKS.md, "Peers").
@@ -78,7 +85,7 @@ bench-peers: build
 	BUILD=$(BUILD) bench/scripts/peers_series.sh $(DEMO_DIR) $(BUILD)/bench-results/peers 8M 3
 
 format:
-	find formats runtime preprocess tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i
+	find formats runtime preprocess study tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i
 
 clean:
 	rm -rf $(BUILD) $(BUILD)-asan
