@@ -1,4 +1,4 @@
-// tetrapage_bench_peers: one flight replayed through FCL, CGAL's AABB tree and tetrapage's
+// tetrapage_bench_peers: one flight replayed through FCL, Embree, CGAL's AABB tree and tetrapage's
 // runtime (in memory and paged), single-threaded, each collider in a fresh process of its own
 // so that its build time, resident memory and cold start are its own. Prints a Markdown table;
 // --report writes the figures as JSON.
@@ -25,6 +25,7 @@
 #include <oneapi/tbb/global_control.h>
 
 #include "tetrapage/bench/CgalCollider.h"
+#include "tetrapage/bench/EmbreePeerCollider.h"
 #include "tetrapage/bench/FclCollider.h"
 #include "tetrapage/bench/TetrapageCollider.h"
 #include "tetrapage/formats/ByteSize.h"
@@ -46,7 +47,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 // The colliders, by the names the command line and the report use.
-const std::vector<std::string> kColliderNames = {"fcl", "cgal-surfaces", "cgal", "tetrapage", "tetrapage-paged"};
+const std::vector<std::string> kColliderNames = {"fcl",       "embree",          "cgal-surfaces", "cgal",
+                                                 "tetrapage", "tetrapage-paged"};
 
 struct Arguments {
   fs::path scene, object, flight, answers, index, report;
@@ -65,6 +67,7 @@ bool needs_environment(const std::string& name) { return name.rfind("tetrapage",
 std::unique_ptr<PeerCollider> make_collider(const std::string& name, const Arguments& args,
                                             const TriangleSoup* environment, const TriangleSoup& object) {
   if (name == "fcl") return std::make_unique<FclCollider>(*environment, object);
+  if (name == "embree") return std::make_unique<EmbreePeerCollider>(*environment, object);
   if (name == "cgal-surfaces") return std::make_unique<CgalCollider>(*environment, object, CollisionQuestion::surfaces);
   if (name == "cgal")
     return std::make_unique<CgalCollider>(*environment, object, CollisionQuestion::surfaces_or_inside);
@@ -353,7 +356,7 @@ void run_all(const Arguments& args) {
 int main(int argc, char** argv) {
   using namespace tetrapage;
   CLI::App app{
-      "Replays a flight through FCL (BVHModel<OBBRSS>), CGAL's AABB tree (the exact oracle, and its\n"
+      "Replays a flight through FCL (BVHModel<OBBRSS>), Embree's rtcCollide, CGAL's AABB tree (the exact oracle, and its\n"
       "surfaces-only test) and tetrapage's runtime (every shard in memory, and paged under --memory),\n"
       "single-threaded, each in a fresh process; prints build time, resident memory, steps per second,\n"
       "latency percentiles, collisions and disagreements with the oracle's answers."};
@@ -368,7 +371,7 @@ int main(int argc, char** argv) {
       ->expected(0, 2)
       ->check(CLI::ExistingFile);
   app.add_option("--memory", args.memory, "Shard budget of the paged run (e.g. 8M); no paged run without it");
-  app.add_option("--colliders", args.colliders, "Subset to run: fcl, cgal-surfaces, cgal, tetrapage, tetrapage-paged")
+  app.add_option("--colliders", args.colliders, "Subset to run: fcl, embree, cgal-surfaces, cgal, tetrapage, tetrapage-paged")
       ->delimiter(',')
       ->check(CLI::IsMember(kColliderNames));
   app.add_flag("--warmup", args.warmup, "One untimed pass before the timed one (in-core colliders only)");
