@@ -223,6 +223,12 @@ TEST(ShardCache, MatchesBruteForceLruModel) {
     EXPECT_EQ(c.evictions, model.evictions);
     EXPECT_EQ(c.page_ins, model.misses);
     EXPECT_EQ(c.resident_bytes, model.used);
+    // Per shard: each page-in is a load of that shard (the loader's own call count).
+    const auto per_shard = cache->page_ins_per_shard();
+    ASSERT_EQ(per_shard.size(), 40u);
+    for (std::uint32_t s = 0; s < 40; ++s) EXPECT_EQ(per_shard[s], std::uint32_t(model_loads[s])) << "shard " << s;
+    cache->reset_counters();
+    for (const auto n : cache->page_ins_per_shard()) EXPECT_EQ(n, 0u);
     held.clear();
     expect_consistent(*cache, index);
   }

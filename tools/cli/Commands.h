@@ -27,5 +27,7 @@ void add_fly_command(CLI::App& app);
 void add_interior_check_command(CLI::App& app);
 /// `check-location` (tools/cli/CheckLocationCommand.cpp)
 void add_check_location_command(CLI::App& app);
+/// `render` (tools/cli/RenderCommand.cpp)
+void add_render_command(CLI::App& app);
 
 }  // namespace tetrapage::cli

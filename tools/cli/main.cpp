@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   tetrapage::cli::add_fly_command(app);
   tetrapage::cli::add_interior_check_command(app);
   tetrapage::cli::add_check_location_command(app);
+  tetrapage::cli::add_render_command(app);
 
   try {
     app.parse(argc, argv);

@@ -209,6 +209,9 @@ class ShardCache {
   ShardCacheCounters counters() const;
   /// Zeroes the counters and the latency samples; the peak restarts from the current bytes.
   void reset_counters();
+  /// How many times each shard was paged in (since construction or reset_counters), by shard
+  /// id: where a flight made the cache work (tetrapage render colours regions by it).
+  std::vector<std::uint32_t> page_ins_per_shard() const;
 
   std::uint64_t budget_bytes() const { return budget_; }
   std::size_t shard_count() const { return entries_.size(); }
@@ -222,6 +225,7 @@ class ShardCache {
     std::uint64_t bytes = 0;  ///< reserved while loading, resident bytes once resident
     std::uint64_t stamp = 0;  ///< acquisitions_ when last acquired, released or prefetched
     std::uint32_t pins = 0;
+    std::uint32_t page_ins = 0;  ///< since construction or the last reset_counters
     std::uint32_t lru_prev = kNone, lru_next = kNone;  ///< in the LRU list iff resident, unpinned
     State state = State::empty;
     bool prefetched_unused = false;
@@ -512,6 +516,7 @@ void ShardCache<ShardType>::install(std::unique_lock<std::mutex>& lock, std::uin
   ++resident_count_;
   if (entry.prefetched_unused) ++prefetched_unused_count_;
   link_lru_tail(shard);
+  ++entry.page_ins;
   page_ins_.fetch_add(1, std::memory_order_relaxed);
   bytes_loaded_.fetch_add(size, std::memory_order_relaxed);
   load_cv_.notify_all();
@@ -847,6 +852,14 @@ ShardCacheCounters ShardCache<ShardType>::counters() const {
 }
 
 template <class ShardType>
+std::vector<std::uint32_t> ShardCache<ShardType>::page_ins_per_shard() const {
+  std::lock_guard lock(mutex_);
+  std::vector<std::uint32_t> counts(entries_.size());
+  for (std::size_t i = 0; i < entries_.size(); ++i) counts[i] = entries_[i].page_ins;
+  return counts;
+}
+
+template <class ShardType>
 void ShardCache<ShardType>::reset_counters() {
   for (auto* counter : {&hits_, &misses_, &page_ins_, &load_failures_, &bytes_loaded_, &evictions_,
                         &pin_waits_, &prefetch_hints_, &prefetch_loads_, &prefetch_hits_,
@@ -855,6 +868,7 @@ void ShardCache<ShardType>::reset_counters() {
   {
     std::lock_guard lock(mutex_);
     peak_ = used_;
+    for (auto& entry : entries_) entry.page_ins = 0;
   }
   std::lock_guard lock(latency_mutex_);
   latency_ns_.clear();

@@ -1,0 +1,133 @@
+// `tetrapage render`: a PNG of an index, regions coloured by shard kind, region or page-ins
+// of a flight, with the flight's path drawn.
+
+#include <cstdio>
+
+#include "Commands.h"
+#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/tools/ModelRenderer.h"
+
+namespace tetrapage::cli {
+namespace {
+
+struct RenderArguments {
+  std::filesystem::path index, output, path, object, report;
+  std::string colour = "kind";
+  std::string size = "1200x800";
+  std::string memory = "64M";
+  double azimuth = 35, elevation = 30, zoom = 1;
+  std::uint64_t max_triangles = 20'000'000;
+};
+
+void run_render(const RenderArguments& args) {
+  check_writable(args.report);
+  RenderOptions options;
+  if (std::sscanf(args.size.c_str(), "%zux%zu", &options.width, &options.height) != 2)
+    throw InputError("--size '" + args.size + "': expected WIDTHxHEIGHT, e.g. 1200x800");
+  options.azimuth_degrees = args.azimuth;
+  options.elevation_degrees = args.elevation;
+  options.zoom = args.zoom;
+  options.max_triangles = args.max_triangles;
+  options.colouring = args.colour == "kind"      ? RenderColouring::shard_kind
+                      : args.colour == "regions" ? RenderColouring::regions
+                                                 : RenderColouring::page_ins;
+  std::vector<Pose> poses;
+  if (!args.path.empty()) {
+    poses = read_poses(args.path);
+    for (const auto& pose : poses) options.path.push_back(pose.translation);
+  }
+  nlohmann::json flight = nlohmann::json::object();
+  if (options.colouring == RenderColouring::page_ins) {
+    if (poses.empty() || args.object.empty())
+      throw InputError("--color page-ins needs the flight (--path) and the object (--object) to replay");
+    // The flight as `fly` runs it, under --memory: the cache counts each shard's page-ins.
+    CollisionIndexOptions index_options;
+    index_options.memory_budget_bytes = parse_byte_size(args.memory);
+    auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
+    FlyingObject object(index, read_mesh(args.object));
+    Progress progress("replaying the flight", poses.size());
+    std::uint64_t collisions = 0;
+    for (const auto& pose : poses) {
+      collisions += object.query(pose).collides ? 1 : 0;
+      progress.advance();
+    }
+    progress.finish();
+    index->cache().wait_prefetch_idle();
+    options.page_ins = index->cache().page_ins_per_shard();
+    const auto counters = index->cache().counters();
+    std::uint64_t touched = 0;
+    for (const auto n : options.page_ins) touched += n > 0;
+    flight = {{"poses", poses.size()},         {"collisions", collisions},
+              {"budget", args.memory},         {"page_ins", counters.page_ins},
+              {"shards_paged_in", touched},    {"bytes_read", counters.bytes_loaded}};
+    std::fprintf(stderr, "flight: %zu poses, %llu page-ins of %llu shards under %s\n", poses.size(),
+                 (unsigned long long)counters.page_ins, (unsigned long long)touched, args.memory.c_str());
+  }
+  // Rendering reads every shard once, through a cache that holds a few at a time.
+  CollisionIndexOptions index_options;
+  index_options.memory_budget_bytes = std::uint64_t(256) << 20;
+  index_options.prefetch = false;
+  const CollisionIndex index(args.index, index_options);
+  RenderSummary summary;
+  const RgbImage image = render_model(index, options, summary);
+  write_png(args.output, image);
+  std::printf("%s: %zux%zu, %llu triangles drawn%s from %llu shards, %.1f %% of pixels on the model, %.2f s\n",
+              args.output.string().c_str(), image.width, image.height, (unsigned long long)summary.triangles_drawn,
+              summary.stride > 1 ? (" (every " + std::to_string(summary.stride) + "th)").c_str() : "",
+              (unsigned long long)summary.shards, 100.0 * double(summary.pixels_hit) / double(image.width * image.height),
+              summary.seconds);
+  if (!args.report.empty())
+    write_report(args.report, {{"command", "render"},
+                               {"index", args.index.string()},
+                               {"output", args.output.string()},
+                               {"colour", args.colour},
+                               {"width", image.width},
+                               {"height", image.height},
+                               {"shards", summary.shards},
+                               {"triangles_drawn", summary.triangles_drawn},
+                               {"stride", summary.stride},
+                               {"pixels_hit", summary.pixels_hit},
+                               {"seconds", summary.seconds},
+                               {"flight", flight}});
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app) {
+  auto args = std::make_shared<RenderArguments>();
+  auto* command = app.add_subcommand(
+      "render",
+      "Ray-trace an index with Embree into a PNG: each region's triangles coloured by its shard\n"
+      "kind (grid blue, R-tree orange), by region, or by how often a flight paged it in\n"
+      "(--color page-ins replays --path with --object under --memory; grey: never), with the\n"
+      "flight's path drawn in magenta (faint where hidden; start green, end red).");
+  command->add_option("index", args->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
+  command->add_option("-o,--output", args->output, "PNG to write")->required();
+  command->add_option("--path", args->path, "Pose file of a flight to draw (CSV tx,ty,tz,qw,qx,qy,qz)")
+      ->check(CLI::ExistingFile);
+  command->add_option("--color", args->colour, "kind, regions or page-ins")
+      ->check(CLI::IsMember({"kind", "regions", "page-ins"}))
+      ->capture_default_str();
+  command->add_option("--object", args->object, "Flying object (for --color page-ins)")->check(CLI::ExistingFile);
+  command->add_option("--memory", args->memory, "Shard budget of the replay (for --color page-ins)")
+      ->capture_default_str();
+  command->add_option("--size", args->size, "Image size WIDTHxHEIGHT")->capture_default_str();
+  command->add_option("--azimuth", args->azimuth, "Camera direction around +z, degrees from +x")->capture_default_str();
+  command->add_option("--elevation", args->elevation, "Camera direction above the xy plane, degrees")
+      ->capture_default_str();
+  command->add_option("--zoom", args->zoom, "Move the camera closer (> 1) or away (< 1)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--max-triangles", args->max_triangles,
+                      "Draw every k-th triangle above this many (Embree's scene memory)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--report", args->report, "Write figures as JSON");
+  command->callback([args] { run_render(*args); });
+}
+
+}  // namespace tetrapage::cli
