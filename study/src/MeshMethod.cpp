@@ -107,13 +107,11 @@ struct Scratch {
   }
 };
 
-// Every tet whose closed solid meets t, by breadth-first search from `start` (a tet around a
-// corner of t): the tets meeting a connected set are connected through shared faces. Calls
-// visit(tet) for each; stops early when visit returns true.
-template <class Visit>
-void tets_meeting_triangle(const TetMesh& mesh, const std::vector<Box>& tet_boxes, std::uint32_t start,
-                           const Triangle& t, Scratch& scratch, Visit&& visit) {
-  const Box box = geometry::box_of(t);
+// Breadth-first search from `start` over the tets whose boxes overlap `box` and that pass
+// `reach(tet)`; calls visit(tet) for each one reached, and stops early when it returns true.
+template <class Reach, class Visit>
+void search_tets(const TetMesh& mesh, const std::vector<Box>& tet_boxes, std::uint32_t start, const Box& box,
+                 Scratch& scratch, Reach&& reach, Visit&& visit) {
   scratch.start(mesh.tet_count());
   scratch.visit(start);
   for (std::size_t head = 0; head < scratch.queue.size(); ++head) {
@@ -121,8 +119,7 @@ void tets_meeting_triangle(const TetMesh& mesh, const std::vector<Box>& tet_boxe
     if (visit(tet)) return;
     for (std::uint32_t next : mesh.neighbours[tet]) {
       if (next == kNone || scratch.stamps[next] == scratch.stamp) continue;
-      if (!geometry::boxes_overlap(tet_boxes[next], box)) continue;
-      if (!geometry::triangle_intersects_tetrahedron(t, mesh.corners(next))) continue;
+      if (!geometry::boxes_overlap(tet_boxes[next], box) || !reach(next)) continue;
       scratch.visit(next);
     }
   }
@@ -189,9 +186,8 @@ std::optional<Point> find_crossing(const TetMesh& mesh, std::uint32_t tet, const
   };
   for (const auto& e : kTetEdges) {
     if (side[e[0]] * side[e[1]] >= 0) continue;
-    if (!geometry::segment_intersects_triangle({c[e[0]], c[e[1]]}, t)) continue;
     const Point p = cut(c[e[0]], c[e[1]], d[e[0]], d[e[1]]);
-    if (usable(p)) return p;
+    if (usable(p) && geometry::segment_intersects_triangle({c[e[0]], c[e[1]]}, t)) return p;
   }
   for (int k = 0; k < 4; ++k) {
     const auto& f = geometry::kTetrahedronFaces[k];
@@ -204,15 +200,15 @@ std::optional<Point> find_crossing(const TetMesh& mesh, std::uint32_t tet, const
     const Triangle face{c[f[0]], c[f[1]], c[f[2]]};
     for (int e = 0; e < 3; ++e) {
       const geometry::Segment edge{t[e], t[(e + 1) % 3]};
-      const auto hit = geometry::classify_segment_triangle(edge, face);
-      if (hit.at_endpoint || (hit.contact != geometry::SegmentTriangleContact::interior &&
-                              hit.contact != geometry::SegmentTriangleContact::edge))
-        continue;
       const ApproximatePlane face_plane(face);
       const double da = face_plane.distance(edge[0]), db = face_plane.distance(edge[1]);
-      if ((da > 0) == (db > 0) || da == 0 || db == 0) continue;  // rounding: no usable point
+      if ((da > 0) == (db > 0) || da == 0 || db == 0) continue;  // no usable point
       const Point p = cut(edge[0], edge[1], da, db);
-      if (usable(p)) return p;
+      if (!usable(p)) continue;
+      const auto hit = geometry::classify_segment_triangle(edge, face);
+      if (!hit.at_endpoint && (hit.contact == geometry::SegmentTriangleContact::interior ||
+                               hit.contact == geometry::SegmentTriangleContact::edge))
+        return p;
     }
   }
   return std::nullopt;
@@ -390,10 +386,23 @@ void MeshMethod::conform(Delaunay& delaunay, std::vector<Point>& sites) {
         const Triangle& t = obstacles_.triangles[o];
         const ApproximatePlane plane(t);
         const std::uint32_t start = vertex_tet_[site_vertex_[corner_site_[3 * o]]];
-        tets_meeting_triangle(mesh_, tet_boxes_, start, t, scratch, [&](std::uint32_t tet) {
-          crossings[o] = find_crossing(mesh_, tet, t, plane, tolerance);
-          return crossings[o].has_value();
-        });
+        // A superset of the tets meeting t, connected and cheaper than the exact test: those
+        // that its plane (with the slack) does not separate from t's box.
+        search_tets(
+            mesh_, tet_boxes_, start, geometry::box_of(t), scratch,
+            [&](std::uint32_t tet) {
+              bool above = false, below = false;
+              for (auto v : mesh_.tets[tet]) {
+                const double d = plane.distance(mesh_.vertices[v]);
+                above |= d >= -tolerance;
+                below |= d <= tolerance;
+              }
+              return above && below;
+            },
+            [&](std::uint32_t tet) {
+              crossings[o] = find_crossing(mesh_, tet, t, plane, tolerance);
+              return crossings[o].has_value();
+            });
       }
     });
     std::vector<Point> steiner;
@@ -437,10 +446,14 @@ void MeshMethod::attach_triangles() {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, obstacles_.size()), [&](const auto& range) {
     Scratch& scratch = scratches.local();
     for (std::size_t o = range.begin(); o != range.end(); ++o) {
+      // Every tet whose closed solid meets the triangle, from a tet around one of its corners:
+      // the tets meeting a connected set are connected through shared faces.
+      const Triangle& t = obstacles_.triangles[o];
       const std::uint32_t start = vertex_tet_[site_vertex_[corner_site_[3 * o]]];
-      tets_meeting_triangle(mesh_, tet_boxes_, start, obstacles_.triangles[o], scratch, [&](std::uint32_t) {
-        return false;
-      });
+      search_tets(
+          mesh_, tet_boxes_, start, geometry::box_of(t), scratch,
+          [&](std::uint32_t tet) { return geometry::triangle_intersects_tetrahedron(t, mesh_.corners(tet)); },
+          [](std::uint32_t) { return false; });
       tets_of[o] = scratch.queue;
     }
   });
