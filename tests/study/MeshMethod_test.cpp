@@ -329,23 +329,5 @@ TEST(MeshMethod, RejectsBadInput) {
   EXPECT_NO_THROW(make_mesh_method(fine));
 }
 
-// The figures of the report (not a check): run with --gtest_also_run_disabled_tests.
-TEST(MeshMethod, DISABLED_Figures) {
-  const std::vector<std::pair<Environment, std::uint64_t>> cases = {
-      {Environment::tetras, 100},   {Environment::tetras, 1000},  {Environment::tetras, 4000},
-      {Environment::scene, 5000},   {Environment::terrain, 5000}, {Environment::terrain, 28322}};
-  for (const auto& [kind, triangles] : cases) {
-    const auto obstacles = generate_environment(kind, triangles, 1);
-    for (unsigned grid : {0u, 10u}) {
-      MeshMethodOptions options;
-      options.grid_points = grid;
-      const auto method = make_mesh_method(obstacles, options);
-      print_figures(name_of(kind) + " " + std::to_string(obstacles.size()), *method);
-      const auto flight = fly(*method, obstacles, flying_object(116, 0.05), 1, 200);
-      std::printf("  %d of %d poses collide\n", flight.collisions, flight.poses);
-    }
-  }
-}
-
 }  // namespace
 }  // namespace tetrapage::study
