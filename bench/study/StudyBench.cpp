@@ -104,7 +104,7 @@ std::vector<EnvironmentSpec> environments(const Options& o, const MeshLibrary& l
   }
   if (wants("scenes")) {
     const std::vector<std::uint64_t> sizes =
-        o.quick ? std::vector<std::uint64_t>{3000} : std::vector<std::uint64_t>{10000, 30000, 100000};
+        o.quick ? std::vector<std::uint64_t>{3000} : std::vector<std::uint64_t>{10000, 20000, 40000};
     for (std::size_t i = 0; i < sizes.size(); ++i) {
       const std::uint64_t n = sizes[i];
       specs.push_back({"scenes", "scene" + std::to_string(n / 1000) + "k", [&library, n, i](MeshWriter& w) {
