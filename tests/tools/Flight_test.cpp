@@ -5,6 +5,8 @@
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +16,10 @@
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
+#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/tools/EmbreeInteriorClassifier.h"
+#include "tetrapage/tools/RuntimeJudge.h"
 
 #include "BoxSoup.h"
 
@@ -226,6 +232,40 @@ TEST(BilliardFlight, RefusesAnObjectLargerThanTheWorkspace) {
   const TriangleSoup environment = boxes_environment(5, 1);
   const ReferenceCollider oracle(environment, tetra_object(2.0));
   EXPECT_THROW(generate_billiard_flight(oracle, FlightOptions{}), InputError);
+}
+
+// For models too large for the oracle, the runtime judges the flight: where it answers as the
+// oracle does (double storage, interiors), the flight is the oracle's, pose for pose.
+TEST(BilliardFlight, TheRuntimeJudgeFliesTheOraclesFlight) {
+  const TriangleSoup environment = boxes_environment(7, 25);
+  const TriangleSoup object = tetra_object(0.02);
+  const std::filesystem::path folder =
+      std::filesystem::path(TETRAPAGE_TEST_TMP) / ("runtime-judge-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  write_mesh(folder / "boxes.ply", environment);
+  PreprocessOptions options;
+  options.region_triangles = 16;
+  options.precision = StoredPrecision::float64;
+  options.interior_classifier = embree_interior_classifier();
+  preprocess({folder / "boxes.ply"}, folder / "boxes.tpi", options);
+  const ReferenceCollider oracle(environment, object);
+  RuntimeJudge judge(std::make_shared<const CollisionIndex>(folder / "boxes.tpi"), object);
+  EXPECT_EQ(judge.environment_bounds().lo, oracle.environment_bounds().lo);
+  EXPECT_EQ(judge.environment_bounds().hi, oracle.environment_bounds().hi);
+  EXPECT_EQ(judge.object_radius(), oracle.object_radius());
+  FlightOptions flight_options;
+  flight_options.steps = 3000;
+  flight_options.seed = 9;
+  const Flight expected = generate_billiard_flight(oracle, flight_options);
+  const Flight flight = generate_billiard_flight(judge, flight_options);
+  EXPECT_GT(expected.collisions, 5u);
+  ASSERT_EQ(flight.poses.size(), expected.poses.size());
+  EXPECT_EQ(flight.collides, expected.collides);
+  for (std::size_t i = 0; i < flight.poses.size(); ++i) {
+    ASSERT_EQ(flight.poses[i].translation, expected.poses[i].translation) << "pose " << i;
+    ASSERT_EQ(flight.poses[i].rotation, expected.poses[i].rotation) << "pose " << i;
+  }
+  std::filesystem::remove_all(folder);
 }
 
 TEST(AnswerFile, RoundTripsAndRejectsBadRows) {

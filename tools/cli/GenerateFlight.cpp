@@ -10,12 +10,15 @@
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/LatencySummary.h"
+#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/tools/RuntimeJudge.h"
 
 namespace tetrapage::cli {
 namespace {
 
 struct FlightArguments {
-  std::filesystem::path environment, object, output, answers, report;
+  std::filesystem::path environment, index, object, output, answers, report;
+  std::string memory = "1G";
   FlightOptions options;
 };
 
@@ -25,21 +28,37 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 void run_generate_flight(const FlightArguments& args) {
   for (const auto* output : {&args.output, &args.answers, &args.report}) check_writable(*output);
+  if (args.environment.empty() == args.index.empty())
+    throw InputError("generate flight: give the environment (--env) or an index (--index), not both");
   const auto start = std::chrono::steady_clock::now();
   std::vector<ReadReport> reports;
-  Progress reading("reading environment", 0);
-  const TriangleSoup environment = load_inputs({args.environment}, &reports, reading);
-  reading.finish();
+  TriangleSoup environment;
+  if (!args.environment.empty()) {
+    Progress reading("reading environment", 0);
+    environment = load_inputs({args.environment}, &reports, reading);
+    reading.finish();
+  }
   const TriangleSoup object = read_mesh(args.object);
   const double read_seconds = seconds_since(start);
 
+  // The judge: the reference oracle over the environment, or the exact runtime over the index
+  // (paged under --memory) for models too large for the oracle.
   const auto build_start = std::chrono::steady_clock::now();
-  const ReferenceCollider oracle(environment, object);
+  std::unique_ptr<ReferenceCollider> oracle;
+  std::unique_ptr<CollisionJudge> judge;
+  if (!args.environment.empty()) {
+    oracle = std::make_unique<ReferenceCollider>(environment, object);
+  } else {
+    CollisionIndexOptions index_options;
+    index_options.memory_budget_bytes = parse_byte_size(args.memory);
+    judge = std::make_unique<RuntimeJudge>(std::make_shared<const CollisionIndex>(args.index, index_options), object);
+  }
   const double build_seconds = seconds_since(build_start);
 
-  Progress flying("flying (reference)", args.options.steps);
+  Progress flying(oracle ? "flying (reference)" : "flying (runtime)", args.options.steps);
   const auto fly_start = std::chrono::steady_clock::now();
-  const Flight flight = generate_billiard_flight(oracle, args.options, flying);
+  const Flight flight = oracle ? generate_billiard_flight(*oracle, args.options, flying)
+                               : generate_billiard_flight(*judge, args.options, flying);
   const double fly_seconds = seconds_since(fly_start);
 
   write_poses(args.output, flight.poses);
@@ -51,19 +70,23 @@ void run_generate_flight(const FlightArguments& args) {
   const auto latency = LatencySummary::of(flight.query_seconds);
   std::printf(
       "flight: %zu poses, %llu collisions, %llu wall bounces, start after %llu attempts\n"
-      "reference oracle (CGAL AABB_tree, exact predicates): %.0f steps/s, latency p50 %.1f us, "
-      "p99 %.1f us, max %.1f us\n"
-      "environment %zu triangles (read %.2f s, tree %.2f s), object %zu triangles; flight %.2f s\n"
+      "%s: %.0f steps/s, latency p50 %.1f us, p99 %.1f us, max %.1f us\n"
+      "environment %zu triangles (read %.2f s, judge built in %.2f s), object %zu triangles; flight %.2f s\n"
       "wrote %s\n",
       flight.poses.size(), static_cast<unsigned long long>(flight.collisions),
       static_cast<unsigned long long>(flight.boundary_reversals),
-      static_cast<unsigned long long>(flight.start_attempts), steps_per_second, latency.p50_us,
-      latency.p99_us, latency.max_us, environment.triangle_count(), read_seconds, build_seconds,
+      static_cast<unsigned long long>(flight.start_attempts),
+      oracle ? "reference oracle (CGAL AABB_tree, exact predicates)" : "runtime (exact, paged)", steps_per_second,
+      latency.p50_us,
+      latency.p99_us, latency.max_us,
+      oracle ? environment.triangle_count() : std::size_t(0), read_seconds, build_seconds,
       object.triangle_count(), fly_seconds, args.output.c_str());
   if (!args.report.empty()) {
     write_report(args.report,
                  {{"command", "generate flight"},
                   {"environment", args.environment.string()},
+                  {"index", args.index.string()},
+                  {"judge", oracle ? "reference oracle" : "runtime"},
                   {"object", args.object.string()},
                   {"seed", args.options.seed},
                   {"steps", flight.poses.size()},
@@ -90,11 +113,16 @@ void add_generate_flight_command(CLI::App& generate) {
       "Billiard flight (the study's section 4.1): the object starts at a random collision-free\n"
       "placement, moves ~0.005 per step with randomly perturbed direction and spin, reverses on\n"
       "collision and bounces off the environment's bounding box. Collisions are decided by the\n"
-      "reference oracle (CGAL AABB_tree, exact predicates). Writes poses as CSV\n"
+      "reference oracle (CGAL AABB_tree, exact predicates), or with --index by tetrapage's exact\n"
+      "runtime. Writes poses as CSV\n"
       "`tx,ty,tz,qw,qx,qy,qz`; the same seed gives the same file.");
   command->add_option("--env", args->environment, "Environment: a mesh file or a manifest (.json)")
-      ->required()
       ->check(CLI::ExistingFile);
+  command->add_option("--index", args->index,
+                      "Instead of --env: an index (.tpi), collisions decided by tetrapage's exact runtime "
+                      "(for models too large for the in-core oracle, ~150 B a triangle)")
+      ->check(CLI::ExistingFile);
+  command->add_option("--memory", args->memory, "Shard budget of the runtime with --index")->capture_default_str();
   command->add_option("--object", args->object, "Flying object mesh (its own frame)")
       ->required()
       ->check(CLI::ExistingFile);

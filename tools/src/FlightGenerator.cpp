@@ -65,8 +65,29 @@ Pose moved(const Pose& pose, const Vec3& velocity, const Vec3& spin) {
 
 }  // namespace
 
+namespace {
+
+class OracleJudge final : public CollisionJudge {
+ public:
+  explicit OracleJudge(const ReferenceCollider& oracle) : oracle_(oracle) {}
+  const BoundingBox& environment_bounds() const override { return oracle_.environment_bounds(); }
+  double object_radius() const override { return oracle_.object_radius(); }
+  BoundingBox object_bounds(const Pose& pose) const override { return oracle_.object_bounds(pose); }
+  bool collides(const Pose& pose) override { return oracle_.query(pose).collides; }
+
+ private:
+  const ReferenceCollider& oracle_;
+};
+
+}  // namespace
+
 Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOptions& options,
                                 Progress& progress) {
+  OracleJudge judge(oracle);
+  return generate_billiard_flight(judge, options, progress);
+}
+
+Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& options, Progress& progress) {
   if (options.steps == 0) throw InputError("flight: --steps must be at least 1");
   if (!(options.displacement > 0.0) || !(options.max_rotation >= 0.0))
     throw InputError("flight: displacement must be positive and rotation non-negative");
@@ -93,7 +114,7 @@ Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOpt
     for (int a = 0; a < 3; ++a)
       pose.translation[a] = random.uniform(workspace.lo[a] + radius, workspace.hi[a] - radius);
     pose.rotation = random_rotation(random);
-    found = inside_workspace(oracle.object_bounds(pose), workspace) && !oracle.query(pose).collides;
+    found = inside_workspace(oracle.object_bounds(pose), workspace) && !oracle.collides(pose);
   }
   if (!found)
     throw InputError("flight: no collision-free start placement found in " +
@@ -148,7 +169,7 @@ Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOpt
     }
     boundary_streak = 0;
     const auto start = std::chrono::steady_clock::now();
-    const bool collides = oracle.query(candidate).collides;
+    const bool collides = oracle.collides(candidate);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     const bool last = flight.poses.size() + 1 == options.steps;

@@ -32,6 +32,25 @@ struct Flight {
   std::vector<double> query_seconds;     ///< oracle time per emitted pose
 };
 
+/// What decides a billiard flight's collisions: the reference oracle (exact, in core), or for
+/// models too large for it tetrapage's own exact runtime over an index (RuntimeJudge.h).
+class CollisionJudge {
+ public:
+  virtual ~CollisionJudge() = default;
+  /// The workspace the object stays in.
+  virtual const BoundingBox& environment_bounds() const = 0;
+  /// Radius of the object's bounding sphere around its own origin.
+  virtual double object_radius() const = 0;
+  /// Box of the object placed at `pose` (from all its placed vertices).
+  virtual BoundingBox object_bounds(const Pose& pose) const = 0;
+  virtual bool collides(const Pose& pose) = 0;
+};
+
+/// Generates a billiard flight, `judge` deciding collisions (the same moves for every judge
+/// that gives the same answers).
+Flight generate_billiard_flight(CollisionJudge& judge, const FlightOptions& options,
+                                Progress& progress = Progress::silent());
+
 /// Generates a billiard flight with the reference oracle deciding collisions.
 /// A colliding pose is followed by the exact reverse of the move that led into it, so the
 /// object is back at a free placement the step after; the last pose is collision-free.
