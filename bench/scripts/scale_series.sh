@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# The out-of-core scale series (issue 8): generated assemblies (the study's scene generator at
+# scale, streamed to a manifest of parts) and a terrain, preprocessed, then flown with the
+# study's object sizes under budgets from 64 MiB to everything resident, prefetch on and off.
+# Flights are judged by tetrapage's exact runtime (`generate flight --index`): the in-core oracle
+# would need ~150 B a triangle; the 1M and 10M series check the runtime against it.
+#
+#   bench/scripts/scale_series.sh OUT_DIR [SIZE...]        (default sizes: 1000000 10000000)
+#   OBJECTS="4 15000" STEPS=10000 TERRAIN=10000000 bench/scripts/scale_series.sh out/scale 100000000
+#
+# Writes OUT_DIR/scale.md (Markdown) and OUT_DIR/scale.csv, from the JSON reports beside them.
+set -euo pipefail
+OUT=${1:?usage: scale_series.sh OUT_DIR [SIZE...]}
+shift
+SIZES=${*:-1000000 10000000}
+TETRAPAGE=${TETRAPAGE:-build/tools/tetrapage}
+OBJECTS=${OBJECTS:-4 116 500 2000 5000 15000}
+STEPS=${STEPS:-10000}
+TERRAIN=${TERRAIN:-}           # also a terrain of this many triangles
+MEMORY=${MEMORY:-2G}           # preprocess working memory
+mkdir -p "$OUT"
+
+models=()
+for N in $SIZES; do models+=("scene:$N"); done
+[ -n "$TERRAIN" ] && models+=("terrain:$TERRAIN")
+
+for model in "${models[@]}"; do
+  kind=${model%%:*}; N=${model##*:}; D="$OUT/$kind$N"
+  mkdir -p "$D"
+  if [ ! -f "$D/model.tpi" ]; then
+    if [ "$kind" = scene ]; then
+      [ -f "$D/model.json" ] || "$TETRAPAGE" generate scene --triangles "$N" --seed 1 -o "$D/model.json"
+      input="$D/model.json"
+    else
+      [ -f "$D/model.ply" ] || "$TETRAPAGE" generate terrain --triangles "$N" --seed 1 -o "$D/model.ply"
+      input="$D/model.ply"
+    fi
+    /usr/bin/time -v "$TETRAPAGE" preprocess "$input" -o "$D/model.tpi" --precision double --memory "$MEMORY" \
+      --report "$D/preprocess.json" 2> "$D/preprocess.time"
+  fi
+  "$TETRAPAGE" inspect "$D/model.tpi" --stabbing-segments 0 --report "$D/inspect.json" > /dev/null
+  shard_bytes=$(python3 -c "import json; print(json.load(open('$D/inspect.json'))['shard_decoded_bytes'])")
+  ten_percent=$(( shard_bytes / 10 ))
+  all=$(( shard_bytes + (256 << 20) ))
+  for size in $OBJECTS; do
+    [ -f "$OUT/object$size.ply" ] || "$TETRAPAGE" generate object --triangles "$size" -o "$OUT/object$size.ply" > /dev/null
+    [ -f "$D/flight$size.csv" ] || "$TETRAPAGE" generate flight --index "$D/model.tpi" --memory 1G \
+      --object "$OUT/object$size.ply" --steps "$STEPS" --seed "$size" -o "$D/flight$size.csv" \
+      --answers "$D/answers$size.csv" > /dev/null 2>&1
+    fly() {  # fly NAME MEMORY [flags...]
+      local name=$1 memory=$2; shift 2
+      "$TETRAPAGE" fly "$D/model.tpi" --object "$OUT/object$size.ply" --path "$D/flight$size.csv" \
+        --memory "$memory" --check "$D/answers$size.csv" --report "$D/fly-$name-$size.json" "$@" > /dev/null 2>&1
+    }
+    fly all "$all" --preload
+    fly 10pct "$ten_percent"
+    fly 10pct-noprefetch "$ten_percent" --no-prefetch
+    [ "$ten_percent" -gt $((64 << 20)) ] && fly 64m 64M
+    echo "$kind $N: object $size done" >&2
+  done
+done
+
+python3 - "$OUT" <<'PY'
+import glob, json, os, re, sys
+out = sys.argv[1]
+rows = []
+for d in sorted(glob.glob(f"{out}/*/"), key=lambda p: (re.sub(r"\d", "", os.path.basename(p.rstrip("/"))), int(re.sub(r"\D", "", os.path.basename(p.rstrip("/"))) or 0))):
+    name = os.path.basename(d.rstrip("/"))
+    try:
+        pre = json.load(open(f"{d}/preprocess.json"))
+        ins = json.load(open(f"{d}/inspect.json"))
+    except FileNotFoundError:
+        continue
+    for f in sorted(glob.glob(f"{d}/fly-*.json")):
+        m = re.match(r".*/fly-(.+)-(\d+)\.json", f)
+        run, size = m.group(1), int(m.group(2))
+        r = json.load(open(f))
+        rows.append(dict(model=name, triangles=pre.get("triangles_read", 0), index_bytes=ins.get("file_bytes", 0),
+                         shard_bytes=ins["shard_decoded_bytes"], object=size, run=run, **{k: r[k] for k in (
+                         "steps_per_second", "budget_bytes", "peak_rss_bytes", "page_ins", "bytes_read_per_step",
+                         "cache_hit_rate", "open_to_first_answer_ms", "disagreements", "collisions")},
+                         p50=r["latency_us"]["p50"], p99=r["latency_us"]["p99"], max=r["latency_us"]["max"],
+                         page_p50=r["page_in_latency_us"]["p50"], page_p99=r["page_in_latency_us"]["p99"]))
+order = {"all": 0, "10pct": 1, "10pct-noprefetch": 2, "64m": 3}
+rows.sort(key=lambda r: (r["model"], r["object"], order.get(r["run"], 9)))
+mib = lambda b: b / 2**20
+lines = ["| model | triangles | index MiB | object | run | budget MiB | steps/s | p50 us | p99 us | max us | page-in p50/p99 us | bytes read/step | hit rate | peak RSS MiB | RSS - budget MiB | open to 1st answer ms | disagreements |",
+         "|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
+for r in rows:
+    lines.append(f"| {r['model']} | {r['triangles']:,} | {mib(r['index_bytes']):.0f} | {r['object']} | {r['run']} | {mib(r['budget_bytes']):.0f} | {r['steps_per_second']:.0f} | {r['p50']:.1f} | {r['p99']:.0f} | {r['max']:.0f} | {r['page_p50']:.0f} / {r['page_p99']:.0f} | {r['bytes_read_per_step']:.0f} | {r['cache_hit_rate']:.4f} | {mib(r['peak_rss_bytes']):.0f} | {mib(r['peak_rss_bytes'] - r['budget_bytes']):.0f} | {r['open_to_first_answer_ms']:.1f} | {r['disagreements']} |")
+open(f"{out}/scale.md", "w").write("\n".join(lines) + "\n")
+with open(f"{out}/scale.csv", "w") as f:
+    keys = list(rows[0].keys()) if rows else []
+    f.write(",".join(keys) + "\n")
+    for r in rows: f.write(",".join(str(r[k]) for k in keys) + "\n")
+print("\n".join(lines))
+PY
