@@ -15,7 +15,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -44,9 +43,7 @@
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/ReferenceCollider.h"
 #include "tetrapage/tools/ReportFile.h"
-#include "tetrapage/tools/SceneGenerator.h"
-#include "tetrapage/tools/TerrainGenerator.h"
-#include "tetrapage/tools/TetrasGenerator.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 
 namespace tetrapage {
 namespace {
@@ -74,46 +71,26 @@ struct Options {
 
 struct EnvironmentSpec {
   std::string group, name;
-  std::function<void(MeshWriter&)> generate;
+  EnvironmentKind kind;
+  std::uint64_t triangles, seed;
 };
 
-std::vector<EnvironmentSpec> environments(const Options& o, const MeshLibrary& library) {
+std::vector<EnvironmentSpec> environments(const Options& o) {
   std::vector<EnvironmentSpec> specs;
   auto wants = [&](const std::string& g) { return std::find(o.groups.begin(), o.groups.end(), g) != o.groups.end(); };
-  if (wants("terrains")) {
+  if (wants("terrains"))
     // The study sampled 1201 x 1201 DEMs down to 120 x 120 (28,322 triangles).
-    const std::uint64_t triangles = o.quick ? 2000 : 28322;
     for (std::uint64_t seed : o.quick ? std::vector<std::uint64_t>{1} : std::vector<std::uint64_t>{1, 2, 3})
-      specs.push_back({"terrains", "terrain" + std::to_string(seed), [=](MeshWriter& w) {
-                         TerrainOptions t;
-                         t.triangles = triangles;
-                         t.seed = seed;
-                         generate_terrain(t, w);
-                       }});
-  }
-  if (wants("tetras")) {
-    const std::vector<std::uint64_t> counts =
-        o.quick ? std::vector<std::uint64_t>{25, 250} : std::vector<std::uint64_t>{25, 100, 250, 500, 1000, 2000, 4000, 16000};
-    for (std::uint64_t n : counts)
-      specs.push_back({"tetras", "tetras" + std::to_string(n), [=](MeshWriter& w) {
-                         TetrasOptions t;
-                         t.triangles = 4 * n;
-                         t.seed = n;
-                         generate_tetras(t, w);
-                       }});
-  }
+      specs.push_back({"terrains", "terrain" + std::to_string(seed), EnvironmentKind::terrain, o.quick ? 2000u : 28322u, seed});
+  if (wants("tetras"))
+    for (std::uint64_t n : o.quick ? std::vector<std::uint64_t>{25, 250}
+                                   : std::vector<std::uint64_t>{25, 100, 250, 500, 1000, 2000, 4000, 16000})
+      specs.push_back({"tetras", "tetras" + std::to_string(n), EnvironmentKind::tetras, 4 * n, n});
   if (wants("scenes")) {
     const std::vector<std::uint64_t> sizes =
         o.quick ? std::vector<std::uint64_t>{3000} : std::vector<std::uint64_t>{10000, 20000, 40000};
-    for (std::size_t i = 0; i < sizes.size(); ++i) {
-      const std::uint64_t n = sizes[i];
-      specs.push_back({"scenes", "scene" + std::to_string(n / 1000) + "k", [&library, n, i](MeshWriter& w) {
-                         SceneOptions s;
-                         s.triangles = n;
-                         s.seed = 10 + i;
-                         generate_scene(library, s, w);
-                       }});
-    }
+    for (std::size_t i = 0; i < sizes.size(); ++i)
+      specs.push_back({"scenes", "scene" + std::to_string(sizes[i] / 1000) + "k", EnvironmentKind::scene, sizes[i], 10 + i});
   }
   return specs;
 }
@@ -157,7 +134,7 @@ Environment load_environment(const EnvironmentSpec& spec, const Options& o, cons
   env.file = folder / (spec.name + ".ply");
   if (!fs::exists(env.file)) {
     MeshWriter writer(env.file);
-    spec.generate(writer);
+    generate_environment(spec.kind, spec.triangles, spec.seed, writer);
     writer.commit();
   }
   env.soup = read_mesh(env.file);
@@ -622,7 +599,7 @@ void run(const Options& o) {
     }
     object_files.push_back(path);
   }
-  const auto specs = environments(o, library);
+  const auto specs = environments(o);
   if (specs.empty()) throw InputError("no environment group selected (terrains, tetras, scenes)");
   json report = {{"command", "bench study"}, {"steps", o.steps}, {"quick", o.quick}, {"methods", methods},
                  {"objects", objects}};

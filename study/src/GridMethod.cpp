@@ -55,35 +55,30 @@ class GridMethod final : public StudyMethod {
   std::string parameters() const override { return "N=" + std::to_string(n_); }
 
   bool collides(const PlacedObject& object, StudyCounters& counters) override {
-    ++counters.queries;
     const geometry::Box& box = object.box();
-    if (!geometry::boxes_overlap(box, obstacles_.bounds)) return false;
-    // Phase I: a triangle in a voxel of BB(F) whose box meets BB(F) is a witness.
-    if (!find_witness(box, counters)) return false;
-    ++counters.full_checks;
-    // Phase II: each object triangle against the triangles of the voxels its box meets.
-    const auto triangles = object.triangles();
-    const auto boxes = object.triangle_boxes();
-    for (std::size_t i = 0; i < triangles.size(); ++i) {
-      if (!geometry::boxes_overlap(boxes[i], obstacles_.bounds)) continue;
-      stamps_.next_round();
-      const Range r = cells_of(boxes[i]);
-      for (unsigned z = r.lo[2]; z <= r.hi[2]; ++z)
-        for (unsigned y = r.lo[1]; y <= r.hi[1]; ++y)
-          for (unsigned x = r.lo[0]; x <= r.hi[0]; ++x) {
-            ++counters.cells_visited;
-            const std::size_t c = cell_index(x, y, z);
-            for (std::uint64_t k = offsets_[c]; k < offsets_[c + 1]; ++k) {
-              const std::uint32_t o = cell_triangles_[k];
-              if (!stamps_.first_visit(o) || !geometry::boxes_overlap(obstacles_.boxes[o], box)) continue;
-              if (obstacles_.meets(triangles[i], boxes[i], o, counters)) {
-                ++counters.collisions;
-                return true;
+    return two_phase_check(
+        object, counters,
+        [&](const geometry::Box& b) { return geometry::boxes_overlap(b, obstacles_.bounds) && find_witness(b, counters); },
+        [&](std::size_t i) {
+          // Each object triangle against the triangles of the voxels its box meets.
+          const geometry::Triangle& t = object.triangles()[i];
+          const geometry::Box& t_box = object.triangle_boxes()[i];
+          if (!geometry::boxes_overlap(t_box, obstacles_.bounds)) return false;
+          stamps_.next_round();
+          const Range r = cells_of(t_box);
+          for (unsigned z = r.lo[2]; z <= r.hi[2]; ++z)
+            for (unsigned y = r.lo[1]; y <= r.hi[1]; ++y)
+              for (unsigned x = r.lo[0]; x <= r.hi[0]; ++x) {
+                ++counters.cells_visited;
+                const std::size_t c = cell_index(x, y, z);
+                for (std::uint64_t k = offsets_[c]; k < offsets_[c + 1]; ++k) {
+                  const std::uint32_t o = cell_triangles_[k];
+                  if (!stamps_.first_visit(o) || !geometry::boxes_overlap(obstacles_.boxes[o], box)) continue;
+                  if (obstacles_.meets(t, t_box, o, counters)) return true;
+                }
               }
-            }
-          }
-    }
-    return false;
+          return false;
+        });
   }
 
   StudyStatistics statistics() const override {

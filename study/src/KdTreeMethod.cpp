@@ -44,22 +44,15 @@ class KdTreeMethod final : public StudyMethod {
   }
 
   bool collides(const PlacedObject& object, StudyCounters& counters) override {
-    ++counters.queries;
-    const geometry::Box& box = object.box();
-    if (!geometry::boxes_overlap(box, obstacles_.bounds)) return false;
-    if (!find_witness(0, box, counters)) return false;
-    ++counters.full_checks;
-    const auto triangles = object.triangles();
-    const auto boxes = object.triangle_boxes();
-    for (std::size_t i = 0; i < triangles.size(); ++i) {
-      if (!geometry::boxes_overlap(boxes[i], obstacles_.bounds)) continue;
-      stamps_.next_round();
-      if (test_triangle(0, triangles[i], boxes[i], box, counters)) {
-        ++counters.collisions;
-        return true;
-      }
-    }
-    return false;
+    return two_phase_check(
+        object, counters,
+        [&](const geometry::Box& b) { return geometry::boxes_overlap(b, obstacles_.bounds) && find_witness(0, b, counters); },
+        [&](std::size_t i) {
+          const geometry::Box& t_box = object.triangle_boxes()[i];
+          if (!geometry::boxes_overlap(t_box, obstacles_.bounds)) return false;
+          stamps_.next_round();
+          return test_triangle(0, object.triangles()[i], t_box, object.box(), counters);
+        });
   }
 
   StudyStatistics statistics() const override {

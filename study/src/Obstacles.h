@@ -35,6 +35,22 @@ struct Obstacles {
   }
 };
 
+/// The study's two phases as every box method runs them: phase I, `witness(BB(F))`, looks for an
+/// obstacle triangle whose box meets the object's box; only then phase II, `test(i)`, checks the
+/// object's triangle i against the obstacles near it (true: they meet), up to the first hit.
+template <class Witness, class Test>
+bool two_phase_check(const PlacedObject& object, StudyCounters& counters, Witness&& witness, Test&& test) {
+  ++counters.queries;
+  if (!witness(object.box())) return false;
+  ++counters.full_checks;
+  for (std::size_t i = 0; i < object.triangle_count(); ++i)
+    if (test(i)) {
+      ++counters.collisions;
+      return true;
+    }
+  return false;
+}
+
 /// Marks the obstacles already looked at for one object triangle, so that a triangle stored
 /// in several cells or leaves is tested once: a stamp per obstacle, no clearing between rounds.
 class VisitStamps {

@@ -42,19 +42,11 @@ class RTreeMethod final : public StudyMethod {
   }
 
   bool collides(const PlacedObject& object, StudyCounters& counters) override {
-    ++counters.queries;
-    const geometry::Box& box = object.box();
-    if (!find_witness(0, box, counters)) return false;
-    ++counters.full_checks;
-    const auto triangles = object.triangles();
-    const auto boxes = object.triangle_boxes();
-    for (std::size_t i = 0; i < triangles.size(); ++i) {
-      if (test_triangle(0, triangles[i], boxes[i], box, counters)) {
-        ++counters.collisions;
-        return true;
-      }
-    }
-    return false;
+    return two_phase_check(
+        object, counters, [&](const geometry::Box& b) { return find_witness(0, b, counters); },
+        [&](std::size_t i) {
+          return test_triangle(0, object.triangles()[i], object.triangle_boxes()[i], object.box(), counters);
+        });
   }
 
   StudyStatistics statistics() const override {

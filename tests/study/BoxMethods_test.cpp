@@ -16,9 +16,7 @@
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/Random.h"
-#include "tetrapage/tools/SceneGenerator.h"
-#include "tetrapage/tools/TerrainGenerator.h"
-#include "tetrapage/tools/TetrasGenerator.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 
 namespace tetrapage::study {
 namespace {
@@ -31,48 +29,24 @@ std::vector<geometry::Triangle> triangles_of(const TriangleSoup& soup) {
   return out;
 }
 
-// Writes a generated environment to a file and reads it back, as the benchmark does.
-template <typename Generate>
-std::vector<geometry::Triangle> generated(const std::string& name, Generate generate) {
+// A generated environment written to a file and read back, as the benchmark does.
+std::vector<geometry::Triangle> generated(EnvironmentKind kind, std::uint64_t triangles, std::uint64_t seed) {
   const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / ("study-" + std::to_string(::getpid()));
   fs::create_directories(folder);
-  const fs::path path = folder / (name + ".ply");
+  const fs::path path = folder / (to_string(kind) + ".ply");
   {
     MeshWriter writer(path);
-    generate(writer);
+    generate_environment(kind, triangles, seed, writer);
     writer.commit();
   }
-  auto triangles = triangles_of(read_mesh(path));
+  auto triangles_read = triangles_of(read_mesh(path));
   fs::remove_all(folder);
-  return triangles;
+  return triangles_read;
 }
 
-std::vector<geometry::Triangle> tetras(std::uint64_t triangles) {
-  return generated("tetras", [&](MeshWriter& w) {
-    TetrasOptions o;
-    o.triangles = triangles;
-    o.seed = 3;
-    generate_tetras(o, w);
-  });
-}
-
-std::vector<geometry::Triangle> scene(std::uint64_t triangles) {
-  return generated("scene", [&](MeshWriter& w) {
-    SceneOptions o;
-    o.triangles = triangles;
-    o.seed = 4;
-    generate_scene(MeshLibrary::load_default(), o, w);
-  });
-}
-
-std::vector<geometry::Triangle> terrain(std::uint64_t triangles) {
-  return generated("terrain", [&](MeshWriter& w) {
-    TerrainOptions o;
-    o.triangles = triangles;
-    o.seed = 5;
-    generate_terrain(o, w);
-  });
-}
+std::vector<geometry::Triangle> tetras(std::uint64_t triangles) { return generated(EnvironmentKind::tetras, triangles, 3); }
+std::vector<geometry::Triangle> scene(std::uint64_t triangles) { return generated(EnvironmentKind::scene, triangles, 4); }
+std::vector<geometry::Triangle> terrain(std::uint64_t triangles) { return generated(EnvironmentKind::terrain, triangles, 5); }
 
 bool brute_force(const PlacedObject& object, std::span<const geometry::Triangle> obstacles) {
   for (const auto& t : object.triangles())

@@ -17,13 +17,11 @@
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 #include "tetrapage/study/MeshMethod.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/study/PlacedObject.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/Random.h"
-#include "tetrapage/tools/SceneGenerator.h"
-#include "tetrapage/tools/TerrainGenerator.h"
-#include "tetrapage/tools/TetrasGenerator.h"
 
 namespace tetrapage::study {
 namespace {
@@ -31,51 +29,19 @@ namespace {
 using geometry::Point;
 using geometry::Triangle;
 
-enum class Environment { tetras, terrain, scene };
-
-std::string name_of(Environment e) {
-  switch (e) {
-    case Environment::tetras: return "tetras";
-    case Environment::terrain: return "terrain";
-    case Environment::scene: return "scene";
-  }
-  return "?";
-}
+using Environment = EnvironmentKind;
 
 // Written by the generator and read back, as the command line would see it; under the
 // running test's name, since ctest runs test cases in parallel processes.
-std::vector<Triangle> generate_environment(Environment kind, std::uint64_t triangles, std::uint64_t seed) {
+std::vector<Triangle> environment_triangles(Environment kind, std::uint64_t triangles, std::uint64_t seed) {
   const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
   const auto folder = std::filesystem::path(TETRAPAGE_TEST_TMP) / "mesh_method" /
                       (std::string(test->test_suite_name()) + "." + test->name());
   std::filesystem::create_directories(folder);
-  const auto path = folder / (name_of(kind) + std::to_string(triangles) + "_" + std::to_string(seed) + ".ply");
+  const auto path = folder / (to_string(kind) + std::to_string(triangles) + "_" + std::to_string(seed) + ".ply");
   {
     MeshWriter writer(path);
-    switch (kind) {
-      case Environment::tetras: {
-        TetrasOptions options;
-        options.triangles = triangles;
-        options.seed = seed;
-        generate_tetras(options, writer);
-        break;
-      }
-      case Environment::terrain: {
-        TerrainOptions options;
-        options.triangles = triangles;
-        options.seed = seed;
-        generate_terrain(options, writer);
-        break;
-      }
-      case Environment::scene: {
-        static const MeshLibrary library = MeshLibrary::load_default();
-        SceneOptions options;
-        options.triangles = triangles;
-        options.seed = seed;
-        generate_scene(library, options, writer);
-        break;
-      }
-    }
+    generate_environment(kind, triangles, seed, writer);
     writer.commit();
   }
   const TriangleSoup soup = read_mesh(path);
@@ -184,9 +150,9 @@ class MeshMethodFlight : public ::testing::TestWithParam<FlightCase> {};
 
 TEST_P(MeshMethodFlight, AnswersEqualBruteForce) {
   const auto c = GetParam();
-  const auto obstacles = generate_environment(c.environment, c.triangles, c.seed);
+  const auto obstacles = environment_triangles(c.environment, c.triangles, c.seed);
   const auto method = make_mesh_method(obstacles);
-  print_figures(name_of(c.environment) + " " + std::to_string(obstacles.size()), *method);
+  print_figures(to_string(c.environment) + " " + std::to_string(obstacles.size()), *method);
   const auto stats = method->statistics();
   EXPECT_EQ(method->name(), "mesh");
   EXPECT_EQ(stats.obstacle_triangles, obstacles.size());
@@ -204,7 +170,7 @@ INSTANTIATE_TEST_SUITE_P(Environments, MeshMethodFlight,
                                            FlightCase{Environment::terrain, 800, 3, 4},
                                            FlightCase{Environment::scene, 2000, 4, 116}),
                          [](const auto& test) {
-                           return name_of(test.param.environment) + std::to_string(test.param.triangles) +
+                           return to_string(test.param.environment) + std::to_string(test.param.triangles) +
                                   "_object" + std::to_string(test.param.object_triangles);
                          });
 
@@ -250,7 +216,7 @@ TEST(MeshMethod, TouchingContactsAreExact) {
 // Disjoint tetrahedra: the Steiner rounds reach a conforming mesh, with a finite growth.
 TEST(MeshMethod, DisjointTetrahedraConform) {
   for (std::uint64_t triangles : {100, 400}) {
-    const auto obstacles = generate_environment(Environment::tetras, triangles, 7);
+    const auto obstacles = environment_triangles(Environment::tetras, triangles, 7);
     const auto method = make_mesh_method(obstacles);
     print_figures("tetras " + std::to_string(triangles), *method);
     const auto details = method->statistics().details;
@@ -301,7 +267,7 @@ TEST(MeshMethod, SelfIntersectingInputBuildsAndAnswersExactly) {
 }
 
 TEST(MeshMethod, GridPointsAndLimitsAreHonoured) {
-  const auto obstacles = generate_environment(Environment::terrain, 200, 5);
+  const auto obstacles = environment_triangles(Environment::terrain, 200, 5);
   MeshMethodOptions options;
   options.grid_points = 5;
   options.max_rounds = 3;

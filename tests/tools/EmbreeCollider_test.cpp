@@ -22,14 +22,12 @@
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/EmbreeCollider.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
-#include "tetrapage/tools/SceneGenerator.h"
-#include "tetrapage/tools/TerrainGenerator.h"
-#include "tetrapage/tools/TetrasGenerator.h"
 
 #include "BoxSoup.h"
 
@@ -47,16 +45,7 @@ std::filesystem::path test_folder(const std::string& name) {
   return folder;
 }
 
-enum class Environment { tetras, terrain, scene };
-
-std::string name_of(Environment e) {
-  switch (e) {
-    case Environment::tetras: return "tetras";
-    case Environment::terrain: return "terrain";
-    case Environment::scene: return "scene";
-  }
-  return "?";
-}
+using Environment = EnvironmentKind;
 
 const MeshLibrary& library() {
   static const MeshLibrary meshes = MeshLibrary::load_default();
@@ -64,33 +53,13 @@ const MeshLibrary& library() {
 }
 
 // Written by the generator and read back, as the command line would see it.
-TriangleSoup generate_environment(Environment kind, std::uint64_t seed) {
-  const auto path = test_folder(name_of(kind) + std::to_string(seed)) / "environment.ply";
+TriangleSoup environment_soup(Environment kind, std::uint64_t seed) {
+  const auto path = test_folder(to_string(kind) + std::to_string(seed)) / "environment.ply";
+  // The sizes keep each case's oracle fast.
+  const std::uint64_t triangles = kind == Environment::tetras ? 400 : kind == Environment::terrain ? 800 : 3000;
   {
     MeshWriter writer(path);
-    switch (kind) {
-      case Environment::tetras: {
-        TetrasOptions options;
-        options.triangles = 400;
-        options.seed = seed;
-        generate_tetras(options, writer);
-        break;
-      }
-      case Environment::terrain: {
-        TerrainOptions options;
-        options.triangles = 800;
-        options.seed = seed;
-        generate_terrain(options, writer);
-        break;
-      }
-      case Environment::scene: {
-        SceneOptions options;
-        options.triangles = 3000;
-        options.seed = seed;
-        generate_scene(library(), options, writer);
-        break;
-      }
-    }
+    generate_environment(kind, triangles, seed, writer);
     writer.commit();
   }
   return read_mesh(path);
@@ -163,11 +132,11 @@ struct Case {
 };
 
 void PrintTo(const Case& c, std::ostream* out) {
-  *out << name_of(c.environment) << ", object " << c.object_triangles << " triangles, seed " << c.seed;
+  *out << to_string(c.environment) << ", object " << c.object_triangles << " triangles, seed " << c.seed;
 }
 
 std::string case_name(const ::testing::TestParamInfo<Case>& info) {
-  return name_of(info.param.environment) + "_object" + std::to_string(info.param.object_triangles) + "_seed" +
+  return to_string(info.param.environment) + "_object" + std::to_string(info.param.object_triangles) + "_seed" +
          std::to_string(info.param.seed);
 }
 
@@ -176,7 +145,7 @@ class EmbreeAgainstOracle : public ::testing::TestWithParam<Case> {};
 TEST_P(EmbreeAgainstOracle, SurfacesTouchAgreeOnFlightsAndOnGrazingPoses) {
   const Case c = GetParam();
   SCOPED_TRACE(case_name({c, 0}));
-  const TriangleSoup environment = generate_environment(c.environment, c.seed);
+  const TriangleSoup environment = environment_soup(c.environment, c.seed);
   const TriangleSoup object = generate_flying_object(c.object_triangles);
   const ReferenceCollider oracle(environment, object);
   EmbreeCollider embree(environment, object);
@@ -237,7 +206,7 @@ INSTANTIATE_TEST_SUITE_P(Generated, EmbreeAgainstOracle,
 // puts the object's vertex x on the environment's vertex e whenever x + (e - x) rounds to e.
 // A single shared point; both boxes meet in one corner at most.
 TEST(EmbreeCollider, VertexOnVertexContactsAreSeen) {
-  const TriangleSoup environment = generate_environment(Environment::tetras, 4);
+  const TriangleSoup environment = environment_soup(Environment::tetras, 4);
   const TriangleSoup object = generate_flying_object(4, 0.02);
   const ReferenceCollider oracle(environment, object);
   EmbreeCollider embree(environment, object);
@@ -318,7 +287,7 @@ TEST(EmbreeCollider, FaceContactsAtCoordinatesNoFloatHolds) {
 TEST(EmbreeCollider, DiffersFromTheOracleExactlyWhereOneBodyIsInsideTheOther) {
   const std::uint64_t seed = 5;
   SCOPED_TRACE("seed " + std::to_string(seed));
-  const TriangleSoup environment = generate_environment(Environment::tetras, seed);
+  const TriangleSoup environment = environment_soup(Environment::tetras, seed);
   const TriangleSoup object = generate_flying_object(116, 0.01);
   const ReferenceCollider oracle(environment, object);
   EmbreeCollider embree(environment, object);
@@ -347,7 +316,7 @@ TEST(EmbreeCollider, DiffersFromTheOracleExactlyWhereOneBodyIsInsideTheOther) {
 // The trees may take another shape with another thread count (so may candidate_pairs), but
 // the pairs whose double boxes meet, and those that touch, are the same.
 TEST(EmbreeCollider, AnswersDoNotDependOnEmbreesThreads) {
-  const TriangleSoup environment = generate_environment(Environment::scene, 3);
+  const TriangleSoup environment = environment_soup(Environment::scene, 3);
   const TriangleSoup object = generate_flying_object(116);
   const ReferenceCollider oracle(environment, object);
   EmbreeCollider one(environment, object, 1), all(environment, object);
@@ -405,7 +374,7 @@ CommandResult run_command(const std::string& arguments, const std::filesystem::p
 // steps, on the same flight shifted by one pose (each bounce then lands a step off).
 TEST(EmbreeCollider, ReplayChecksAnswersAndCatchesAShiftedFlight) {
   const auto folder = test_folder("replay");
-  const TriangleSoup environment = generate_environment(Environment::tetras, 6);
+  const TriangleSoup environment = environment_soup(Environment::tetras, 6);
   const TriangleSoup object = generate_flying_object(116);
   write_mesh(folder / "environment.ply", environment);
   write_mesh(folder / "object.ply", object);
