@@ -63,6 +63,8 @@ demo: build
 	@echo "--- paged flight: a shard budget of 8 MiB, well under the index's shards ---"
 	$(TETRAPAGE) fly $(DEMO_DIR)/scene.tpi --object $(DEMO_DIR)/object.ply --path $(DEMO_DIR)/flight.csv \
 	  --memory 8M --check $(DEMO_DIR)/answers.csv --report $(DEMO_DIR)/fly.json
+	$(TETRAPAGE) render $(DEMO_DIR)/scene.tpi -o $(DEMO_DIR)/page-ins.png --path $(DEMO_DIR)/flight.csv \
+	  --object $(DEMO_DIR)/object.ply --color page-ins --memory 8M
 
 bench: build
 	@mkdir -p $(BUILD)/bench-results
