@@ -17,6 +17,8 @@
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
 #include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/Pose.h"
+#include <nlohmann/json.hpp>
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/RuntimeJudge.h"
@@ -265,6 +267,23 @@ TEST(BilliardFlight, TheRuntimeJudgeFliesTheOraclesFlight) {
     ASSERT_EQ(flight.poses[i].translation, expected.poses[i].translation) << "pose " << i;
     ASSERT_EQ(flight.poses[i].rotation, expected.poses[i].rotation) << "pose " << i;
   }
+
+  // `fly --preload`, the all-resident reference of the scale series: no page-in during the
+  // flight, the oracle's answers; refused when the shards exceed the budget.
+  write_poses(folder / "flight.csv", flight.poses);
+  write_answers(folder / "answers.csv", expected.collides);
+  write_mesh(folder / "object.ply", object);
+  const std::string fly = std::string(TETRAPAGE_CLI) + " fly " + (folder / "boxes.tpi").string() + " --object " +
+                          (folder / "object.ply").string() + " --path " + (folder / "flight.csv").string() +
+                          " --check " + (folder / "answers.csv").string() + " --report " +
+                          (folder / "fly.json").string() + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system((fly + " --memory 64M --preload").c_str()), 0);
+  std::ifstream report_file(folder / "fly.json");
+  const auto report = nlohmann::json::parse(report_file);
+  EXPECT_TRUE(report["preloaded"].get<bool>());
+  EXPECT_EQ(report["page_ins"].get<std::uint64_t>(), 0u);
+  EXPECT_EQ(report["cache_hit_rate"].get<double>(), 1.0);
+  EXPECT_NE(std::system((fly + " --memory 1K --preload").c_str()), 0);
   std::filesystem::remove_all(folder);
 }
 
