@@ -44,6 +44,27 @@ constexpr double kPlacementReach = 0x1p-36;
 
 geometry::Point to_point(const Kernel::Point_3& p) { return {p.x(), p.y(), p.z()}; }
 
+// The convex hull of the points as vertices and triangles (outward, coplanar facets
+// triangulated; nothing for fewer than three non-collinear points). Through a Surface_mesh:
+// CGAL 5.5's indexed-triangle-set output crashed on some inputs.
+void hull_of(const std::vector<Kernel::Point_3>& points, std::vector<Kernel::Point_3>& vertices,
+             std::vector<std::array<std::size_t, 3>>& faces) {
+  CGAL::Surface_mesh<Kernel::Point_3> hull;
+  CGAL::convex_hull_3(points.begin(), points.end(), hull);
+  vertices.clear();
+  faces.clear();
+  for (const auto v : hull.vertices()) vertices.push_back(hull.point(v));
+  for (const auto f : hull.faces()) {
+    std::array<std::size_t, 3> corners{};
+    int k = 0;
+    for (const auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) {
+      if (k == 3) break;
+      corners[k++] = std::size_t(v.idx());
+    }
+    if (k == 3) faces.push_back(corners);
+  }
+}
+
 }  // namespace
 
 /// The solid standing for the object in one step: a box, or a convex hull as triangles (CGAL's
@@ -116,7 +137,7 @@ void FlyingObject::prepare_hull_candidates() {
         points.emplace_back(object_.vertices[v][0], object_.vertices[v][1], object_.vertices[v][2]);
   std::vector<Kernel::Point_3> hull_points;
   std::vector<std::array<std::size_t, 3>> faces;
-  if (points.size() >= 4) CGAL::convex_hull_3(points.begin(), points.end(), hull_points, faces);
+  if (points.size() >= 4) hull_of(points, hull_points, faces);
   // Outward unit normals of a hull with volume; a flat or tiny object keeps every vertex.
   std::vector<std::pair<Vec3, double>> planes;
   if (!faces.empty()) {
@@ -196,8 +217,7 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
   solid.points.erase(std::unique(solid.points.begin(), solid.points.end()), solid.points.end());
   solid.hull_points.clear();
   solid.hull_faces.clear();
-  if (solid.points.size() >= 4)
-    CGAL::convex_hull_3(solid.points.begin(), solid.points.end(), solid.hull_points, solid.hull_faces);
+  if (solid.points.size() >= 4) hull_of(solid.points, solid.hull_points, solid.hull_faces);
   for (const auto& f : solid.hull_faces)
     solid.faces.push_back({to_point(solid.hull_points[f[0]]), to_point(solid.hull_points[f[1]]),
                            to_point(solid.hull_points[f[2]])});
