@@ -84,12 +84,12 @@ bench-peers: build
 	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
 	BUILD=$(BUILD) bench/scripts/peers_series.sh $(DEMO_DIR) $(BUILD)/bench-results/peers 8M 3
 
-# Speed against accuracy on the demo's scene and object (double index reused, float built):
+# Speed against accuracy on the demo's scene and object (both indexes built, without interiors):
 # every accuracy x shape x motion x storage on a billiard and a grazing flight, a Pareto plot.
 bench-accuracy: build
 	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
 	$(BUILD)/bench/tetrapage_bench_accuracy --scene $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
-	  --index-double $(DEMO_DIR)/scene.tpi --steps 2000 --out $(BUILD)/bench-results/accuracy
+	  --steps 2000 --out $(BUILD)/bench-results/accuracy
 
 format:
 	find formats runtime preprocess study tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i

@@ -32,8 +32,12 @@ namespace fs = std::filesystem;
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Mesh = CGAL::Surface_mesh<K::Point_3>;
 
-K::Point_3 cgal(const Vec3& p) { return {p[0], p[1], p[2]}; }
-K::Triangle_3 cgal(const std::array<Vec3, 3>& t) { return {cgal(t[0]), cgal(t[1]), cgal(t[2])}; }
+K::Point_3 cgal(const Vec3& p) {
+  return {p[0], p[1], p[2]};
+}
+K::Triangle_3 cgal(const std::array<Vec3, 3>& t) {
+  return {cgal(t[0]), cgal(t[1]), cgal(t[2])};
+}
 
 // The environment's triangles as CGAL sees them, with their boxes.
 struct Environment {
@@ -52,7 +56,8 @@ bool box_oracle(const Environment& env, const BoundingBox& box) {
   const K::Iso_cuboid_3 cuboid(cgal(box.lo), cgal(box.hi));
   const CGAL::Bbox_3 bbox(box.lo[0], box.lo[1], box.lo[2], box.hi[0], box.hi[1], box.hi[2]);
   for (std::size_t t = 0; t < env.triangles.size(); ++t)
-    if (CGAL::do_overlap(bbox, env.boxes[t]) && CGAL::do_intersect(env.triangles[t], cuboid)) return true;
+    if (CGAL::do_overlap(bbox, env.boxes[t]) && CGAL::do_intersect(env.triangles[t], cuboid))
+      return true;
   return false;
 }
 
@@ -63,7 +68,8 @@ bool hull_oracle(const Environment& env, const std::vector<K::Point_3>& points) 
   std::vector<K::Triangle_3> faces;
   for (const auto f : hull.faces()) {
     std::vector<K::Point_3> corners;
-    for (const auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) corners.push_back(hull.point(v));
+    for (const auto v : CGAL::vertices_around_face(hull.halfedge(f), hull))
+      corners.push_back(hull.point(v));
     faces.emplace_back(corners[0], corners[1], corners[2]);
   }
   const CGAL::Bbox_3 bbox = CGAL::bbox_3(points.begin(), points.end());
@@ -71,7 +77,8 @@ bool hull_oracle(const Environment& env, const std::vector<K::Point_3>& points) 
   for (std::size_t t = 0; t < env.triangles.size(); ++t) {
     if (!CGAL::do_overlap(bbox, env.boxes[t])) continue;
     for (const auto& f : faces)
-      if (CGAL::do_overlap(f.bbox(), env.boxes[t]) && CGAL::do_intersect(f, env.triangles[t])) return true;
+      if (CGAL::do_overlap(f.bbox(), env.boxes[t]) && CGAL::do_intersect(f, env.triangles[t]))
+        return true;
     if (side(env.triangles[t].vertex(0)) != CGAL::ON_UNBOUNDED_SIDE) return true;
   }
   return false;
@@ -162,8 +169,11 @@ TEST(ObjectShapes, ShapesAndMotionsEqualBruteForceOnAGrazingFlight) {
     const bool hull = hull_oracle(env, points);
     if (!first) add_placed(object, grazing.poses[i - 1], points);
     const bool swept_hull = first ? hull : hull_oracle(env, points);
-    const bool expected[] = {bool(grazing.collides[i]), hull, box_oracle(env, box),
-                             first ? bool(grazing.collides[i]) : swept_hull, swept_hull,
+    const bool expected[] = {bool(grazing.collides[i]),
+                             hull,
+                             box_oracle(env, box),
+                             first ? bool(grazing.collides[i]) : swept_hull,
+                             swept_hull,
                              box_oracle(env, swept_box)};
     previous_box = box;
     bool got[std::size(kSettings)];
@@ -173,22 +183,25 @@ TEST(ObjectShapes, ShapesAndMotionsEqualBruteForceOnAGrazingFlight) {
       options.motion = kSettings[s].motion;
       got[s] = flying[s].query(pose, options).collides;
       if (got[s] != expected[s] && ++differences[s] <= 3)
-        ADD_FAILURE() << kSettings[s].name << ": pose " << i << " runtime " << got[s] << " oracle " << expected[s];
+        ADD_FAILURE() << kSettings[s].name << ": pose " << i << " runtime " << got[s] << " oracle "
+                      << expected[s];
     }
     // The orderings of the exact answers: mesh => hull => box, discrete => swept.
     EXPECT_TRUE(!got[0] || got[1]) << "pose " << i;
     EXPECT_TRUE(!got[1] || got[2]) << "pose " << i;
     EXPECT_TRUE(!got[3] || got[4]) << "pose " << i;
     EXPECT_TRUE(!got[4] || got[5]) << "pose " << i;
-    for (int s = 0; s < 3; ++s) EXPECT_TRUE(!got[s] || got[s + 3]) << kSettings[s].name << " pose " << i;
+    for (int s = 0; s < 3; ++s)
+      EXPECT_TRUE(!got[s] || got[s + 3]) << kSettings[s].name << " pose " << i;
     hull_only += got[1] && !got[0];
     box_only += got[2] && !got[1];
     swept_only += got[4] && !got[1];
   }
   std::printf("%zu grazing poses (%llu colliding): hull only %zu, box only %zu, swept only %zu\n",
-              grazing.poses.size(), static_cast<unsigned long long>(grazing.collisions), hull_only, box_only,
-              swept_only);
-  for (std::size_t s = 0; s < std::size(kSettings); ++s) EXPECT_EQ(differences[s], 0u) << kSettings[s].name;
+              grazing.poses.size(), static_cast<unsigned long long>(grazing.collisions), hull_only,
+              box_only, swept_only);
+  for (std::size_t s = 0; s < std::size(kSettings); ++s)
+    EXPECT_EQ(differences[s], 0u) << kSettings[s].name;
   // The coarser questions really are coarser on this flight (else the test checks little).
   EXPECT_GT(hull_only, 0u);
   EXPECT_GT(box_only, 0u);
@@ -211,8 +224,10 @@ TEST(ObjectShapes, ATouchingVertexCountsForEveryShapeAndAGapForNone) {
   const auto index = std::make_shared<const CollisionIndex>(preprocess_double(scene_path));
   // An octahedron whose lowest vertex is (0, 0, -0.0625).
   TriangleSoup object;
-  object.vertices = {{0.0625, 0, 0}, {-0.0625, 0, 0}, {0, 0.0625, 0}, {0, -0.0625, 0}, {0, 0, 0.0625}, {0, 0, -0.0625}};
-  object.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  object.vertices = {{0.0625, 0, 0},  {-0.0625, 0, 0}, {0, 0.0625, 0},
+                     {0, -0.0625, 0}, {0, 0, 0.0625},  {0, 0, -0.0625}};
+  object.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                      {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   object.part_of.assign(object.triangles.size(), 0);
   object.part_names = {"octahedron"};
   Pose touching;  // the identity rotation places exactly: the vertex lands on z = 0
@@ -227,7 +242,8 @@ TEST(ObjectShapes, ATouchingVertexCountsForEveryShapeAndAGapForNone) {
     EXPECT_FALSE(flying.query(apart, options).collides) << setting.name << " apart (first query)";
     EXPECT_TRUE(flying.query(touching, options).collides) << setting.name << " touching";
     // Swept from the touching pose to the free one still touches; discrete does not.
-    EXPECT_EQ(flying.query(apart, options).collides, setting.motion == Motion::swept) << setting.name << " after";
+    EXPECT_EQ(flying.query(apart, options).collides, setting.motion == Motion::swept)
+        << setting.name << " after";
     const QueryResult result = flying.query(touching, options);
     ASSERT_TRUE(result.collides);
     EXPECT_EQ(result.contacts.front().object_triangle == Contact::kNoObjectTriangle,
