@@ -14,7 +14,7 @@ DEB_PACKAGES := cmake make g++ pkg-config \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
   libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev
 
-.PHONY: deps configure build test sanitize demo bench bench-study bench-peers clean format
+.PHONY: deps configure build test sanitize demo bench bench-study bench-peers bench-accuracy clean format
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -85,6 +85,13 @@ bench-study: build
 bench-peers: build
 	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
 	BUILD=$(BUILD) bench/scripts/peers_series.sh $(DEMO_DIR) $(BUILD)/bench-results/peers 8M 3
+
+# Speed against accuracy on the demo's scene and object (both indexes built, without interiors):
+# every accuracy x shape x motion x storage on a billiard and a grazing flight, a Pareto plot.
+bench-accuracy: build
+	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
+	$(BUILD)/bench/tetrapage_bench_accuracy --scene $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
+	  --steps 2000 --out $(BUILD)/bench-results/accuracy
 
 format:
 	find formats runtime preprocess study tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i

@@ -237,6 +237,14 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
 tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
                                  tetrapage_accuracy accuracy, double parameter, int all_contacts,
                                  int* collides) {
+  return tetrapage_query_shaped(object, pose, accuracy, parameter, TETRAPAGE_SHAPE_MESH,
+                                TETRAPAGE_MOTION_DISCRETE, all_contacts, collides);
+}
+
+tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double pose[7],
+                                        tetrapage_accuracy accuracy, double parameter,
+                                        tetrapage_object_shape shape, tetrapage_motion motion,
+                                        int all_contacts, int* collides) {
   if (collides) *collides = 0;
   if (object) object->has_result = false;
   return guarded(__func__, [&] {
@@ -245,6 +253,17 @@ tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
     require(collides, "collides");
     tetrapage::QueryOptions options;
     options.accuracy = to_accuracy(accuracy, parameter);
+    switch (shape) {
+      case TETRAPAGE_SHAPE_MESH: options.shape = tetrapage::ObjectShape::mesh; break;
+      case TETRAPAGE_SHAPE_HULL: options.shape = tetrapage::ObjectShape::hull; break;
+      case TETRAPAGE_SHAPE_BOX: options.shape = tetrapage::ObjectShape::box; break;
+      default: throw tetrapage::InputError("unknown object shape " + std::to_string(int(shape)));
+    }
+    switch (motion) {
+      case TETRAPAGE_MOTION_DISCRETE: options.motion = tetrapage::Motion::discrete; break;
+      case TETRAPAGE_MOTION_SWEPT: options.motion = tetrapage::Motion::swept; break;
+      default: throw tetrapage::InputError("unknown motion " + std::to_string(int(motion)));
+    }
     options.mode = all_contacts ? tetrapage::QueryMode::all_contacts : tetrapage::QueryMode::first_hit;
     tetrapage::Pose placed;
     placed.translation = {pose[0], pose[1], pose[2]};

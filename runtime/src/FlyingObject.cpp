@@ -12,7 +12,9 @@
 #include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/runtime/geometry/SegmentTriangle.h"
+#include "tetrapage/runtime/geometry/TriangleBox.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 
 namespace tetrapage {
@@ -35,7 +37,50 @@ Vec3 centre_in_mesh_box(const geometry::Box& box, const CollisionIndex& index) {
 // Hill-climbing pays off on objects with many hull vertices; tiny ones are placed whole.
 constexpr std::size_t kHillClimbMinimum = 32;
 
+// How far the placement (apply_pose) may move a vertex, relative to the object's radius plus
+// the translation's magnitude, taken far beyond the few ulps it really moves: a vertex deeper
+// inside the object's hull than this cannot reach the hull of the placed hull vertices.
+constexpr double kPlacementReach = 0x1p-36;
+
+geometry::Point to_point(const Kernel::Point_3& p) { return {p.x(), p.y(), p.z()}; }
+
+// The convex hull of the points as vertices and triangles (outward, coplanar facets
+// triangulated; nothing for fewer than three non-collinear points). Through a Surface_mesh:
+// CGAL 5.5's indexed-triangle-set output crashed on some inputs.
+void hull_of(const std::vector<Kernel::Point_3>& points, std::vector<Kernel::Point_3>& vertices,
+             std::vector<std::array<std::size_t, 3>>& faces) {
+  CGAL::Surface_mesh<Kernel::Point_3> hull;
+  CGAL::convex_hull_3(points.begin(), points.end(), hull);
+  vertices.clear();
+  faces.clear();
+  for (const auto v : hull.vertices()) vertices.push_back(hull.point(v));
+  for (const auto f : hull.faces()) {
+    std::array<std::size_t, 3> corners{};
+    int k = 0;
+    for (const auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) {
+      if (k == 3) break;
+      corners[k++] = std::size_t(v.idx());
+    }
+    if (k == 3) faces.push_back(corners);
+  }
+}
+
 }  // namespace
+
+/// The solid standing for the object in one step: a box, or a convex hull as triangles (CGAL's
+/// hull, outward, coplanar facets triangulated) with the orient3d sign of outside points.
+struct FlyingObject::Solid {
+  enum class Kind : std::uint8_t { box, hull } kind = Kind::box;
+  bool built = false;
+  geometry::Box box;  ///< box: the solid; hull: the hull's box
+  std::vector<geometry::Triangle> faces;
+  std::vector<geometry::Box> face_boxes;
+  /// zero for a flat hull (no inside: only its faces count)
+  geometry::Sign outside = geometry::Sign::zero;
+  // Scratch of the hull construction.
+  std::vector<Kernel::Point_3> points, hull_points;
+  std::vector<std::array<std::size_t, 3>> hull_faces;
+};
 
 FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
     : index_(std::move(index)), object_(std::move(object)), bvh_(object_) {
@@ -80,6 +125,139 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, Triangle
     // No usable hull: every vertex, no graph (world_box scans them all).
     for (const auto& [point, id] : id_of) hull_vertices_.push_back(id);
   }
+}
+
+void FlyingObject::prepare_hull_candidates() {
+  hull_candidates_ready_ = true;
+  std::vector<Kernel::Point_3> points;
+  std::map<std::array<double, 3>, std::uint32_t> id_of;
+  for (const auto& t : object_.triangles)
+    for (const auto v : t)
+      if (id_of.emplace(object_.vertices[v], v).second)
+        points.emplace_back(object_.vertices[v][0], object_.vertices[v][1], object_.vertices[v][2]);
+  std::vector<Kernel::Point_3> hull_points;
+  std::vector<std::array<std::size_t, 3>> faces;
+  if (points.size() >= 4) hull_of(points, hull_points, faces);
+  // Outward unit normals of a hull with volume; a flat or tiny object keeps every vertex.
+  std::vector<std::pair<Vec3, double>> planes;
+  if (!faces.empty()) {
+    Vec3 centre{0, 0, 0};
+    for (const auto& p : hull_points)
+      for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
+    for (const auto& f : faces) {
+      const geometry::Point a = to_point(hull_points[f[0]]), b = to_point(hull_points[f[1]]),
+                            c = to_point(hull_points[f[2]]);
+      const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+      Vec3 n{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+      if (!(length > 0)) continue;
+      for (auto& x : n) x /= length;
+      double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+      if (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2] > offset) {
+        for (auto& x : n) x = -x;
+        offset = -offset;
+      }
+      planes.push_back({n, offset});
+    }
+  }
+  std::vector<bool> on_hull(object_.vertices.size(), false);
+  for (const auto& p : hull_points) {
+    const std::uint32_t id = id_of.at({p.x(), p.y(), p.z()});
+    on_hull[id] = true;
+    hull_candidates_.push_back(id);
+  }
+  for (const auto& [point, id] : id_of) {
+    if (on_hull[id]) continue;
+    // The distance to the hull's boundary: the nearest facet plane (0 without a 3D hull).
+    double depth = planes.empty() ? 0.0 : 1e300;
+    for (const auto& [n, offset] : planes)
+      depth = std::min(depth, offset - (n[0] * point[0] + n[1] * point[1] + n[2] * point[2]));
+    near_hull_.emplace_back(std::max(depth, 0.0), id);
+  }
+  std::sort(near_hull_.begin(), near_hull_.end());
+}
+
+void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
+  solid.built = true;
+  solid.faces.clear();
+  solid.face_boxes.clear();
+  solid.outside = geometry::Sign::zero;
+  const bool swept = options.motion == Motion::swept && previous_valid_;
+  if (options.shape == ObjectShape::box) {
+    solid.kind = Solid::Kind::box;
+    solid.box = current_box_;
+    if (swept) solid.box.extend(previous_box_);
+    return;
+  }
+  solid.kind = Solid::Kind::hull;
+  if (!hull_candidates_ready_) prepare_hull_candidates();
+  // The hull candidates at each pose: the object's hull vertices and the vertices within the
+  // placement's reach of its surface.
+  auto magnitude = [&](const Vec3& t) {
+    return object_radius_ + std::max({std::fabs(t[0]), std::fabs(t[1]), std::fabs(t[2])});
+  };
+  double reach = magnitude(translation_);
+  if (swept) reach = std::max(reach, magnitude(previous_translation_));
+  reach *= kPlacementReach;
+  solid.points.clear();
+  auto add_pose = [&](bool current) {
+    auto add = [&](std::uint32_t v) {
+      const Vec3 p = current ? world_vertex(v) : apply_pose(previous_rotation_, previous_translation_, object_.vertices[v]);
+      solid.points.emplace_back(p[0], p[1], p[2]);
+    };
+    for (const auto v : hull_candidates_) add(v);
+    for (const auto& [depth, v] : near_hull_) {
+      if (depth > reach) break;
+      add(v);
+    }
+  };
+  add_pose(true);
+  if (swept) add_pose(false);
+  std::sort(solid.points.begin(), solid.points.end());
+  solid.points.erase(std::unique(solid.points.begin(), solid.points.end()), solid.points.end());
+  solid.hull_points.clear();
+  solid.hull_faces.clear();
+  if (solid.points.size() >= 4) hull_of(solid.points, solid.hull_points, solid.hull_faces);
+  for (const auto& f : solid.hull_faces)
+    solid.faces.push_back({to_point(solid.hull_points[f[0]]), to_point(solid.hull_points[f[1]]),
+                           to_point(solid.hull_points[f[2]])});
+  if (solid.faces.empty()) {
+    // Fewer than four points, or no hull: the placed triangles stand for themselves.
+    for (std::uint32_t t = 0; t < object_.triangle_count(); ++t) solid.faces.push_back(world_triangle(t));
+  } else {
+    // CGAL orients every facet the same way: the first vertex off facet 0 names the inside.
+    const auto& f = solid.faces[0];
+    for (const auto& p : solid.hull_points) {
+      const geometry::Sign s = geometry::orient3d(f[0], f[1], f[2], to_point(p));
+      if (s != geometry::Sign::zero) {
+        solid.outside = -s;
+        break;
+      }
+    }
+  }
+  solid.box = {};
+  for (const auto& face : solid.faces) {
+    solid.face_boxes.push_back(geometry::box_of(face));
+    solid.box.extend(solid.face_boxes.back());
+  }
+}
+
+bool FlyingObject::solid_collides(const Solid& solid, const geometry::Triangle& environment,
+                                  const geometry::Accuracy& accuracy, double reach) {
+  if (solid.kind == Solid::Kind::box) return geometry::triangle_collides_with_box(environment, solid.box, accuracy);
+  geometry::Box near = geometry::box_of(environment);
+  if (reach > 0) near = geometry::inflated(near, reach);
+  if (!geometry::boxes_overlap(near, solid.box)) return false;
+  for (std::size_t i = 0; i < solid.faces.size(); ++i)
+    if (geometry::boxes_overlap(near, solid.face_boxes[i]) &&
+        geometry::triangles_collide(environment, solid.faces[i], accuracy))
+      return true;
+  // No surface contact: the triangle lies wholly inside or wholly outside; one vertex decides,
+  // exactly whatever the accuracy.
+  if (solid.outside == geometry::Sign::zero || !geometry::box_contains(solid.box, environment[0])) return false;
+  for (const auto& f : solid.faces)
+    if (geometry::orient3d(f[0], f[1], f[2], environment[0]) == solid.outside) return false;
+  return true;
 }
 
 FlyingObject::~FlyingObject() = default;
@@ -271,9 +449,27 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
 
   auto start = Clock::now();
   geometry::Box box = world_box(pose);
+  current_box_ = box;
+  // Whatever way this query leaves, its pose is the next one's previous pose (swept motion).
+  struct RememberPose {
+    FlyingObject& object;
+    ~RememberPose() {
+      object.previous_valid_ = true;
+      object.previous_rotation_ = object.rotation_;
+      object.previous_translation_ = object.translation_;
+      object.previous_box_ = object.current_box_;
+    }
+  } remember{*this};
+  // The object as a solid (hull or box, or swept between the poses), or as its mesh.
+  const bool swept = options.motion == Motion::swept && previous_valid_;
+  const bool solid_query = options.shape != ObjectShape::mesh || swept;
+  // The phase I box covers both poses of a swept step.
+  if (swept) box.extend(previous_box_);
   // Environment triangles within the accuracy's reach of the object count: grow the box.
   const double reach = geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
-  if (reach > 0)
+  if (solid_query)
+    box = reach > 0 ? geometry::inflated(box, reach) : box;  // covers the solid box's own growth
+  else if (reach > 0)
     for (int a = 0; a < 3; ++a) box.lo[a] -= reach, box.hi[a] += reach;
   result.world_box = box;
   counters.locate_seconds = seconds_since(start);
@@ -295,6 +491,11 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // Phase I and II over the region's shards whose bounds meet the box.
   const bool all = options.mode == QueryMode::all_contacts;
   bool stop = false;
+  // The object's own box prunes in its frame while the question is about the current pose's
+  // object or its hull (both inside that box), not for its world box or a swept solid.
+  const bool own_frame = !solid_query || (options.shape == ObjectShape::hull && !swept);
+  if (!solid_) solid_ = std::make_unique<Solid>();
+  solid_->built = false;
   // The object's own box (grown by the reach), to prune R-tree nodes and triangles in its
   // frame: for a rotated object it is much tighter than the world box.
   geometry::Point own_centre, own_half;
@@ -308,6 +509,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // its half extents through |R| (separating axes of the object's frame); the roundings are
   // covered by a margin far beyond them. Conservative: it only prunes.
   auto meets_own_box = [&](const geometry::Box& b) {
+    if (!own_frame) return true;
     Vec3 c, h;
     for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
     const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
@@ -334,8 +536,20 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
       const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-      if (!geometry::boxes_overlap(query, object_box_) || !geometry::triangle_intersects_box(environment, box)) return;
+      if ((own_frame && !geometry::boxes_overlap(query, object_box_)) ||
+          !geometry::triangle_intersects_box(environment, box))
+        return;
       ++counters.candidates;
+      if (solid_query) {
+        if (!solid_->built) build_solid(options, *solid_);
+        ++counters.triangle_tests;
+        if (!solid_collides(*solid_, environment, options.accuracy, reach)) return;
+        result.collides = true;
+        if (all || result.contacts.empty())
+          result.contacts.push_back({shard.part_id(local), shard.triangle_id(local), Contact::kNoObjectTriangle});
+        if (!all) stop = true;
+        return;
+      }
       if (closed_ && !result.collides && geometry::box_contains(box, environment[0]) &&
           geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
           in_object_box(environment[0]))

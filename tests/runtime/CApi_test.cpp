@@ -396,6 +396,34 @@ TEST_F(CApiTest, InvalidPosesAndAccuraciesAreInputErrorsAndClearTheContacts) {
   tetrapage_object_destroy(object);
 }
 
+TEST_F(CApiTest, ShapedQueriesCollideWhereTheMeshDoesAndRejectUnknownShapes) {
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  const double touching[7] = {1.5, 0.75, 0.75, 1, 0, 0, 0};
+  int collides = -1;
+  for (const auto shape : {TETRAPAGE_SHAPE_MESH, TETRAPAGE_SHAPE_HULL, TETRAPAGE_SHAPE_BOX})
+    for (const auto motion : {TETRAPAGE_MOTION_DISCRETE, TETRAPAGE_MOTION_SWEPT}) {
+      ASSERT_EQ(tetrapage_query_shaped(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, shape, motion, 0, &collides),
+                TETRAPAGE_OK);
+      EXPECT_EQ(collides, 1) << int(shape) << " " << int(motion);  // coarser shapes hold the object
+      tetrapage_contact contact{};
+      std::size_t written = 0;
+      ASSERT_EQ(tetrapage_get_contacts(object, &contact, 1, &written), TETRAPAGE_OK);
+      ASSERT_EQ(written, 1u);
+      // Solids name no object triangle (the second query of the loop sweeps).
+      EXPECT_EQ(contact.object_triangle == UINT32_MAX, shape != TETRAPAGE_SHAPE_MESH || motion == TETRAPAGE_MOTION_SWEPT);
+    }
+  EXPECT_EQ(tetrapage_query_shaped(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, static_cast<tetrapage_object_shape>(7),
+                                   TETRAPAGE_MOTION_DISCRETE, 0, &collides),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(collides, 0);
+  EXPECT_EQ(tetrapage_query_shaped(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, TETRAPAGE_SHAPE_MESH,
+                                   static_cast<tetrapage_motion>(9), 0, &collides),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("9"), std::string::npos) << tetrapage_last_error();
+  tetrapage_object_destroy(object);
+}
+
 TEST_F(CApiTest, ParseAccuracyFollowsTheCommandLineSyntax) {
   tetrapage_accuracy accuracy = TETRAPAGE_ACCURACY_EXACT;
   double parameter = -1;

@@ -1,6 +1,8 @@
 #include "tetrapage/tools/FlightGenerator.h"
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <string>
 
@@ -190,6 +192,70 @@ Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& opt
     pose = candidate;
   }
   progress.finish();
+  return flight;
+}
+
+Flight generate_grazing_flight(const ReferenceCollider& oracle, const Flight& billiard,
+                               const GrazingOptions& options) {
+  Flight flight;
+  const double radius = oracle.object_radius();
+  // The pose at s in [0, 1] between a and b: translation and quaternion interpolated linearly,
+  // the quaternion normalised (the shorter arc).
+  auto between = [](const Pose& a, const Pose& b, double s) {
+    Pose p;
+    for (int k = 0; k < 3; ++k) p.translation[k] = a.translation[k] + s * (b.translation[k] - a.translation[k]);
+    double dot = 0;
+    for (int k = 0; k < 4; ++k) dot += a.rotation[k] * b.rotation[k];
+    const double sign = dot < 0 ? -1.0 : 1.0;
+    double n = 0;
+    for (int k = 0; k < 4; ++k) {
+      p.rotation[k] = a.rotation[k] + s * (sign * b.rotation[k] - a.rotation[k]);
+      n += p.rotation[k] * p.rotation[k];
+    }
+    n = std::sqrt(n);
+    for (int k = 0; k < 4; ++k) p.rotation[k] /= n;
+    return p;
+  };
+  auto add = [&](const Pose& pose, bool collides) {
+    flight.poses.push_back(pose);
+    flight.collides.push_back(collides ? 1 : 0);
+    flight.collisions += collides ? 1 : 0;
+  };
+  std::vector<double> distances = options.distances;
+  std::sort(distances.begin(), distances.end(), std::greater<>());
+  for (std::size_t i = 1; i < billiard.poses.size(); ++i) {
+    if (!billiard.collides[i] || billiard.collides[i - 1]) continue;
+    const Pose& a = billiard.poses[i - 1];
+    const Pose& b = billiard.poses[i];
+    double move = 0, dot = 0;
+    for (int k = 0; k < 3; ++k) move += (b.translation[k] - a.translation[k]) * (b.translation[k] - a.translation[k]);
+    for (int k = 0; k < 4; ++k) dot += a.rotation[k] * b.rotation[k];
+    const double angle = 2 * std::acos(std::min(1.0, std::fabs(dot)));
+    move = std::sqrt(move) + angle * radius;
+    if (!(move > 0)) continue;
+    double lo = 0, hi = 1;
+    std::vector<double> free_side, colliding_side;
+    for (const double d : distances) {
+      while ((hi - lo) * move > d && hi - lo > 1e-15) {
+        const double mid = 0.5 * (lo + hi);
+        (oracle.query(between(a, b, mid)).collides ? hi : lo) = mid;
+      }
+      free_side.push_back(lo);
+      colliding_side.push_back(hi);
+    }
+    // The oracle's own answer for every emitted pose (a renormalised quaternion is not the
+    // one bisected on).
+    add(a, false);
+    for (const double s : free_side) {
+      const Pose p = between(a, b, s);
+      add(p, oracle.query(p).collides);
+    }
+    for (auto it = colliding_side.rbegin(); it != colliding_side.rend(); ++it) {
+      const Pose p = between(a, b, *it);
+      add(p, oracle.query(p).collides);
+    }
+    add(b, true);
+  }
   return flight;
 }
 

@@ -156,7 +156,34 @@ tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
                                  tetrapage_accuracy accuracy, double parameter, int all_contacts,
                                  int* collides);
 
-/* One contact: an environment triangle (its part and model-wide id) and an object triangle. */
+/* How finely the object is checked (the C++ ObjectShape): its triangles; the convex hull of
+   its placed vertices as a solid; its world axis-aligned box as a solid. Coarser shapes never
+   miss a contact of the finer ones under the exact accuracy, and answer yes more often. */
+typedef enum tetrapage_object_shape {
+  TETRAPAGE_SHAPE_MESH = 0,
+  TETRAPAGE_SHAPE_HULL = 1,
+  TETRAPAGE_SHAPE_BOX = 2
+} tetrapage_object_shape;
+
+/* The pose alone, or the convex hull of the object at the previous and the current pose (the
+   box of both boxes for TETRAPAGE_SHAPE_BOX; there is no exact swept mesh: MESH sweeps the
+   hull). An object's first query has no previous pose and is discrete. */
+typedef enum tetrapage_motion {
+  TETRAPAGE_MOTION_DISCRETE = 0,
+  TETRAPAGE_MOTION_SWEPT = 1
+} tetrapage_motion;
+
+/* tetrapage_query with the object's shape and motion chosen (tetrapage_query is
+   TETRAPAGE_SHAPE_MESH, TETRAPAGE_MOTION_DISCRETE). Contacts of a solid (hull, box, swept)
+   name the environment triangle and UINT32_MAX as the object triangle.
+   Errors: as tetrapage_query; TETRAPAGE_ERROR_INPUT for an unknown shape or motion. */
+tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double pose[7],
+                                        tetrapage_accuracy accuracy, double parameter,
+                                        tetrapage_object_shape shape, tetrapage_motion motion,
+                                        int all_contacts, int* collides);
+
+/* One contact: an environment triangle (its part and model-wide id) and an object triangle
+   (UINT32_MAX when the object was checked as a solid). */
 typedef struct tetrapage_contact {
   uint64_t environment_triangle;
   uint32_t environment_part;

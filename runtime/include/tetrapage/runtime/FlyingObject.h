@@ -10,8 +10,10 @@
 ///     placement), so that the exact mode answers exactly what an exact oracle answers.
 /// One FlyingObject is used from one thread at a time; many may share a CollisionIndex.
 
+#include <array>
 #include <cstdint>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "tetrapage/formats/Pose.h"
@@ -25,13 +27,45 @@ namespace tetrapage {
 
 enum class QueryMode : std::uint8_t { first_hit, all_contacts };
 
+/// How finely phase II represents the object (DESIGN.md: "the object is represented only as
+/// finely as the chosen accuracy needs"). Coarser shapes are supersets of the object, so under
+/// the exact accuracy they never miss a contact of the mesh (mesh => hull => box), and answer
+/// yes more often: in the hull's concavities, in the box's corners.
+enum class ObjectShape : std::uint8_t {
+  /// Its triangles, and for a closed object its inside: the question ReferenceCollider answers.
+  mesh,
+  /// The convex hull of its placed vertices, as a solid: an environment triangle collides when
+  /// it meets the hull's surface or lies inside it. A few hundred faces stand for the object's
+  /// triangles, and no containment test is needed.
+  hull,
+  /// Its world axis-aligned box (world_box), as a solid: one exact triangle/box test per
+  /// candidate, the cheapest and coarsest question.
+  box,
+};
+
+/// Whether a step checks the pose alone or the motion that led to it.
+enum class Motion : std::uint8_t {
+  /// The pose alone: a fast object can jump through a thin obstacle between two steps.
+  discrete,
+  /// The convex hull of the object's placed vertices at the previous and the current pose, as a
+  /// solid (the study's section 5, item 1): it holds the object at both poses and, for a
+  /// translation between them, every pose in between. There is no exact swept mesh: with
+  /// shape mesh or hull, swept checks this swept hull; with shape box, the box of both world
+  /// boxes. The first query of a FlyingObject has no previous pose and is discrete.
+  swept,
+};
+
 struct QueryOptions {
   geometry::Accuracy accuracy = geometry::Accuracy::exact();
   QueryMode mode = QueryMode::first_hit;
+  ObjectShape shape = ObjectShape::mesh;
+  Motion motion = Motion::discrete;
 };
 
-/// One contact: an environment triangle (its part and model-wide id) and an object triangle.
+/// One contact: an environment triangle (its part and model-wide id) and an object triangle
+/// (kNoObjectTriangle when the object was checked as a solid: hull, box, or swept).
 struct Contact {
+  static constexpr std::uint32_t kNoObjectTriangle = 0xffffffffu;
   std::uint32_t environment_part = 0;
   std::uint64_t environment_triangle = 0;
   std::uint32_t object_triangle = 0;
@@ -121,6 +155,13 @@ class FlyingObject {
   // only prune with it, with margins far beyond the rounding).
   Vec3 to_object_frame(const geometry::Point& p) const;
   geometry::Triangle world_triangle(std::uint32_t t);
+  // The solid that stands for the object in this step (shape hull or box, or swept), built on
+  // the first candidate that needs it; does an environment triangle collide with it?
+  struct Solid;
+  void prepare_hull_candidates();
+  void build_solid(const QueryOptions& options, Solid& solid);
+  static bool solid_collides(const Solid& solid, const geometry::Triangle& environment,
+                             const geometry::Accuracy& accuracy, double reach);
 
   std::shared_ptr<const CollisionIndex> index_;
   TriangleSoup object_;
@@ -136,6 +177,20 @@ class FlyingObject {
   std::vector<std::uint32_t> hull_vertices_;
   std::vector<std::uint32_t> hull_offsets_, hull_neighbours_;  // indices into hull_vertices_
   std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
+  // The solids' vertex candidates (prepared on the first hull or swept query): the vertices of
+  // the object's own hull, then the other vertices by their depth inside it (ascending). A
+  // vertex deeper than the placement's rounding stays inside the hull of the placed
+  // candidates, so the hull of the placed candidates is the hull of all placed vertices.
+  bool hull_candidates_ready_ = false;
+  std::vector<std::uint32_t> hull_candidates_;
+  std::vector<std::pair<double, std::uint32_t>> near_hull_;
+  // The previous query's pose and world box (before the accuracy's growth), for swept motion.
+  bool previous_valid_ = false;
+  std::array<double, 9> previous_rotation_{};
+  Vec3 previous_translation_{};
+  geometry::Box previous_box_;
+  geometry::Box current_box_;  ///< this query's world box, before the accuracy's growth
+  std::unique_ptr<Solid> solid_;  ///< per-step scratch
 
   // Per-step state.
   std::array<double, 9> rotation_{};

@@ -59,4 +59,17 @@ Flight generate_billiard_flight(CollisionJudge& judge, const FlightOptions& opti
 Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOptions& options,
                                 Progress& progress = Progress::silent());
 
+/// Near-contact poses for the accuracy benchmarks: for each colliding pose of `billiard` whose
+/// predecessor is free, the step between them is bisected with the oracle (Answer::collides)
+/// and the brackets are emitted where the step's motion across them falls below each of
+/// `distances` (object motion = translation + rotation angle x object radius): free poses
+/// approaching the contact, then colliding poses leaving it, in the order of the motion,
+/// between the free predecessor and the colliding pose. The grazing flight is those runs,
+/// one after another; `collides` holds the oracle's answers.
+struct GrazingOptions {
+  std::vector<double> distances{1e-6, 1e-7, 1e-8, 1e-9};
+};
+Flight generate_grazing_flight(const ReferenceCollider& oracle, const Flight& billiard,
+                               const GrazingOptions& options = {});
+
 }  // namespace tetrapage
