@@ -538,7 +538,12 @@ void write_plots(const fs::path& folder, const json& report, const std::vector<s
     int index = 0;
     for (const auto& m : methods) {
       if (!by_method.count(m)) continue;
-      script << (index ? ", " : "") << "'" << group << ".dat' index " << index << " with linespoints title '" << m << "'";
+      // One colour per method (gnuplot's default cycle repeats after eight).
+      static const char* const colours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                             "#8c564b", "#e377c2", "#7f7f7f", "#17becf"};
+      const auto slot = std::size_t(std::find(kAllMethods.begin(), kAllMethods.end(), m) - kAllMethods.begin());
+      script << (index ? ", " : "") << "'" << group << ".dat' index " << index << " with linespoints lw 2 lc rgb '"
+             << colours[slot % 9] << "' title '" << m << "'";
       ++index;
     }
     script << "\n";
@@ -561,6 +566,7 @@ void write_plots(const fs::path& folder, const json& report, const std::vector<s
               "unset logscale y\nset output 'figure4-stabbing.png'\nset title 'Figure 4: average stabbing number'\nset "
               "ylabel 'tets crossed per unit length'\nplot 'mesh.dat' using 1:4 with points pt 7 title 'environments'\n";
   script.close();
+  mesh.close();  // gnuplot reads it next
   const std::string command = "cd '" + data.string() + "' && gnuplot plots.gp 2>gnuplot.log";
   if (std::system("command -v gnuplot >/dev/null 2>&1") != 0) {
     std::fprintf(stderr, "gnuplot not found: plot data and script left in %s\n", data.string().c_str());
