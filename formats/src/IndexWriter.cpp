@@ -123,10 +123,10 @@ struct IndexWriter::Impl {
                        path.string() + "' failed");
   }
 
-  /// A chunked, deflated, checksummed dataset whose first dimension may grow.
+  /// A chunked, checksummed dataset whose first dimension may grow, deflated when `deflate`.
   DatasetHandle create_dataset(hid_t parent, const std::string& name, const std::string& what,
                                hid_t type, std::span<const hsize_t> dims,
-                               std::span<const hsize_t> chunk) {
+                               std::span<const hsize_t> chunk, bool deflate) {
     std::array<hsize_t, 2> max_dims{H5S_UNLIMITED, 0};
     for (std::size_t d = 1; d < dims.size(); ++d) max_dims[d] = dims[d];
     DataspaceHandle space(check_id(
@@ -136,8 +136,9 @@ struct IndexWriter::Impl {
     check(H5Pset_chunk(creation.get(), static_cast<int>(chunk.size()), chunk.data()),
           "the chunking of " + what);
     // Order matters: deflate first, then the checksum over the compressed bytes.
-    check(H5Pset_deflate(creation.get(), static_cast<unsigned>(options.deflate_level)),
-          "the deflate filter of " + what);
+    if (deflate)
+      check(H5Pset_deflate(creation.get(), static_cast<unsigned>(options.deflate_level)),
+            "the deflate filter of " + what);
     check(H5Pset_fletcher32(creation.get()), "the Fletcher-32 filter of " + what);
     return DatasetHandle(check_id(H5Dcreate2(parent, name.c_str(), type, space.get(),
                                              H5P_DEFAULT, creation.get(), H5P_DEFAULT),
@@ -153,9 +154,11 @@ struct IndexWriter::Impl {
     const std::array<hsize_t, 2> dims{rows, columns};
     const std::array<hsize_t, 2> chunk{chunk_rows, columns};
     const std::size_t rank = columns == 0 ? 1 : 2;
+    // The mesh and the tables are read whole when an index opens: stored plain (checksummed),
+    // since inflating them was two thirds of the open time of a 100M-triangle index.
     DatasetHandle dataset = create_dataset(parent, name, what, file_type<T>(),
                                            std::span(dims).first(rank),
-                                           std::span(chunk).first(rank));
+                                           std::span(chunk).first(rank), false);
     if (rows > 0)
       check(H5Dwrite(dataset.get(), memory_type<T>(), H5S_ALL, H5S_ALL, H5P_DEFAULT, data),
             what);
@@ -242,7 +245,7 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   const std::array<hsize_t, 1> empty{0};
   const std::array<hsize_t, 1> chunk{options.chunk_bytes};
   w.shard_data = w.create_dataset(w.shards_group.get(), "data", "dataset /shards/data",
-                                  H5T_STD_U8LE, empty, chunk);
+                                  H5T_STD_U8LE, empty, chunk, true);
 }
 
 IndexWriter::~IndexWriter() = default;
