@@ -67,6 +67,13 @@ struct Options {
   std::size_t table8_placements = 20;
   double table8_seconds = 0.05;  // per method and placement, at least one repetition
   std::uint64_t seed = 1;
+  // The methods' parameters (the study's values by default).
+  study::GridOptions grid;
+  study::KdTreeOptions kd_tree;
+  study::RTreeOptions r_tree;
+  study::MeshMethodOptions mesh;
+  unsigned terrain_grid_points = 10;  // the study's extra Steiner grid for terrain meshes
+  bool figure2 = true;                // the mesh method on each library mesh alone
 };
 
 struct EnvironmentSpec {
@@ -153,13 +160,13 @@ Environment load_environment(const EnvironmentSpec& spec, const Options& o, cons
                    {"build_seconds", s.build_seconds},   {"details", s.details}};
     env.study_methods[name] = std::move(method);
   };
-  if (wants("grid")) add("grid", study::make_grid_method(triangles));
-  if (wants("3d-tree")) add("3d-tree", study::make_kd_tree_method(triangles));
-  if (wants("r-tree")) add("r-tree", study::make_r_tree_method(triangles));
+  if (wants("grid")) add("grid", study::make_grid_method(triangles, o.grid));
+  if (wants("3d-tree")) add("3d-tree", study::make_kd_tree_method(triangles, o.kd_tree));
+  if (wants("r-tree")) add("r-tree", study::make_r_tree_method(triangles, o.r_tree));
   if (wants("mesh")) {
-    study::MeshMethodOptions mesh_options;
+    study::MeshMethodOptions mesh_options = o.mesh;
     // The study added a 10 x 10 x 10 grid of Steiner points to its terrains' meshes.
-    if (spec.group == "terrains") mesh_options.grid_points = 10;
+    if (spec.group == "terrains") mesh_options.grid_points = o.terrain_grid_points;
     add("mesh", study::make_mesh_method(triangles, mesh_options));
   }
   env.record["methods"] = stats;
@@ -380,6 +387,19 @@ void write_markdown(const fs::path& path, const json& report, const std::vector<
         << " |\n";
   }
 
+  if (report.contains("figure2")) {
+    out << "\n## Figure 2: the mesh method on each library mesh alone\n\n| mesh | #T | #V | mesh #V | growth | tets | "
+           "rounds | non-conforming | degenerate | stopped | build s |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|\n";
+    for (const auto& r : report["figure2"]) {
+      const auto& d = r["details"];
+      out << "| " << r["mesh"].get<std::string>() << " | " << r["triangles"] << " | " << d.value("original_vertices", 0)
+          << " | " << d.value("vertices", 0) << " | " << fixed(d.value("growth_factor", 0.0), 2) << " | "
+          << d.value("tets", 0) << " | " << d.value("rounds", 0) << " | " << d.value("non_conforming_triangles", 0)
+          << " | " << d.value("degenerate_triangles", 0) << " | " << d.value("stopped", std::string("-")) << " | "
+          << fixed(r["build_seconds"].get<double>(), 2) << " |\n";
+    }
+  }
+
   for (const std::string group : {"terrains", "tetras", "scenes"}) {
     bool any = false;
     for (const auto& p : pairs) any = any || p["group"] == group;
@@ -576,6 +596,32 @@ void write_plots(const fs::path& folder, const json& report, const std::vector<s
     std::fprintf(stderr, "gnuplot failed: see %s\n", (data / "gnuplot.log").string().c_str());
 }
 
+// The study's Figure 2: the conforming mesh of each real mesh alone (the library's, many with
+// self-intersections and near-coplanar faces), scaled into the unit cube.
+json library_mesh_growth(const MeshLibrary& library, const Options& o) {
+  json rows = json::array();
+  Progress progress("figure 2 (library meshes)", library.size());
+  for (std::size_t m = 0; m < library.size(); ++m) {
+    const LibraryMesh& mesh = library[m];
+    const Vec3 size = mesh.bounds.size();
+    const double scale = 1.0 / std::max({size[0], size[1], size[2], 1e-300});
+    std::vector<geometry::Triangle> triangles;
+    for (std::size_t t = 0; t < mesh.soup.triangle_count(); ++t) {
+      geometry::Triangle c = mesh.soup.corners(t);
+      for (auto& p : c)
+        for (int a = 0; a < 3; ++a) p[a] = (p[a] - mesh.bounds.lo[a]) * scale;
+      triangles.push_back(c);
+    }
+    const auto method = study::make_mesh_method(triangles, o.mesh);
+    const study::StudyStatistics s = method->statistics();
+    rows.push_back({{"mesh", mesh.name}, {"triangles", triangles.size()}, {"details", s.details},
+                    {"build_seconds", s.build_seconds}});
+    progress.advance();
+  }
+  progress.finish();
+  return rows;
+}
+
 void run(const Options& o) {
   const oneapi::tbb::global_control one_thread(oneapi::tbb::global_control::max_allowed_parallelism, 1);
   fs::create_directories(o.out);
@@ -623,6 +669,8 @@ void run(const Options& o) {
   progress.finish();
   report["environments"] = env_records;
   report["pairs"] = pairs;
+  if (o.figure2 && std::find(methods.begin(), methods.end(), "mesh") != methods.end())
+    report["figure2"] = library_mesh_growth(library, o);
   report["seconds"] = seconds_since(start);
   report["summary"] = std::to_string(specs.size()) + " environments x " + std::to_string(objects.size()) +
                       " objects, " + std::to_string(o.steps) + "-step billiard flights, one thread, in one process; " +
@@ -656,8 +704,34 @@ int main(int argc, char** argv) {
   app.add_option("--methods", o.methods, "Methods to run (default: all)")->delimiter(',')->check(CLI::IsMember(kAllMethods));
   app.add_option("--memory", o.memory, "Budget of the paged hybrid run (e.g. 8M); none without it");
   app.add_option("--seed", o.seed, "Seed of the flights");
+  app.add_option("--grid-n", o.grid.cells_per_axis, "Grid: N x N x N voxels")->capture_default_str();
+  app.add_option("--kd-leaf", o.kd_tree.leaf_triangles, "3d-tree: K, the leaf threshold")->capture_default_str();
+  std::string kd_axis = "c", r_split = "a";
+  app.add_option("--kd-axis", kd_axis,
+                 "3d-tree axis rule: a (min max(n1,n2)), b (min |n1-n2|), c (min n1*n2), d (longest side)")
+      ->check(CLI::IsMember({"a", "b", "c", "d"}))
+      ->capture_default_str();
+  app.add_option("--kd-no-gain", o.kd_tree.no_gain_splits, "3d-tree: no-gain splits allowed on a path")
+      ->capture_default_str();
+  app.add_option("--rtree-leaf", o.r_tree.leaf_triangles, "R-tree: K, triangles per leaf")->capture_default_str();
+  app.add_option("--rtree-split", r_split, "R-tree split rule: a (min max(V1,V2)), b (min V1+V2)")
+      ->check(CLI::IsMember({"a", "b"}))
+      ->capture_default_str();
+  app.add_option("--mesh-rounds", o.mesh.max_rounds, "Mesh: rounds of Steiner points at most")->capture_default_str();
+  app.add_option("--mesh-growth", o.mesh.max_growth, "Mesh: stop inserting beyond this vertex growth")
+      ->capture_default_str();
+  app.add_option("--terrain-grid", o.terrain_grid_points, "Mesh: extra n x n x n Steiner grid for terrains (0: none)")
+      ->capture_default_str();
+  bool no_figure2 = false;
+  app.add_flag("--no-figure2", no_figure2, "Skip Figure 2 (the mesh method on each library mesh)");
   try {
     app.parse(argc, argv);
+    o.kd_tree.axis_rule = kd_axis == "a"   ? study::KdAxisRule::min_max_count
+                          : kd_axis == "b" ? study::KdAxisRule::min_count_gap
+                          : kd_axis == "c" ? study::KdAxisRule::min_count_product
+                                           : study::KdAxisRule::longest_side;
+    o.r_tree.split_rule = r_split == "a" ? study::RTreeSplitRule::min_max_volume : study::RTreeSplitRule::min_volume_sum;
+    o.figure2 = !no_figure2 && !o.quick;
     run(o);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
