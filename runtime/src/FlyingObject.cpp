@@ -92,6 +92,7 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, Triangle
   EdgeParity parity;
   for (std::size_t t = 0; t < object_.triangle_count(); ++t) parity.add_triangle(object_.corners(t));
   closed_ = parity.closed();
+  if (closed_) interior_grid_ = ObjectInteriorGrid(bvh_);
   world_.resize(object_.vertices.size());
   world_step_.assign(object_.vertices.size(), ~std::uint64_t{0});
 
@@ -634,15 +635,27 @@ bool FlyingObject::in_object_box(const geometry::Point& p) const {
   // p in the object's own frame (rounded back, so the box is grown far beyond the rounding):
   // outside that box means outside the object. The world box is looser for a rotated object.
   const Vec3 x = to_object_frame(p);
-  const double margin = (object_radius_ + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
-                         std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])})) *
-                        0x1p-40;
+  const double margin = frame_margin(p);
   for (int a = 0; a < 3; ++a)
     if (x[a] < object_box_.lo[a] - margin || x[a] > object_box_.hi[a] + margin) return false;
   return true;
 }
 
+double FlyingObject::frame_margin(const geometry::Point& p) const {
+  // Far beyond the rounding of to_object_frame and of the placement: a point this close to
+  // the object's box or surface is left to the exact tests.
+  return (object_radius_ + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
+          std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])})) *
+         0x1p-40;
+}
+
 bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& box) {
+  // Most points are far from the surface: the interior grid answers them with one lookup.
+  switch (interior_grid_.classify(to_object_frame(p), frame_margin(p))) {
+    case ObjectInteriorGrid::Side::inside: return true;
+    case ObjectInteriorGrid::Side::outside: return false;
+    case ObjectInteriorGrid::Side::unknown: break;
+  }
   // Parity of crossings with the placed object along a segment from p to beyond the object's
   // box; a direction whose segment meets an edge, a vertex or a plane is replaced by the next.
   // Directions are nearly along the object's own axes, so that the segment's box in the

@@ -20,6 +20,7 @@
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/BoxSearch.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/ObjectInteriorGrid.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
 
@@ -151,6 +152,9 @@ class FlyingObject {
   void check_containment(const geometry::Box& box, QueryResult& result);
   bool object_holds(const geometry::Point& p, const geometry::Box& box);
   bool in_object_box(const geometry::Point& p) const;
+  // How far from the object's box or surface a world point must be for the frame change's
+  // rounding not to matter.
+  double frame_margin(const geometry::Point& p) const;
   // A world point taken back to the object's frame at the current pose (rounded: callers
   // only prune with it, with margins far beyond the rounding).
   Vec3 to_object_frame(const geometry::Point& p) const;
@@ -169,6 +173,7 @@ class FlyingObject {
   double object_radius_ = 0;  ///< largest |x| over the object's vertices (object frame)
   bool closed_ = false;
   BoundingBox object_box_;  ///< of the object's vertices, in its own frame
+  ObjectInteriorGrid interior_grid_;  ///< closed objects only: inside/outside by cell
   // Per step: a vertex and the part of each candidate environment triangle whose box lies in
   // the object's box (only those can lie inside the object).
   std::vector<std::pair<geometry::Point, std::uint32_t>> enclosed_;
