@@ -49,21 +49,32 @@ ObjectInteriorGrid::ObjectInteriorGrid(const geometry::ObjectBVH& bvh) : box_(bv
     for (std::size_t i = 0; i <= n_; ++i) cuts_[a][i] = box_.lo[a] + (box_.hi[a] - box_.lo[a]) * double(i) / double(n_);
     cuts_[a][n_] = box_.hi[a];
   }
-  // Surface cells: some triangle meets the closed cell (exact); the others are "free".
+  // Surface cells: some triangle meets the closed cell (exact); the others are "free". Each
+  // triangle is tried against the cells its box reaches only.
   const std::size_t cells = n_ * n_ * n_;
   std::vector<std::uint8_t> surface(cells, 0);
-  for (std::size_t k = 0; k < n_; ++k)
-    for (std::size_t j = 0; j < n_; ++j)
-      for (std::size_t i = 0; i < n_; ++i) {
-        geometry::Box cell;
-        cell.lo = {cuts_[0][i], cuts_[1][j], cuts_[2][k]};
-        cell.hi = {cuts_[0][i + 1], cuts_[1][j + 1], cuts_[2][k + 1]};
-        bvh.for_each_in_box(cell, [&](std::uint32_t t) {
-          if (!geometry::triangle_intersects_box(bvh.triangle(t), cell)) return true;
-          surface[index(i, j, k)] = 1;
-          return false;
-        });
-      }
+  for (std::uint32_t t = 0; t < bvh.triangle_count(); ++t) {
+    const geometry::Triangle& triangle = bvh.triangle(t);
+    const geometry::Box b = geometry::box_of(triangle);
+    std::array<std::size_t, 3> lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = cell_of(a, b.lo[a]);
+      hi[a] = cell_of(a, b.hi[a]);
+      // A coordinate on a cut belongs to both cells: widen by one, the exact test decides.
+      if (lo[a] > 0) --lo[a];
+      if (hi[a] + 1 < n_) ++hi[a];
+    }
+    for (std::size_t k = lo[2]; k <= hi[2]; ++k)
+      for (std::size_t j = lo[1]; j <= hi[1]; ++j)
+        for (std::size_t i = lo[0]; i <= hi[0]; ++i) {
+          std::uint8_t& mark = surface[index(i, j, k)];
+          if (mark) continue;
+          geometry::Box cell;
+          cell.lo = {cuts_[0][i], cuts_[1][j], cuts_[2][k]};
+          cell.hi = {cuts_[0][i + 1], cuts_[1][j + 1], cuts_[2][k + 1]};
+          if (geometry::triangle_intersects_box(triangle, cell)) mark = 1;
+        }
+  }
   // Face-adjacent free cells share a face no triangle meets: one side for each group, decided
   // once by parity from a cell centre.
   sides_.assign(cells, Side::unknown);
