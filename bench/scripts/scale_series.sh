@@ -18,6 +18,7 @@ OBJECTS=${OBJECTS:-4 116 500 2000 5000 15000}
 STEPS=${STEPS:-10000}
 TERRAIN=${TERRAIN:-}           # also a terrain of this many triangles
 MEMORY=${MEMORY:-2G}           # preprocess working memory
+REGION=${REGION:-}             # --region-triangles (default: preprocess's own); names the folder
 mkdir -p "$OUT"
 
 models=()
@@ -25,17 +26,20 @@ for N in $SIZES; do models+=("scene:$N"); done
 [ -n "$TERRAIN" ] && models+=("terrain:$TERRAIN")
 
 for model in "${models[@]}"; do
-  kind=${model%%:*}; N=${model##*:}; D="$OUT/$kind$N"
+  kind=${model%%:*}; N=${model##*:}; D="$OUT/$kind$N${REGION:+-r$REGION}"
   mkdir -p "$D"
   if [ ! -f "$D/model.tpi" ]; then
     if [ "$kind" = scene ]; then
-      [ -f "$D/model.json" ] || "$TETRAPAGE" generate scene --triangles "$N" --seed 1 -o "$D/model.json"
-      input="$D/model.json"
+      input="$OUT/$kind$N/model.json"  # one scene for every region size
+      mkdir -p "$OUT/$kind$N"
+      [ -f "$input" ] || "$TETRAPAGE" generate scene --triangles "$N" --seed 1 -o "$input"
     else
-      [ -f "$D/model.ply" ] || "$TETRAPAGE" generate terrain --triangles "$N" --seed 1 -o "$D/model.ply"
-      input="$D/model.ply"
+      input="$OUT/$kind$N/model.ply"
+      mkdir -p "$OUT/$kind$N"
+      [ -f "$input" ] || "$TETRAPAGE" generate terrain --triangles "$N" --seed 1 -o "$input"
     fi
     /usr/bin/time -v "$TETRAPAGE" preprocess "$input" -o "$D/model.tpi" --precision double --memory "$MEMORY" \
+      ${REGION:+--region-triangles "$REGION"} \
       --report "$D/preprocess.json" 2> "$D/preprocess.time"
   fi
   "$TETRAPAGE" inspect "$D/model.tpi" --stabbing-segments 0 --report "$D/inspect.json" > /dev/null
