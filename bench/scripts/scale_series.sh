@@ -8,7 +8,8 @@
 #   bench/scripts/scale_series.sh OUT_DIR [SIZE...]        (default sizes: 1000000 10000000)
 #   OBJECTS="4 15000" STEPS=10000 TERRAIN=10000000 bench/scripts/scale_series.sh out/scale 100000000
 #
-# Writes OUT_DIR/scale.md (Markdown) and OUT_DIR/scale.csv, from the JSON reports beside them.
+# Writes OUT_DIR/scale.md (Markdown), OUT_DIR/scale.csv and OUT_DIR/plots/*.png (scale_table.py),
+# from the JSON reports beside them.
 set -euo pipefail
 OUT=${1:?usage: scale_series.sh OUT_DIR [SIZE...]}
 shift
@@ -66,38 +67,4 @@ for model in "${models[@]}"; do
   done
 done
 
-python3 - "$OUT" <<'PY'
-import glob, json, os, re, sys
-out = sys.argv[1]
-rows = []
-for d in sorted(glob.glob(f"{out}/*/"), key=lambda p: (re.sub(r"\d", "", os.path.basename(p.rstrip("/"))), int(re.sub(r"\D", "", os.path.basename(p.rstrip("/"))) or 0))):
-    name = os.path.basename(d.rstrip("/"))
-    try:
-        pre = json.load(open(f"{d}/preprocess.json"))
-        ins = json.load(open(f"{d}/inspect.json"))
-    except FileNotFoundError:
-        continue
-    for f in sorted(glob.glob(f"{d}/fly-*.json")):
-        m = re.match(r".*/fly-(.+)-(\d+)\.json", f)
-        run, size = m.group(1), int(m.group(2))
-        r = json.load(open(f))
-        rows.append(dict(model=name, triangles=pre.get("triangles_read", 0), index_bytes=ins.get("file_bytes", 0),
-                         shard_bytes=ins["shard_decoded_bytes"], object=size, run=run, **{k: r[k] for k in (
-                         "steps_per_second", "budget_bytes", "peak_rss_bytes", "page_ins", "bytes_read_per_step",
-                         "cache_hit_rate", "open_to_first_answer_ms", "disagreements", "collisions")},
-                         p50=r["latency_us"]["p50"], p99=r["latency_us"]["p99"], max=r["latency_us"]["max"],
-                         page_p50=r["page_in_latency_us"]["p50"], page_p99=r["page_in_latency_us"]["p99"]))
-order = {"all": 0, "10pct": 1, "10pct-noprefetch": 2, "64m": 3}
-rows.sort(key=lambda r: (r["model"], r["object"], order.get(r["run"], 9)))
-mib = lambda b: b / 2**20
-lines = ["| model | triangles | index MiB | object | run | budget MiB | steps/s | p50 us | p99 us | max us | page-in p50/p99 us | bytes read/step | hit rate | peak RSS MiB | RSS - budget MiB | open to 1st answer ms | disagreements |",
-         "|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
-for r in rows:
-    lines.append(f"| {r['model']} | {r['triangles']:,} | {mib(r['index_bytes']):.0f} | {r['object']} | {r['run']} | {mib(r['budget_bytes']):.0f} | {r['steps_per_second']:.0f} | {r['p50']:.1f} | {r['p99']:.0f} | {r['max']:.0f} | {r['page_p50']:.0f} / {r['page_p99']:.0f} | {r['bytes_read_per_step']:.0f} | {r['cache_hit_rate']:.4f} | {mib(r['peak_rss_bytes']):.0f} | {mib(r['peak_rss_bytes'] - r['budget_bytes']):.0f} | {r['open_to_first_answer_ms']:.1f} | {r['disagreements']} |")
-open(f"{out}/scale.md", "w").write("\n".join(lines) + "\n")
-with open(f"{out}/scale.csv", "w") as f:
-    keys = list(rows[0].keys()) if rows else []
-    f.write(",".join(keys) + "\n")
-    for r in rows: f.write(",".join(str(r[k]) for k in keys) + "\n")
-print("\n".join(lines))
-PY
+python3 "$(dirname "$0")/scale_table.py" "$OUT"
