@@ -12,9 +12,9 @@ DEMO_DIR  ?= out/demo
 DEB_PACKAGES := cmake make g++ pkg-config \
   libeigen3-dev libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev
+  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev time python3
 
-.PHONY: deps configure build test sanitize demo bench bench-study bench-peers bench-accuracy clean format
+.PHONY: deps configure build test sanitize demo bench bench-study bench-peers bench-accuracy bench-scale clean format
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -72,13 +72,20 @@ bench: build
 	  $(BUILD)/bench/tetrapage_bench_$$b --benchmark_out=$(BUILD)/bench-results/$$b.json \
 	    --benchmark_out_format=json || exit 1; \
 	done
-	$(MAKE) --no-print-directory bench-study
+	$(MAKE) --no-print-directory bench-study bench-accuracy bench-scale
 
 # The study's flight benchmark: its environment groups x its six objects, the four methods, the
 # hybrid (in memory and paged under 1 MiB) and the peers; tables and plots for docs/BENCHMARKS.md.
 # Long (an hour or more); STUDY_FLAGS=--quick for a short run.
 bench-study: build
 	$(BUILD)/bench/tetrapage_bench_study --out $(BUILD)/bench-results/study --memory 1M $(STUDY_FLAGS)
+
+# The out-of-core scale series (issue 8): generated scenes of SCALE_SIZES triangles and a terrain,
+# preprocessed and flown under budgets from 64 MiB to everything resident; scale.md and plots.
+# The 100M scene needs about 10 GB of disk and an hour.
+SCALE_SIZES ?= 1000000 10000000 50000000 100000000
+bench-scale: build
+	TETRAPAGE=$(TETRAPAGE) TERRAIN=10000000 bench/scripts/scale_series.sh $(BUILD)/bench-results/scale $(SCALE_SIZES)
 
 # FCL, CGAL's AABB tree and tetrapage (in memory, and paged under 8 MiB) on the demo's scene,
 # the study's object sizes, 10,000-pose flights, 3 repetitions (docs/BENCHMARKS.md, "Peers").
