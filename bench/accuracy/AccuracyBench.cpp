@@ -43,9 +43,8 @@
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/ReferenceCollider.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/tools/ReportFile.h"
-#include "tetrapage/tools/SceneGenerator.h"
-#include "tetrapage/tools/TetrasGenerator.h"
 
 namespace tetrapage {
 namespace {
@@ -325,17 +324,8 @@ int run(int argc, char** argv) {
   if (scene_path.empty()) {
     scene_path = out / "scene.ply";
     MeshWriter writer(scene_path);
-    if (tetras > 0) {
-      TetrasOptions options;
-      options.triangles = tetras;
-      options.seed = seed;
-      generate_tetras(options, writer);
-    } else {
-      SceneOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_scene(MeshLibrary::load_default(), options, writer);
-    }
+    generate_environment(tetras > 0 ? EnvironmentKind::tetras : EnvironmentKind::scene, tetras > 0 ? tetras : triangles,
+                         seed, writer);
     writer.commit();
   }
   const TriangleSoup scene = read_mesh(scene_path);

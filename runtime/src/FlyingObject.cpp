@@ -65,6 +65,16 @@ void hull_of(const std::vector<Kernel::Point_3>& points, std::vector<Kernel::Poi
   }
 }
 
+// The object's distinct vertex positions that some triangle uses, as CGAL points, and the first
+// vertex id of each position.
+void distinct_triangle_vertices(const TriangleSoup& object, std::vector<Kernel::Point_3>& points,
+                                std::map<std::array<double, 3>, std::uint32_t>& id_of) {
+  for (const auto& t : object.triangles)
+    for (const auto v : t)
+      if (id_of.emplace(object.vertices[v], v).second)
+        points.emplace_back(object.vertices[v][0], object.vertices[v][1], object.vertices[v][2]);
+}
+
 }  // namespace
 
 /// The solid standing for the object in one step: a box, or a convex hull as triangles (CGAL's
@@ -100,10 +110,7 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, Triangle
   // do not matter; a flat object has no 3D hull and is placed whole.
   std::vector<Kernel::Point_3> points;
   std::map<std::array<double, 3>, std::uint32_t> id_of;
-  for (const auto& t : object_.triangles)
-    for (const auto v : t)
-      if (id_of.emplace(object_.vertices[v], v).second)
-        points.emplace_back(object_.vertices[v][0], object_.vertices[v][1], object_.vertices[v][2]);
+  distinct_triangle_vertices(object_, points, id_of);
   if (points.size() >= kHillClimbMinimum) {
     CGAL::Surface_mesh<Kernel::Point_3> hull;
     CGAL::convex_hull_3(points.begin(), points.end(), hull);
@@ -132,10 +139,7 @@ void FlyingObject::prepare_hull_candidates() {
   hull_candidates_ready_ = true;
   std::vector<Kernel::Point_3> points;
   std::map<std::array<double, 3>, std::uint32_t> id_of;
-  for (const auto& t : object_.triangles)
-    for (const auto v : t)
-      if (id_of.emplace(object_.vertices[v], v).second)
-        points.emplace_back(object_.vertices[v][0], object_.vertices[v][1], object_.vertices[v][2]);
+  distinct_triangle_vertices(object_, points, id_of);
   std::vector<Kernel::Point_3> hull_points;
   std::vector<std::array<std::size_t, 3>> faces;
   if (points.size() >= 4) hull_of(points, hull_points, faces);
@@ -684,18 +688,8 @@ bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& b
     }
     const double grow = magnitude * 0x1p-40;
     for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-    bool generic = true, odd = false;
-    bvh_.for_each_in_box(query, [&](std::uint32_t t) {
-      const auto hit = geometry::classify_segment_triangle(segment, world_triangle(t));
-      if (!hit) return true;
-      if (hit.contact != geometry::SegmentTriangleContact::interior || hit.at_endpoint) {
-        generic = false;
-        return false;
-      }
-      odd = !odd;
-      return true;
-    });
-    if (generic) return odd;
+    if (const auto odd = crossing_parity(bvh_, segment, query, [&](std::uint32_t t) { return world_triangle(t); }))
+      return *odd;
   }
   return false;  // every direction grazed the object: taken as outside
 }

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "tetrapage/runtime/geometry/SegmentTriangle.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
 
 namespace tetrapage {
@@ -24,18 +23,8 @@ ObjectInteriorGrid::Side parity(const geometry::ObjectBVH& bvh, const Vec3& p) {
     geometry::Box query;
     query.extend(segment[0]);
     query.extend(segment[1]);
-    bool generic = true, odd = false;
-    bvh.for_each_in_box(query, [&](std::uint32_t t) {
-      const auto hit = geometry::classify_segment_triangle(segment, bvh.triangle(t));
-      if (!hit) return true;
-      if (hit.contact != geometry::SegmentTriangleContact::interior || hit.at_endpoint) {
-        generic = false;
-        return false;
-      }
-      odd = !odd;
-      return true;
-    });
-    if (generic) return odd ? ObjectInteriorGrid::Side::inside : ObjectInteriorGrid::Side::outside;
+    const auto odd = crossing_parity(bvh, segment, query, [&](std::uint32_t t) { return bvh.triangle(t); });
+    if (odd) return *odd ? ObjectInteriorGrid::Side::inside : ObjectInteriorGrid::Side::outside;
   }
   return ObjectInteriorGrid::Side::unknown;
 }

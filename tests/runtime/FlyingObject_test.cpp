@@ -22,6 +22,7 @@
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/ReferenceCollider.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/TerrainGenerator.h"
 #include "tetrapage/tools/TetrasGenerator.h"
@@ -42,13 +43,13 @@ struct World {
   Flight flight;
 };
 
-enum class Kind { scene, tetras, terrain };
+using Kind = EnvironmentKind;
 
 // Generates an environment and an object, preprocesses (double storage: the stored geometry
 // is the input's, so exact answers must equal the oracle's), and flies a billiard path.
 World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triangles, std::size_t steps,
                  std::uint64_t seed, std::size_t region_triangles = 400) {
-  const std::string name = kind == Kind::scene ? "scene" : (kind == Kind::tetras ? "tetras" : "terrain");
+  const std::string name = to_string(kind);
   const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "flying" / (name + std::to_string(seed));
   fs::remove_all(folder);
   fs::create_directories(folder);
@@ -56,22 +57,7 @@ World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triang
   world.environment_path = folder / "environment.ply";
   {
     MeshWriter writer(world.environment_path);
-    if (kind == Kind::scene) {
-      SceneOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_scene(library(), options, writer);
-    } else if (kind == Kind::tetras) {
-      TetrasOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_tetras(options, writer);
-    } else {
-      TerrainOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_terrain(options, writer);
-    }
+    generate_environment(kind, triangles, seed, writer);
     writer.commit();
   }
   world.environment = read_mesh(world.environment_path);

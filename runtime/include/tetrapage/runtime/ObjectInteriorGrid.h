@@ -12,11 +12,35 @@
 /// centre (in the object's own, unrounded coordinates).
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
+#include "tetrapage/runtime/geometry/SegmentTriangle.h"
 
 namespace tetrapage {
+
+/// Crossing parity of `segment` with the object's triangles whose boxes meet `query` (in the
+/// BVH's frame), each triangle given by `triangle_of(t)` (its own or its placed coordinates):
+/// true for an odd number of proper crossings; nothing when the segment touches an edge, a
+/// vertex or a triangle's plane, or ends on a triangle (the caller tries another direction).
+template <class TriangleOf>
+std::optional<bool> crossing_parity(const geometry::ObjectBVH& bvh, const geometry::Segment& segment,
+                                    const geometry::Box& query, TriangleOf&& triangle_of) {
+  bool generic = true, odd = false;
+  bvh.for_each_in_box(query, [&](std::uint32_t t) {
+    const auto hit = geometry::classify_segment_triangle(segment, triangle_of(t));
+    if (!hit) return true;
+    if (hit.contact != geometry::SegmentTriangleContact::interior || hit.at_endpoint) {
+      generic = false;
+      return false;
+    }
+    odd = !odd;
+    return true;
+  });
+  if (!generic) return std::nullopt;
+  return odd;
+}
 
 class ObjectInteriorGrid {
  public:
