@@ -29,7 +29,8 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 void run_generate_flight(const FlightArguments& args) {
   for (const auto* output : {&args.output, &args.answers, &args.report}) check_writable(*output);
   if (args.environment.empty() == args.index.empty())
-    throw InputError("generate flight: give the environment (--env) or an index (--index), not both");
+    throw InputError(args.environment.empty() ? "generate flight: give the environment (--env) or an index (--index)"
+                                              : "generate flight: give --env or --index, not both");
   const auto start = std::chrono::steady_clock::now();
   std::vector<ReadReport> reports;
   TriangleSoup environment;

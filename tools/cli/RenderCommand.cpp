@@ -24,7 +24,8 @@ struct RenderArguments {
 };
 
 void run_render(const RenderArguments& args) {
-  check_writable(args.report);
+  // Before the work: a picture that cannot be written is known now, not after the render.
+  for (const auto* output : {&args.output, &args.report}) check_writable(*output);
   RenderOptions options;
   if (std::sscanf(args.size.c_str(), "%zux%zu", &options.width, &options.height) != 2)
     throw InputError("--size '" + args.size + "': expected WIDTHxHEIGHT, e.g. 1200x800");
