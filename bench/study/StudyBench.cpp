@@ -102,12 +102,6 @@ std::vector<EnvironmentSpec> environments(const Options& o) {
   return specs;
 }
 
-std::vector<geometry::Triangle> triangles_of(const TriangleSoup& soup) {
-  std::vector<geometry::Triangle> out;
-  out.reserve(soup.triangle_count());
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t) out.push_back(soup.corners(t));
-  return out;
-}
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
@@ -150,7 +144,7 @@ Environment load_environment(const EnvironmentSpec& spec, const Options& o, cons
                 {"file", env.file.string()},
                 {"triangles", env.soup.triangle_count()},
                 {"vertices", env.soup.vertices.size()}};
-  const auto triangles = triangles_of(env.soup);
+  const auto triangles = env.soup.all_corners();
   auto wants = [&](const std::string& m) { return std::find(methods.begin(), methods.end(), m) != methods.end(); };
   json stats = json::object();
   auto add = [&](const std::string& name, std::unique_ptr<study::StudyMethod> method) {
@@ -260,9 +254,10 @@ json run_pair(Environment& env, const fs::path& object_file, std::uint64_t objec
   std::vector<std::uint8_t> full_steps;
   std::vector<json> runs;
   std::vector<Replay> replays;
+  std::vector<std::unique_ptr<PeerCollider>> colliders;  // kept for Table 8: built once
   for (const auto& name : methods) {
     const auto build_start = Clock::now();
-    auto collider = make_collider(name, env, object, o);
+    auto& collider = colliders.emplace_back(make_collider(name, env, object, o));
     const double build_seconds = seconds_since(build_start);
     Replay r = replay(*collider, flight.poses);
     json run = {{"method", name},
@@ -312,7 +307,7 @@ json run_pair(Environment& env, const fs::path& object_file, std::uint64_t objec
   pair["table8_placements"] = colliding.size();
   if (!colliding.empty())
     for (std::size_t m = 0; m < runs.size(); ++m) {
-      auto collider = make_collider(methods[m], env, object, o);
+      PeerCollider* collider = colliders[m].get();
       double total = 0;
       std::uint64_t checks = 0;
       for (const std::size_t i : colliding) {
@@ -605,13 +600,10 @@ json library_mesh_growth(const MeshLibrary& library, const Options& o) {
     const LibraryMesh& mesh = library[m];
     const Vec3 size = mesh.bounds.size();
     const double scale = 1.0 / std::max({size[0], size[1], size[2], 1e-300});
-    std::vector<geometry::Triangle> triangles;
-    for (std::size_t t = 0; t < mesh.soup.triangle_count(); ++t) {
-      geometry::Triangle c = mesh.soup.corners(t);
+    std::vector<geometry::Triangle> triangles = mesh.soup.all_corners();
+    for (auto& c : triangles)
       for (auto& p : c)
         for (int a = 0; a < 3; ++a) p[a] = (p[a] - mesh.bounds.lo[a]) * scale;
-      triangles.push_back(c);
-    }
     const auto method = study::make_mesh_method(triangles, o.mesh);
     const study::StudyStatistics s = method->statistics();
     rows.push_back({{"mesh", mesh.name}, {"triangles", triangles.size()}, {"details", s.details},

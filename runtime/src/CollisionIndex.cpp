@@ -91,4 +91,19 @@ void CollisionIndex::read_interiors(const std::string& where) {
   interior_offsets_ = std::move(offsets);
 }
 
+void CollisionIndex::preload(const std::function<void(std::uint32_t)>& progress) const {
+  if (total_shard_bytes_ > options_.memory_budget_bytes)
+    throw InputError(path().string() + ": its " + std::to_string(total_shard_bytes_) +
+                     " bytes of shards do not fit a budget of " + std::to_string(options_.memory_budget_bytes) +
+                     " bytes, so they cannot all be preloaded");
+  for (std::uint32_t shard = 0; shard < shard_count(); ++shard) {
+    (void)cache_->acquire(shard);
+    if (progress) progress(shard + 1);
+  }
+  const std::uint64_t resident = cache_->counters().resident_shards;
+  if (resident != shard_count())
+    throw InputError(path().string() + ": " + std::to_string(resident) + " of " + std::to_string(shard_count()) +
+                     " shards stayed resident after preloading");
+}
+
 }  // namespace tetrapage

@@ -23,12 +23,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<geometry::Triangle> triangles_of(const TriangleSoup& soup) {
-  std::vector<geometry::Triangle> out;
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t) out.push_back(soup.corners(t));
-  return out;
-}
-
 // A generated environment written to a file and read back, as the benchmark does.
 std::vector<geometry::Triangle> generated(EnvironmentKind kind, std::uint64_t triangles, std::uint64_t seed) {
   const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / ("study-" + std::to_string(::getpid()));
@@ -39,7 +33,7 @@ std::vector<geometry::Triangle> generated(EnvironmentKind kind, std::uint64_t tr
     generate_environment(kind, triangles, seed, writer);
     writer.commit();
   }
-  auto triangles_read = triangles_of(read_mesh(path));
+  auto triangles_read = read_mesh(path).all_corners();
   fs::remove_all(folder);
   return triangles_read;
 }

@@ -44,10 +44,7 @@ std::vector<Triangle> environment_triangles(Environment kind, std::uint64_t tria
     generate_environment(kind, triangles, seed, writer);
     writer.commit();
   }
-  const TriangleSoup soup = read_mesh(path);
-  std::vector<Triangle> out;
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t) out.push_back(soup.corners(t));
-  return out;
+  return read_mesh(path).all_corners();
 }
 
 TriangleSoup flying_object(std::uint64_t triangles, double size) {

@@ -42,16 +42,12 @@ void run_fly(const FlyArguments& args) {
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   double preload_seconds = 0;
   if (args.preload) {
-    // Everything resident before the first step: the reference a paged run is compared with.
     if (index->total_shard_bytes() > index_options.memory_budget_bytes)
       throw InputError("--preload: the index's " + format_byte_size(index->total_shard_bytes()) +
                        " of shards do not fit --memory " + args.memory);
     const auto preload_start = std::chrono::steady_clock::now();
     Progress loading("preloading shards", index->shard_count());
-    for (std::uint32_t shard = 0; shard < index->shard_count(); ++shard) {
-      (void)index->cache().acquire(shard);
-      loading.advance();
-    }
+    index->preload([&](std::uint32_t) { loading.advance(); });
     loading.finish();
     preload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - preload_start).count();
     index->cache().reset_counters();

@@ -41,14 +41,17 @@ void run_render(const RenderArguments& args) {
     poses = read_poses(args.path);
     for (const auto& pose : poses) options.path.push_back(pose.translation);
   }
+  // One index for the replay and the picture: rendering reads every shard once through the
+  // cache, which any budget holding the largest shard allows.
+  const bool replay = options.colouring == RenderColouring::page_ins;
+  if (replay && (poses.empty() || args.object.empty()))
+    throw InputError("--color page-ins needs the flight (--path) and the object (--object) to replay");
+  CollisionIndexOptions index_options;
+  index_options.memory_budget_bytes = replay ? parse_byte_size(args.memory) : std::uint64_t(256) << 20;
+  index_options.prefetch = replay;  // as `fly` runs the flight
+  const auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   nlohmann::json flight = nlohmann::json::object();
-  if (options.colouring == RenderColouring::page_ins) {
-    if (poses.empty() || args.object.empty())
-      throw InputError("--color page-ins needs the flight (--path) and the object (--object) to replay");
-    // The flight as `fly` runs it, under --memory: the cache counts each shard's page-ins.
-    CollisionIndexOptions index_options;
-    index_options.memory_budget_bytes = parse_byte_size(args.memory);
-    auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
+  if (replay) {
     FlyingObject object(index, read_mesh(args.object));
     Progress progress("replaying the flight", poses.size());
     std::uint64_t collisions = 0;
@@ -68,13 +71,8 @@ void run_render(const RenderArguments& args) {
     std::fprintf(stderr, "flight: %zu poses, %llu page-ins of %llu shards under %s\n", poses.size(),
                  (unsigned long long)counters.page_ins, (unsigned long long)touched, args.memory.c_str());
   }
-  // Rendering reads every shard once, through a cache that holds a few at a time.
-  CollisionIndexOptions index_options;
-  index_options.memory_budget_bytes = std::uint64_t(256) << 20;
-  index_options.prefetch = false;
-  const CollisionIndex index(args.index, index_options);
   RenderSummary summary;
-  const RgbImage image = render_model(index, options, summary);
+  const RgbImage image = render_model(*index, options, summary);
   write_png(args.output, image);
   std::printf("%s: %zux%zu, %llu triangles drawn%s from %llu shards, %.1f %% of pixels on the model, %.2f s\n",
               args.output.string().c_str(), image.width, image.height, (unsigned long long)summary.triangles_drawn,

@@ -17,13 +17,7 @@ std::shared_ptr<const CollisionIndex> open_index(const std::filesystem::path& pa
   index_options.memory_budget_bytes = options.memory_budget_bytes.value_or(kUnboundedBudget);
   index_options.prefetch = options.prefetch;
   auto index = std::make_shared<const CollisionIndex>(path, index_options);
-  if (!options.memory_budget_bytes) {
-    for (std::uint32_t shard = 0; shard < index->shard_count(); ++shard) index->cache().acquire(shard);
-    const auto counters = index->cache().counters();
-    if (counters.resident_shards != index->shard_count())
-      throw Error(path.string() + ": " + std::to_string(counters.resident_shards) + " of " +
-                  std::to_string(index->shard_count()) + " shards stayed resident after preloading");
-  }
+  if (!options.memory_budget_bytes) index->preload();
   return index;
 }
 

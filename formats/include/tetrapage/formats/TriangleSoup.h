@@ -53,6 +53,13 @@ struct TriangleSoup {
     const auto& tri = triangles[t];
     return {vertices[tri[0]], vertices[tri[1]], vertices[tri[2]]};
   }
+  /// Every triangle's corners, in order (what the in-core methods and oracles are built over).
+  std::vector<std::array<Vec3, 3>> all_corners() const {
+    std::vector<std::array<Vec3, 3>> out;
+    out.reserve(triangles.size());
+    for (std::size_t t = 0; t < triangles.size(); ++t) out.push_back(corners(t));
+    return out;
+  }
 
   BoundingBox bounds() const {
     BoundingBox box;

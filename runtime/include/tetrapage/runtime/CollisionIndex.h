@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -52,6 +53,11 @@ class CollisionIndex {
   const geometry::Box& shard_bounds(std::uint32_t shard) const { return shard_bounds_[shard]; }
   /// Decoded bytes of all shards (what "everything resident" costs).
   std::uint64_t total_shard_bytes() const { return total_shard_bytes_; }
+  /// Loads every shard into the cache (everything resident: the reference a paged run is
+  /// compared with), calling `progress(loaded)` after each.
+  /// @throw InputError (naming the file) when the shards do not fit the budget or do not all
+  ///        stay resident; what the cache throws for a damaged shard.
+  void preload(const std::function<void(std::uint32_t)>& progress = {}) const;
 
   ShardCache<Shard>& cache() const { return *cache_; }
 
