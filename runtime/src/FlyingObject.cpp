@@ -320,7 +320,9 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
       double best = sign * coordinate(at);
       for (bool moved = true; moved;) {
         moved = false;
-        for (std::uint32_t i = hull_offsets_[at]; i < hull_offsets_[at + 1]; ++i) {
+        // The neighbours of the vertex the pass started from: `at` moves during the pass.
+        const std::uint32_t from = at;
+        for (std::uint32_t i = hull_offsets_[from]; i < hull_offsets_[from + 1]; ++i) {
           const std::uint32_t next = hull_neighbours_[i];
           const double value = sign * coordinate(next);
           if (value > best) best = value, at = next, moved = true;
@@ -513,7 +515,18 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // Does a world box meet the object's own box? Its centre taken to the object's frame and
   // its half extents through |R| (separating axes of the object's frame); the roundings are
   // covered by a margin far beyond them. Conservative: it only prunes.
-  auto meets_own_box = [&](const geometry::Box& b) {
+  // For the mesh, a node must also come near the object's surface (its BVH) or lie inside it:
+  // a node whose box meets no object triangle's box lies wholly inside or wholly outside the
+  // object, and one point of it tells which.
+  const bool near_surface_only = own_frame && !solid_query;
+  // The surface test pays off on leaves and cells that hold a few triangles and are small
+  // beside the object (measured on the 1M and 10M scenes with 500 to 15,000 triangles): a
+  // larger box nearly always meets the surface anyway.
+  constexpr std::uint32_t kSurfaceTestTriangles = 4;
+  const double surface_test_extent =
+      0.1 * std::max({object_box_.hi[0] - object_box_.lo[0], object_box_.hi[1] - object_box_.lo[1],
+                      object_box_.hi[2] - object_box_.lo[2]});
+  auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
     Vec3 c, h;
     for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
@@ -521,13 +534,22 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
                                      std::fabs(b.hi[1]), std::fabs(b.hi[2])}) +
                            translation_magnitude + object_radius_) *
                           0x1p-40;
+    geometry::Box in_frame;  // the node's box in the object's frame, grown by reach and margin
     for (int a = 0; a < 3; ++a) {
       const double x = rotation_[a] * c[0] + rotation_[3 + a] * c[1] + rotation_[6 + a] * c[2];
       const double e = std::fabs(rotation_[a]) * h[0] + std::fabs(rotation_[3 + a]) * h[1] +
                        std::fabs(rotation_[6 + a]) * h[2];
       if (std::fabs(x - own_centre[a]) > e + own_half[a] + margin) return false;
+      in_frame.lo[a] = x - e - reach - margin;
+      in_frame.hi[a] = x + e + reach + margin;
     }
-    return true;
+    if (!near_surface_only || triangles < kSurfaceTestTriangles || std::max({h[0], h[1], h[2]}) > surface_test_extent)
+      return true;
+    bool near_surface = false;
+    bvh_.for_each_in_box(in_frame, [&](std::uint32_t) { return !(near_surface = true); });
+    if (near_surface) return true;
+    if (!closed_) return false;
+    return interior_grid_.classify(in_frame.center(), margin) != ObjectInteriorGrid::Side::outside;
   };
   auto test_shard = [&](const Shard& shard) {
     shard.for_each_box_candidate(box, meets_own_box, [&](std::uint32_t local, const geometry::Triangle& environment) {
@@ -614,12 +636,27 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
     }
   }
   // An obstacle inside the object: each enclosed candidate triangle lies wholly inside or
-  // wholly outside (its surface does not cross the object's), so one vertex decides.
-  // Neighbouring triangles share vertices: test each vertex once.
+  // wholly outside (its surface does not cross the object's), so one vertex decides. Most
+  // vertices are far from the object's surface, where the interior grid answers at once; the
+  // rest need a parity count, once per vertex (neighbouring triangles share vertices).
+  std::size_t undecided = 0;
+  for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
+    const geometry::Point& p = enclosed_[i].first;
+    switch (interior_grid_.classify(to_object_frame(p), frame_margin(p))) {
+      case ObjectInteriorGrid::Side::inside:
+        result.collides = true;
+        result.containment = Containment::obstacle_inside_object;
+        result.containing_part = enclosed_[i].second;
+        break;
+      case ObjectInteriorGrid::Side::outside: break;
+      case ObjectInteriorGrid::Side::unknown: enclosed_[undecided++] = enclosed_[i]; break;
+    }
+  }
+  enclosed_.resize(undecided);
   std::sort(enclosed_.begin(), enclosed_.end());
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
     if (i > 0 && enclosed_[i].first == enclosed_[i - 1].first) continue;
-    if (object_holds(enclosed_[i].first, box)) {
+    if (crossing_parity_holds(enclosed_[i].first, box)) {
       result.collides = true;
       result.containment = Containment::obstacle_inside_object;
       result.containing_part = enclosed_[i].second;
@@ -653,13 +690,7 @@ double FlyingObject::frame_margin(const geometry::Point& p) const {
          0x1p-40;
 }
 
-bool FlyingObject::object_holds(const geometry::Point& p, const geometry::Box& box) {
-  // Most points are far from the surface: the interior grid answers them with one lookup.
-  switch (interior_grid_.classify(to_object_frame(p), frame_margin(p))) {
-    case ObjectInteriorGrid::Side::inside: return true;
-    case ObjectInteriorGrid::Side::outside: return false;
-    case ObjectInteriorGrid::Side::unknown: break;
-  }
+bool FlyingObject::crossing_parity_holds(const geometry::Point& p, const geometry::Box& box) {
   // Parity of crossings with the placed object along a segment from p to beyond the object's
   // box; a direction whose segment meets an edge, a vertex or a plane is replaced by the next.
   // Directions are nearly along the object's own axes, so that the segment's box in the

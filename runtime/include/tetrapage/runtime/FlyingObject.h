@@ -150,7 +150,9 @@ class FlyingObject {
   const Vec3& world_vertex(std::uint32_t v);
   // Containment checks of a step whose surfaces do not touch.
   void check_containment(const geometry::Box& box, QueryResult& result);
-  bool object_holds(const geometry::Point& p, const geometry::Box& box);
+  // Does the placed object hold p? By the parity of crossings (the interior grid could not
+  // tell): p must not lie on the object's surface.
+  bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box);
   bool in_object_box(const geometry::Point& p) const;
   // How far from the object's box or surface a world point must be for the frame change's
   // rounding not to matter.

@@ -122,8 +122,12 @@ class Shard {
 
   /// Calls visit(local, triangle) once for each stored triangle whose box overlaps `box` (no
   /// exact triangle/box test: for callers that decide each triangle exactly anyway), pruning
-  /// R-tree nodes whose box `accept(node_box)` rejects as well (a conservative filter of the
-  /// caller's, e.g. an oriented box). No state is shared between concurrent queries.
+  /// what `accept(node_box, triangles)` rejects as well (a conservative filter of the
+  /// caller's, e.g. an oriented box): the shard's bounds and R-tree inner nodes with
+  /// triangles 0, R-tree leaves and grid cells (whose closed box holds every point of a
+  /// triangle that a query can reach through that cell) with the number they hold. A triangle is visited
+  /// when some leaf or cell holding it is accepted. No state is shared between concurrent
+  /// queries.
   template <class Accept, class Visit>
   void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
     ShardQueryCounters counters;
@@ -211,14 +215,14 @@ class Shard {
     count,   ///< count cells or nodes and references only (the cost model's measure)
     boxes,   ///< visit(local, triangle) for each triangle whose box overlaps the box, once
   };
-  static constexpr auto always = [](const geometry::Box&) { return true; };
+  static constexpr auto always = [](const geometry::Box&, std::uint32_t) { return true; };
 
   // The one traversal of both kinds; `accept` may prune R-tree nodes (and the whole shard).
   template <QueryMode kMode, class Accept, class Visit>
   void query(const geometry::Box& box, const Accept& accept, Visit& visit, ShardQueryCounters& counters) const {
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
-    if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_)) return;
+    if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_, 0u)) return;
     // A triangle meets the box iff it meets the box clipped to the shard's bounds, which is
     // finite even when the query is not.
     geometry::Box clipped;
@@ -237,13 +241,13 @@ class Shard {
       }
     };
     if (kind_ == ShardKind::grid)
-      query_grid<kMode>(clipped, reach, counters);
+      query_grid<kMode>(clipped, accept, reach, counters);
     else
       query_rtree<kMode>(clipped, accept, reach, counters);
   }
 
-  template <QueryMode kMode, class Reach>
-  void query_grid(const geometry::Box& box, Reach& reach, ShardQueryCounters& counters) const {
+  template <QueryMode kMode, class Accept, class Reach>
+  void query_grid(const geometry::Box& box, const Accept& accept, Reach& reach, ShardQueryCounters& counters) const {
     std::array<std::uint32_t, 3> first{}, last{};
     for (int k = 0; k < 3; ++k)
       if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k],
@@ -261,6 +265,12 @@ class Shard {
           const std::uint32_t begin = cell_offsets_[cell], end = cell_offsets_[cell + 1];
           counters.references += end - begin;
           if constexpr (kMode == QueryMode::count) continue;
+          if constexpr (kMode == QueryMode::boxes) {
+            if (begin == end) continue;
+            const geometry::Box cell_box{{grid_boundary(0, x), grid_boundary(1, y), grid_boundary(2, z)},
+                                         {grid_boundary(0, x + 1), grid_boundary(1, y + 1), grid_boundary(2, z + 1)}};
+            if (!accept(cell_box, end - begin)) continue;
+          }
           for (std::uint32_t r = begin; r < end; ++r) {
             const std::uint32_t t = references16_.empty() ? references32_[r] : references16_[r];
             if (marks->first_visit(t)) reach(t);
@@ -278,9 +288,10 @@ class Shard {
     while (size > 0) {
       const Node& node = nodes_[stack[--size]];
       ++counters.visited;
-      if (!geometry::boxes_overlap(node.box, box) || !accept(node.box)) continue;
-      if (node.count & shard_format::kLeafFlag) {
-        const std::uint32_t count = node.count & ~shard_format::kLeafFlag;
+      const bool leaf = (node.count & shard_format::kLeafFlag) != 0;
+      const std::uint32_t count = leaf ? node.count & ~shard_format::kLeafFlag : 0;
+      if (!geometry::boxes_overlap(node.box, box) || !accept(node.box, count)) continue;
+      if (leaf) {
         counters.references += count;
         if constexpr (kMode == QueryMode::count) continue;
         for (std::uint32_t t = node.first; t < node.first + count; ++t) reach(t);
