@@ -8,6 +8,8 @@
 #include <cmath>
 #include <map>
 
+#include <tbb/parallel_invoke.h>
+
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/runtime/MeshWalk.h"
@@ -99,13 +101,21 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, Triangle
     object_radius_ = std::max(object_radius_, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
     object_box_.extend(v);
   }
-  EdgeParity parity;
-  for (std::size_t t = 0; t < object_.triangle_count(); ++t) parity.add_triangle(object_.corners(t));
-  closed_ = parity.closed();
-  if (closed_) interior_grid_ = ObjectInteriorGrid(bvh_);
   world_.resize(object_.vertices.size());
   world_step_.assign(object_.vertices.size(), ~std::uint64_t{0});
+  // The interior grid and the hull are independent: build them side by side (opening an
+  // index and placing a large object must take milliseconds).
+  tbb::parallel_invoke(
+      [&] {
+        EdgeParity parity;
+        for (std::size_t t = 0; t < object_.triangle_count(); ++t) parity.add_triangle(object_.corners(t));
+        closed_ = parity.closed();
+        if (closed_) interior_grid_ = ObjectInteriorGrid(bvh_);
+      },
+      [&] { build_hull_graph(); });
+}
 
+void FlyingObject::build_hull_graph() {
   // The hull's vertex graph, for hill-climbing the world box. Vertices not on any triangle
   // do not matter; a flat object has no 3D hull and is placed whole.
   std::vector<Kernel::Point_3> points;
@@ -595,6 +605,16 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // One clock pair around the loop (a free step is a few microseconds; a clock read per shard
   // cost a tenth of it): the tests' time is the loop's less the acquisitions'.
   const auto loop_start = Clock::now();
+  if (index.options().prefetch) {
+    // Several shards to page in: the prefetch thread loads them from the last while this
+    // thread loads from the first (on two cores, a step entering a new region waits about half).
+    hints_.clear();
+    for (std::size_t k = 0; k < shards_.size(); ++k)
+      if (geometry::boxes_overlap(box, shard_reach_[k]) && !(keep_pins_ && pins_[k]) &&
+          !index.cache().contains(shards_[k]))
+        hints_.push_back(shards_[k]);
+    if (hints_.size() > 1) index.cache().prefetch_urgently(std::span(hints_).subspan(1));
+  }
   for (std::size_t k = 0; k < shards_.size() && !stop; ++k) {
     const std::uint32_t shard_id = shards_[k];
     // Shards whose stored triangles cannot meet the box are neither read nor pinned.

@@ -141,6 +141,7 @@ class FlyingObject {
   bool closed() const { return closed_; }
 
  private:
+  void build_hull_graph();
   void place(const Pose& pose);
   // Walk, box search and pinning for a new searched region around `box`; false when the box
   // lies outside the mesh.

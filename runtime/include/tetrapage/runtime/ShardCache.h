@@ -188,7 +188,11 @@ class ShardCache {
   /// otherwise, or when the queue overflows (oldest first), or when the load fails, it is
   /// dropped and counted.
   /// @throw InputError if a shard id is out of range (nothing is queued then).
-  void prefetch(std::span<const std::uint32_t> shards);
+  void prefetch(std::span<const std::uint32_t> shards) { enqueue(shards, false); }
+  /// The same, ahead of every queued hint, the last shard first: for the shards a query is
+  /// about to acquire in order (the threads load from the end while the query loads from the
+  /// start). On overflow the newest ordinary hints are dropped.
+  void prefetch_urgently(std::span<const std::uint32_t> shards) { enqueue(shards, true); }
 
   /// Blocks until the prefetch queue is empty and no prefetch load is in flight (for
   /// benchmarks and tests that need a settled cache; hints queued meanwhile extend the wait).
@@ -260,6 +264,7 @@ class ShardCache {
   }
   void record_latency(std::chrono::nanoseconds duration);
   void check_shard(std::uint32_t shard, const char* operation) const;
+  void enqueue(std::span<const std::uint32_t> shards, bool urgent);
   void prefetch_worker(std::stop_token stop);
   void prefetch_one(std::uint32_t shard, const std::stop_token& stop);
 
@@ -700,7 +705,7 @@ void ShardCache<ShardType>::record_latency(std::chrono::nanoseconds duration) {
 }
 
 template <class ShardType>
-void ShardCache<ShardType>::prefetch(std::span<const std::uint32_t> shards) {
+void ShardCache<ShardType>::enqueue(std::span<const std::uint32_t> shards, bool urgent) {
   for (const std::uint32_t shard : shards) check_shard(shard, "prefetch");
   prefetch_hints_.fetch_add(shards.size(), std::memory_order_relaxed);
   if (workers_.empty()) {
@@ -710,9 +715,15 @@ void ShardCache<ShardType>::prefetch(std::span<const std::uint32_t> shards) {
   std::uint64_t stale = 0;
   {
     std::lock_guard lock(queue_mutex_);
-    queue_.insert(queue_.end(), shards.begin(), shards.end());
+    if (urgent)
+      queue_.insert(queue_.begin(), shards.rbegin(), shards.rend());
+    else
+      queue_.insert(queue_.end(), shards.begin(), shards.end());
     while (queue_.size() > options_.prefetch_queue_limit) {
-      queue_.pop_front();
+      if (urgent)
+        queue_.pop_back();
+      else
+        queue_.pop_front();
       ++stale;
     }
   }
