@@ -1,10 +1,12 @@
 #include "ChunkCodec.h"
 
+#include <libdeflate.h>
 #include <zlib.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 
 #include "tetrapage/formats/Error.h"
 
@@ -109,21 +111,21 @@ std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter
   const unsigned cmf = std::to_integer<unsigned>(filtered[0]), flg = std::to_integer<unsigned>(filtered[1]);
   if ((cmf & 0x0f) != 8 || (cmf >> 4) > 7 || ((cmf << 8) | flg) % 31 != 0 || (flg & 0x20) != 0)
     return "chunk does not start with a zlib deflate header";
-  z_stream stream{};
-  if (inflateInit2(&stream, -15) != Z_OK) return "zlib cannot start inflating";
-  stream.next_in = reinterpret_cast<Bytef*>(const_cast<std::byte*>(filtered.data() + kZlibHeader));
-  stream.avail_in = static_cast<uInt>(filtered.size() - kZlibHeader - kAdlerTrailer);
-  stream.next_out = reinterpret_cast<Bytef*>(out.data());
-  stream.avail_out = static_cast<uInt>(out.size());
-  const int status = inflate(&stream, Z_FINISH);
-  const auto inflated_bytes = stream.total_out;
-  inflateEnd(&stream);
-  if (status == Z_BUF_ERROR)
-    return "chunk inflates to more than " + std::to_string(out.size()) +
-           " bytes, or its zlib stream is incomplete";
-  if (status != Z_STREAM_END)
-    return std::string("zlib cannot inflate the chunk (") +
-           (status == Z_DATA_ERROR ? "corrupt data" : "status " + std::to_string(status)) + ")";
+  // libdeflate inflates about twice as fast as zlib (page-ins are on the query's path); one
+  // decompressor per thread, as page-ins run on several threads at once.
+  struct FreeDecompressor {
+    void operator()(libdeflate_decompressor* d) const { libdeflate_free_decompressor(d); }
+  };
+  thread_local const std::unique_ptr<libdeflate_decompressor, FreeDecompressor> decompressor(
+      libdeflate_alloc_decompressor());
+  if (!decompressor) return "cannot allocate a deflate decompressor";
+  std::size_t inflated_bytes = 0;
+  const libdeflate_result status = libdeflate_deflate_decompress(
+      decompressor.get(), filtered.data() + kZlibHeader, filtered.size() - kZlibHeader - kAdlerTrailer,
+      out.data(), out.size(), &inflated_bytes);
+  if (status == LIBDEFLATE_INSUFFICIENT_SPACE)
+    return "chunk inflates to more than " + std::to_string(out.size()) + " bytes";
+  if (status != LIBDEFLATE_SUCCESS) return "cannot inflate the chunk (corrupt or incomplete deflate data)";
   if (inflated_bytes != out.size())
     return "chunk inflates to " + std::to_string(inflated_bytes) + " bytes, expected " +
            std::to_string(out.size());
