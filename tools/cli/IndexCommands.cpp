@@ -28,7 +28,7 @@ namespace {
 struct PreprocessArguments {
   std::vector<std::filesystem::path> inputs;
   std::filesystem::path output;
-  std::size_t region_triangles = 2048;
+  std::size_t region_triangles = PreprocessOptions{}.region_triangles;
   std::string memory = "1G";
   unsigned threads = 0;
   std::string shard = "auto";
