@@ -94,33 +94,15 @@ struct FlyingObject::Solid {
   std::vector<std::array<std::size_t, 3>> hull_faces;
 };
 
-FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
-    : index_(std::move(index)), object_(std::move(object)), bvh_(object_) {
-  if (!index_) throw InputError("a flying object needs an index");
-  for (const auto& v : object_.vertices) {
-    object_radius_ = std::max(object_radius_, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
-    object_box_.extend(v);
-  }
-  world_.resize(object_.vertices.size());
-  world_step_.assign(object_.vertices.size(), ~std::uint64_t{0});
-  // The interior grid and the hull are independent: build them side by side (opening an
-  // index and placing a large object must take milliseconds).
-  tbb::parallel_invoke(
-      [&] {
-        EdgeParity parity;
-        for (std::size_t t = 0; t < object_.triangle_count(); ++t) parity.add_triangle(object_.corners(t));
-        closed_ = parity.closed();
-        if (closed_) interior_grid_ = ObjectInteriorGrid(bvh_);
-      },
-      [&] { build_hull_graph(); });
-}
+namespace {
 
-void FlyingObject::build_hull_graph() {
+// The hull's vertex graph of a model (ObjectModel::hull_vertices, hull_offsets, hull_neighbours).
+void build_hull_graph(ObjectModel& model, const TriangleSoup& object) {
   // The hull's vertex graph, for hill-climbing the world box. Vertices not on any triangle
   // do not matter; a flat object has no 3D hull and is placed whole.
   std::vector<Kernel::Point_3> points;
   std::map<std::array<double, 3>, std::uint32_t> id_of;
-  distinct_triangle_vertices(object_, points, id_of);
+  distinct_triangle_vertices(object, points, id_of);
   if (points.size() >= kHillClimbMinimum) {
     CGAL::Surface_mesh<Kernel::Point_3> hull;
     CGAL::convex_hull_3(points.begin(), points.end(), hull);
@@ -128,28 +110,58 @@ void FlyingObject::build_hull_graph() {
       std::map<CGAL::Surface_mesh<Kernel::Point_3>::Vertex_index, std::uint32_t> position;
       for (const auto v : hull.vertices()) {
         const auto& p = hull.point(v);
-        position[v] = std::uint32_t(hull_vertices_.size());
-        hull_vertices_.push_back(id_of.at({p.x(), p.y(), p.z()}));
+        position[v] = std::uint32_t(model.hull_vertices.size());
+        model.hull_vertices.push_back(id_of.at({p.x(), p.y(), p.z()}));
       }
-      hull_offsets_.push_back(0);
+      model.hull_offsets.push_back(0);
       for (const auto v : hull.vertices()) {
         for (const auto h : CGAL::halfedges_around_target(hull.halfedge(v), hull))
-          hull_neighbours_.push_back(position.at(hull.source(h)));
-        hull_offsets_.push_back(std::uint32_t(hull_neighbours_.size()));
+          model.hull_neighbours.push_back(position.at(hull.source(h)));
+        model.hull_offsets.push_back(std::uint32_t(model.hull_neighbours.size()));
       }
     }
   }
-  if (hull_vertices_.empty()) {
+  if (model.hull_vertices.empty()) {
     // No usable hull: every vertex, no graph (world_box scans them all).
-    for (const auto& [point, id] : id_of) hull_vertices_.push_back(id);
+    for (const auto& [point, id] : id_of) model.hull_vertices.push_back(id);
   }
+}
+
+}  // namespace
+
+ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mesh) {
+  for (const auto& v : mesh.vertices) {
+    radius = std::max(radius, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    box.extend(v);
+  }
+  // The interior grid and the hull are independent: build them side by side (opening an
+  // index and placing a large object must take milliseconds).
+  tbb::parallel_invoke(
+      [&] {
+        EdgeParity parity;
+        for (std::size_t t = 0; t < mesh.triangle_count(); ++t) parity.add_triangle(mesh.corners(t));
+        closed = parity.closed();
+        if (closed) interior_grid = ObjectInteriorGrid(bvh);
+      },
+      [&] { build_hull_graph(*this, mesh); });
+}
+
+FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
+    : FlyingObject(std::move(index), std::make_shared<const ObjectModel>(std::move(object))) {}
+
+FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, std::shared_ptr<const ObjectModel> model)
+    : index_(std::move(index)), model_(std::move(model)) {
+  if (!index_) throw InputError("a flying object needs an index");
+  if (!model_) throw InputError("a flying object needs an object model");
+  world_.resize(model_->mesh.vertices.size());
+  world_step_.assign(model_->mesh.vertices.size(), ~std::uint64_t{0});
 }
 
 void FlyingObject::prepare_hull_candidates() {
   hull_candidates_ready_ = true;
   std::vector<Kernel::Point_3> points;
   std::map<std::array<double, 3>, std::uint32_t> id_of;
-  distinct_triangle_vertices(object_, points, id_of);
+  distinct_triangle_vertices(model_->mesh, points, id_of);
   std::vector<Kernel::Point_3> hull_points;
   std::vector<std::array<std::size_t, 3>> faces;
   if (points.size() >= 4) hull_of(points, hull_points, faces);
@@ -175,7 +187,7 @@ void FlyingObject::prepare_hull_candidates() {
       planes.push_back({n, offset});
     }
   }
-  std::vector<bool> on_hull(object_.vertices.size(), false);
+  std::vector<bool> on_hull(model_->mesh.vertices.size(), false);
   for (const auto& p : hull_points) {
     const std::uint32_t id = id_of.at({p.x(), p.y(), p.z()});
     on_hull[id] = true;
@@ -209,7 +221,7 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
   // The hull candidates at each pose: the object's hull vertices and the vertices within the
   // placement's reach of its surface.
   auto magnitude = [&](const Vec3& t) {
-    return object_radius_ + std::max({std::fabs(t[0]), std::fabs(t[1]), std::fabs(t[2])});
+    return model_->radius + std::max({std::fabs(t[0]), std::fabs(t[1]), std::fabs(t[2])});
   };
   double reach = magnitude(translation_);
   if (swept) reach = std::max(reach, magnitude(previous_translation_));
@@ -217,7 +229,7 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
   solid.points.clear();
   auto add_pose = [&](bool current) {
     auto add = [&](std::uint32_t v) {
-      const Vec3 p = current ? world_vertex(v) : apply_pose(previous_rotation_, previous_translation_, object_.vertices[v]);
+      const Vec3 p = current ? world_vertex(v) : apply_pose(previous_rotation_, previous_translation_, model_->mesh.vertices[v]);
       solid.points.emplace_back(p[0], p[1], p[2]);
     };
     for (const auto v : hull_candidates_) add(v);
@@ -238,7 +250,7 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
                            to_point(solid.hull_points[f[2]])});
   if (solid.faces.empty()) {
     // Fewer than four points, or no hull: the placed triangles stand for themselves.
-    for (std::uint32_t t = 0; t < object_.triangle_count(); ++t) solid.faces.push_back(world_triangle(t));
+    for (std::uint32_t t = 0; t < model_->mesh.triangle_count(); ++t) solid.faces.push_back(world_triangle(t));
   } else {
     // CGAL orients every facet the same way: the first vertex off facet 0 names the inside.
     const auto& f = solid.faces[0];
@@ -298,22 +310,22 @@ void FlyingObject::place(const Pose& pose) {
 
 const Vec3& FlyingObject::world_vertex(std::uint32_t v) {
   if (world_step_[v] != step_) {
-    world_[v] = apply_pose(rotation_, translation_, object_.vertices[v]);
+    world_[v] = apply_pose(rotation_, translation_, model_->mesh.vertices[v]);
     world_step_[v] = step_;
   }
   return world_[v];
 }
 
 geometry::Triangle FlyingObject::world_triangle(std::uint32_t t) {
-  const auto& c = object_.triangles[t];
+  const auto& c = model_->mesh.triangles[t];
   return {world_vertex(c[0]), world_vertex(c[1]), world_vertex(c[2])};
 }
 
 geometry::Box FlyingObject::world_box(const Pose& pose) {
   place(pose);
   geometry::Box box;
-  if (hull_offsets_.empty()) {
-    for (const auto v : hull_vertices_) box.extend(world_vertex(v));
+  if (model_->hull_offsets.empty()) {
+    for (const auto v : model_->hull_vertices) box.extend(world_vertex(v));
   } else {
     // Per axis and side, climb from the last extreme to a vertex no neighbour beats: on a
     // convex polytope a local extreme of a linear function is the global one. Only the
@@ -323,7 +335,7 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
       const double sign = k % 2 == 0 ? -1.0 : 1.0;
       const double r0 = rotation_[3 * axis], r1 = rotation_[3 * axis + 1], r2 = rotation_[3 * axis + 2];
       const auto coordinate = [&](std::uint32_t hull_vertex) {
-        const Vec3& x = object_.vertices[hull_vertices_[hull_vertex]];
+        const Vec3& x = model_->mesh.vertices[model_->hull_vertices[hull_vertex]];
         return r0 * x[0] + r1 * x[1] + r2 * x[2] + translation_[axis];
       };
       std::uint32_t at = extreme_[k];
@@ -332,8 +344,8 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
         moved = false;
         // The neighbours of the vertex the pass started from: `at` moves during the pass.
         const std::uint32_t from = at;
-        for (std::uint32_t i = hull_offsets_[from]; i < hull_offsets_[from + 1]; ++i) {
-          const std::uint32_t next = hull_neighbours_[i];
+        for (std::uint32_t i = model_->hull_offsets[from]; i < model_->hull_offsets[from + 1]; ++i) {
+          const std::uint32_t next = model_->hull_neighbours[i];
           const double value = sign * coordinate(next);
           if (value > best) best = value, at = next, moved = true;
         }
@@ -344,7 +356,7 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
   }
   // The placement rounds each coordinate; rounded values can make a near-tie climb stop one
   // vertex short. Grow the box far beyond those roundings (it only prunes).
-  const double magnitude = object_radius_ + std::max({std::fabs(translation_[0]), std::fabs(translation_[1]),
+  const double magnitude = model_->radius + std::max({std::fabs(translation_[0]), std::fabs(translation_[1]),
                                                       std::fabs(translation_[2])});
   const double margin = magnitude * 0x1p-40;
   for (int a = 0; a < 3; ++a) box.lo[a] -= margin, box.hi[a] += margin;
@@ -517,8 +529,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // frame: for a rotated object it is much tighter than the world box.
   geometry::Point own_centre, own_half;
   for (int a = 0; a < 3; ++a) {
-    own_centre[a] = 0.5 * (object_box_.lo[a] + object_box_.hi[a]);
-    own_half[a] = 0.5 * (object_box_.hi[a] - object_box_.lo[a]) + reach;
+    own_centre[a] = 0.5 * (model_->box.lo[a] + model_->box.hi[a]);
+    own_half[a] = 0.5 * (model_->box.hi[a] - model_->box.lo[a]) + reach;
   }
   const double translation_magnitude =
       std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])});
@@ -534,15 +546,15 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // larger box nearly always meets the surface anyway.
   constexpr std::uint32_t kSurfaceTestTriangles = 4;
   const double surface_test_extent =
-      0.1 * std::max({object_box_.hi[0] - object_box_.lo[0], object_box_.hi[1] - object_box_.lo[1],
-                      object_box_.hi[2] - object_box_.lo[2]});
+      0.1 * std::max({model_->box.hi[0] - model_->box.lo[0], model_->box.hi[1] - model_->box.lo[1],
+                      model_->box.hi[2] - model_->box.lo[2]});
   auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
     Vec3 c, h;
     for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
     const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
                                      std::fabs(b.hi[1]), std::fabs(b.hi[2])}) +
-                           translation_magnitude + object_radius_) *
+                           translation_magnitude + model_->radius) *
                           0x1p-40;
     geometry::Box in_frame;  // the node's box in the object's frame, grown by reach and margin
     for (int a = 0; a < 3; ++a) {
@@ -556,10 +568,10 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     if (!near_surface_only || triangles < kSurfaceTestTriangles || std::max({h[0], h[1], h[2]}) > surface_test_extent)
       return true;
     bool near_surface = false;
-    bvh_.for_each_in_box(in_frame, [&](std::uint32_t) { return !(near_surface = true); });
+    model_->bvh.for_each_in_box(in_frame, [&](std::uint32_t) { return !(near_surface = true); });
     if (near_surface) return true;
-    if (!closed_) return false;
-    return interior_grid_.classify(in_frame.center(), margin) != ObjectInteriorGrid::Side::outside;
+    if (!model_->closed) return false;
+    return model_->interior_grid.classify(in_frame.center(), margin) != ObjectInteriorGrid::Side::outside;
   };
   auto test_shard = [&](const Shard& shard) {
     shard.for_each_box_candidate(box, meets_own_box, [&](std::uint32_t local, const geometry::Triangle& environment) {
@@ -568,12 +580,12 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       geometry::Box query;
       for (const auto& p : environment) query.extend(to_object_frame(p));
       // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
-      double magnitude = object_radius_;
+      double magnitude = model_->radius;
       for (const auto& p : environment)
         for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
       const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-      if ((own_frame && !geometry::boxes_overlap(query, object_box_)) ||
+      if ((own_frame && !geometry::boxes_overlap(query, model_->box)) ||
           !geometry::triangle_intersects_box(environment, box))
         return;
       ++counters.candidates;
@@ -587,11 +599,11 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         if (!all) stop = true;
         return;
       }
-      if (closed_ && !result.collides && geometry::box_contains(box, environment[0]) &&
+      if (model_->closed && !result.collides && geometry::box_contains(box, environment[0]) &&
           geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
           in_object_box(environment[0]))
         enclosed_.emplace_back(environment[0], shard.part_id(local));
-      bvh_.for_each_in_box(query, [&](std::uint32_t object_triangle) {
+      model_->bvh.for_each_in_box(query, [&](std::uint32_t object_triangle) {
         ++counters.triangle_tests;
         if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;
         result.collides = true;
@@ -648,7 +660,7 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
   const auto start = Clock::now();
   // The object inside an obstacle: with no surface contact, one vertex decides for all.
   if (index_->has_interiors()) {
-    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(object_.triangles[0][0]));
+    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(model_->mesh.triangles[0][0]));
     if (inside.containment == ObstacleContainment::inside) {
       result.collides = true;
       result.containment = Containment::object_inside_obstacle;
@@ -662,7 +674,7 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
   std::size_t undecided = 0;
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
     const geometry::Point& p = enclosed_[i].first;
-    switch (interior_grid_.classify(to_object_frame(p), frame_margin(p))) {
+    switch (model_->interior_grid.classify(to_object_frame(p), frame_margin(p))) {
       case ObjectInteriorGrid::Side::inside:
         result.collides = true;
         result.containment = Containment::obstacle_inside_object;
@@ -698,14 +710,14 @@ bool FlyingObject::in_object_box(const geometry::Point& p) const {
   const Vec3 x = to_object_frame(p);
   const double margin = frame_margin(p);
   for (int a = 0; a < 3; ++a)
-    if (x[a] < object_box_.lo[a] - margin || x[a] > object_box_.hi[a] + margin) return false;
+    if (x[a] < model_->box.lo[a] - margin || x[a] > model_->box.hi[a] + margin) return false;
   return true;
 }
 
 double FlyingObject::frame_margin(const geometry::Point& p) const {
   // Far beyond the rounding of to_object_frame and of the placement: a point this close to
   // the object's box or surface is left to the exact tests.
-  return (object_radius_ + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
+  return (model_->radius + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
           std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])})) *
          0x1p-40;
 }
@@ -732,14 +744,14 @@ bool FlyingObject::crossing_parity_holds(const geometry::Point& p, const geometr
     const geometry::Segment segment{p, far};
     // The segment's box in the object's frame (rounded: it only prunes), as in phase II.
     geometry::Box query;
-    double magnitude = object_radius_;
+    double magnitude = model_->radius;
     for (const auto& q : segment) {
       query.extend(to_object_frame(q));
       for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(q[a]) + std::fabs(translation_[a]));
     }
     const double grow = magnitude * 0x1p-40;
     for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-    if (const auto odd = crossing_parity(bvh_, segment, query, [&](std::uint32_t t) { return world_triangle(t); }))
+    if (const auto odd = crossing_parity(model_->bvh, segment, query, [&](std::uint32_t t) { return world_triangle(t); }))
       return *odd;
   }
   return false;  // every direction grazed the object: taken as outside

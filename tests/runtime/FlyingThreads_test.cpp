@@ -1,5 +1,6 @@
-// Several flying objects, each from its own thread, through one index under a shared budget:
-// the same answers as one thread alone, and the budget holds. Lean on purpose (no generators,
+// Several flying objects, each from its own thread, through one index under a shared budget
+// (two of them instances of one shared ObjectModel): the same answers as one thread alone, and
+// the budget holds. Lean on purpose (no generators,
 // no oracle library): `make test` also runs it in an AddressSanitizer + UBSan build.
 
 #include <gtest/gtest.h>
@@ -90,9 +91,11 @@ TEST(FlyingThreads, SeveralObjectsAgreeWithOneUnderASharedBudget) {
   constexpr int kThreads = 4;
   std::vector<std::vector<std::uint8_t>> answers(kThreads, std::vector<std::uint8_t>(poses.size()));
   std::vector<std::thread> threads;
+  // Threads 1 and 3 fly instances of one shared model; 0 and 2 build their own.
+  const auto shared_model = std::make_shared<const ObjectModel>(object);
   for (int t = 0; t < kThreads; ++t)
     threads.emplace_back([&, t] {
-      FlyingObject flying(index, object);
+      FlyingObject flying = t % 2 == 1 ? FlyingObject(index, shared_model) : FlyingObject(index, object);
       QueryOptions query;
       query.mode = t % 2 == 0 ? QueryMode::first_hit : QueryMode::all_contacts;
       QueryResult result;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <future>
 
 #include "Commands.h"
 #include "tetrapage/formats/ByteSize.h"
@@ -39,7 +40,10 @@ void run_fly(const FlyArguments& args) {
   const std::vector<Pose> poses = read_poses(args.path);
   AnswerCheck check(args.check, poses.size(), "fly");
   const auto open_start = std::chrono::steady_clock::now();
+  // The object's structures do not need the index: build them while it opens.
+  auto model = std::async(std::launch::async, [&] { return std::make_shared<const ObjectModel>(object_mesh); });
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
+  FlyingObject object(index, model.get());
   double preload_seconds = 0;
   if (args.preload) {
     if (index->total_shard_bytes() > index_options.memory_budget_bytes)
@@ -52,7 +56,6 @@ void run_fly(const FlyArguments& args) {
     preload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - preload_start).count();
     index->cache().reset_counters();
   }
-  FlyingObject object(index, object_mesh);
   QueryResult result;
   double first_answer_seconds = 0;
 

@@ -20,7 +20,7 @@
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/BoxSearch.h"
 #include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/ObjectInteriorGrid.h"
+#include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
 
@@ -116,6 +116,9 @@ class FlyingObject {
  public:
   /// @throw InputError for an empty object or non-finite coordinates (as ObjectBVH).
   FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object);
+  /// A flying instance of a shared model (built beforehand, e.g. while the index opened).
+  /// @throw InputError for a null index or model.
+  FlyingObject(std::shared_ptr<const CollisionIndex> index, std::shared_ptr<const ObjectModel> model);
   ~FlyingObject();
   FlyingObject(FlyingObject&&) noexcept;
   FlyingObject& operator=(FlyingObject&&) noexcept;
@@ -134,14 +137,14 @@ class FlyingObject {
   /// cover the rounding of the placement.
   geometry::Box world_box(const Pose& pose);
 
-  const TriangleSoup& object() const { return object_; }
-  std::size_t hull_vertex_count() const { return hull_vertices_.size(); }
+  const TriangleSoup& object() const { return model_->mesh; }
+  const std::shared_ptr<const ObjectModel>& model() const { return model_; }
+  std::size_t hull_vertex_count() const { return model_->hull_vertices.size(); }
   /// Every edge of the object is used an even number of times (EdgeParity): only then can an
   /// obstacle lie inside it.
-  bool closed() const { return closed_; }
+  bool closed() const { return model_->closed; }
 
  private:
-  void build_hull_graph();
   void place(const Pose& pose);
   // Walk, box search and pinning for a new searched region around `box`; false when the box
   // lies outside the mesh.
@@ -171,19 +174,11 @@ class FlyingObject {
                              const geometry::Accuracy& accuracy, double reach);
 
   std::shared_ptr<const CollisionIndex> index_;
-  TriangleSoup object_;
-  geometry::ObjectBVH bvh_;
-  double object_radius_ = 0;  ///< largest |x| over the object's vertices (object frame)
-  bool closed_ = false;
-  BoundingBox object_box_;  ///< of the object's vertices, in its own frame
-  ObjectInteriorGrid interior_grid_;  ///< closed objects only: inside/outside by cell
+  std::shared_ptr<const ObjectModel> model_;
   // Per step: a vertex and the part of each candidate environment triangle whose box lies in
   // the object's box (only those can lie inside the object).
   std::vector<std::pair<geometry::Point, std::uint32_t>> enclosed_;
   std::uint32_t interior_tet_ = 0;  ///< where the last containment walk ended
-  // The convex hull as a vertex graph: object vertex ids and neighbour lists (CSR).
-  std::vector<std::uint32_t> hull_vertices_;
-  std::vector<std::uint32_t> hull_offsets_, hull_neighbours_;  // indices into hull_vertices_
   std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
   // The solids' vertex candidates (prepared on the first hull or swept query): the vertices of
   // the object's own hull, then the other vertices by their depth inside it (ascending). A

@@ -1,0 +1,38 @@
+#pragma once
+/// @file ObjectModel.h
+/// What a flying object is, whatever the index and the pose: its triangles, their BVH, whether
+/// the surface is closed and then its interior grid, and the vertex graph of its convex hull
+/// (for the world box by hill-climbing). Built once, tens of milliseconds for 15,000 triangles,
+/// and immutable afterwards: any number of FlyingObjects (one per thread, on one index or
+/// several) share one model, and a model can be built while an index opens.
+
+#include <cstdint>
+#include <vector>
+
+#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/runtime/ObjectInteriorGrid.h"
+#include "tetrapage/runtime/geometry/ObjectBVH.h"
+
+namespace tetrapage {
+
+class ObjectModel {
+ public:
+  /// @throw InputError for an empty object or non-finite coordinates (as ObjectBVH).
+  explicit ObjectModel(TriangleSoup object);
+
+  /// Read-only after construction (models are shared as std::shared_ptr<const ObjectModel>).
+  const TriangleSoup mesh;
+  const geometry::ObjectBVH bvh;
+  double radius = 0;   ///< largest |x| over the vertices (object frame)
+  BoundingBox box;     ///< of the vertices (object frame)
+  /// Every edge is used an even number of times (EdgeParity): only then can an obstacle lie
+  /// inside the object.
+  bool closed = false;
+  ObjectInteriorGrid interior_grid;  ///< closed objects only: inside/outside by cell
+  /// The convex hull as a vertex graph: object vertex ids, and per hull vertex its neighbours
+  /// (CSR, indices into hull_vertices). Without a usable 3D hull, every vertex and no graph.
+  std::vector<std::uint32_t> hull_vertices;
+  std::vector<std::uint32_t> hull_offsets, hull_neighbours;
+};
+
+}  // namespace tetrapage
