@@ -85,12 +85,22 @@ with open(f"{plots}/budget.dat", "w") as f:
             fraction = 1.0 if r["run"] == "all" else r["budget_bytes"] / r["shard_bytes"]
             f.write(f"{fraction} {r['p50']} {r['p99']}\n")
         f.write("\n\n")
+# The scaling curve follows one region size: the one with the most scene sizes ("" = the default).
+def region_of(model):
+    return model.partition("-r")[2]
+
+
+region_sizes = {}
+for r in rows:
+    if r["model"].startswith("scene"):
+        region_sizes.setdefault(region_of(r["model"]), set()).add(r["triangles"])
+curve_region = max(region_sizes, key=lambda k: (len(region_sizes[k]), k == "")) if region_sizes else ""
 with open(f"{plots}/scaling.dat", "w") as f:
     for run in ("all", "10pct"):
         for obj in sorted({r["object"] for r in rows}):
             f.write(f"# {run} object {obj}\n")
             for r in sorted((r for r in rows if r["run"] == run and r["object"] == obj and r["model"].startswith("scene")
-                             and "-r" not in r["model"]), key=lambda r: r["triangles"]):
+                             and region_of(r["model"]) == curve_region), key=lambda r: r["triangles"]):
                 f.write(f"{r['triangles']} {r['steps_per_second']} {r['p99']} {r['open_to_first_answer_ms']} "
                         f"{mib(r['peak_rss_bytes'])}\n")
             f.write("\n\n")

@@ -392,11 +392,15 @@ ShardChoice parse_shard_choice(const std::string& text) {
   throw InputError("unknown shard kind '" + text + "' (use auto, grid or rtree)");
 }
 
+std::size_t auto_region_triangles(std::uint64_t triangles) {
+  constexpr std::uint64_t kMinimum = 4096, kLeaves = 12'000;  // 12,000 leaves: about 100k tets
+  return std::size_t(std::max(kMinimum, (triangles + kLeaves - 1) / kLeaves));
+}
+
 PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                              const std::filesystem::path& output,
                              const PreprocessOptions& options) {
   if (inputs.empty()) throw InputError("no input given");
-  if (options.region_triangles == 0) throw InputError("--region-triangles must be at least 1");
   if (options.memory_bytes < (std::uint64_t(16) << 20))
     throw InputError("--memory " + format_byte_size(options.memory_bytes) +
                      " is below the 16 MiB the pipeline needs to work");
@@ -431,7 +435,9 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     StageClock clock(summary, "coarse mesh");
     // The sample stands for all triangles: scale the leaf size to its share.
     const double share = double(in.sample.size()) / double(triangle_count);
-    sampling.leaf_triangles = std::max<std::size_t>(1, std::size_t(std::llround(double(options.region_triangles) * share)));
+    summary.region_triangles =
+        options.region_triangles != 0 ? options.region_triangles : auto_region_triangles(triangle_count);
+    sampling.leaf_triangles = std::max<std::size_t>(1, std::size_t(std::llround(double(summary.region_triangles) * share)));
     const std::vector<Vec3> sites = sample_sites(in.sample, in.bounds, sampling);
     summary.sites = sites.size();
     mesh = build_coarse_mesh(sites);
@@ -679,6 +685,7 @@ std::string PreprocessSummary::to_json() const {
   j["parts"] = parts;
   j["triangles_read"] = triangles_read;
   j["degenerate_dropped"] = degenerate_dropped;
+  j["region_triangles"] = region_triangles;
   j["sites"] = sites;
   j["regions"] = regions;
   j["empty_regions"] = empty_regions;
@@ -716,8 +723,10 @@ std::string PreprocessSummary::to_text() const {
                 (unsigned long long)triangles_read, (unsigned long long)degenerate_dropped,
                 (unsigned long long)files_read, (unsigned long long)parts);
   text << line;
-  std::snprintf(line, sizeof line, "regions %llu (empty %llu), shards: grid %llu, rtree %llu; duplication factor %.3f\n",
-                (unsigned long long)regions, (unsigned long long)empty_regions,
+  std::snprintf(line, sizeof line,
+                "regions %llu (empty %llu; %llu triangles per region asked), shards: grid %llu, rtree %llu; "
+                "duplication factor %.3f\n",
+                (unsigned long long)regions, (unsigned long long)empty_regions, (unsigned long long)region_triangles,
                 (unsigned long long)grid_shards, (unsigned long long)rtree_shards, duplication_factor);
   text << line;
   std::snprintf(line, sizeof line, "index %s: %s (%.1f B/triangle), shards decoded %s; %s coordinates, max rounding %.3g\n",

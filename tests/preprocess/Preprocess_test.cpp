@@ -137,6 +137,24 @@ TEST(Preprocess, SceneTetsHoldExactlyTheTrianglesTheyMeet) {
   expect_tets_match_brute_force(input, folder / "scene.tpi", true);
 }
 
+TEST(Preprocess, AutomaticRegionSizeKeepsTheCoarseMeshBounded) {
+  // 4096 up to 49M triangles, then about 12,000 leaves whatever the size.
+  EXPECT_EQ(auto_region_triangles(1), 4096u);
+  EXPECT_EQ(auto_region_triangles(10'000'000), 4096u);
+  for (const std::uint64_t n : {std::uint64_t(60'000'000), std::uint64_t(100'000'000), std::uint64_t(1'000'000'000)}) {
+    const std::size_t size = auto_region_triangles(n);
+    EXPECT_GT(size, 4096u) << n;
+    EXPECT_LE(double(n) / double(size), 12'000.0) << n;
+    EXPECT_GT(double(n) / double(size), 11'999.0) << n;
+  }
+  // The default asks for the automatic size, and the summary says which it used.
+  const fs::path folder = test_folder("auto-region");
+  const fs::path input = make_scene(folder, 3000, 5);
+  const PreprocessSummary summary = preprocess({input}, folder / "scene.tpi", PreprocessOptions{});
+  EXPECT_EQ(summary.region_triangles, 4096u);
+  EXPECT_GE(summary.regions, 1u);
+}
+
 TEST(Preprocess, TetrasWithFloatStorageAndForcedKinds) {
   const fs::path folder = test_folder("tetras");
   const fs::path input = make_tetras(folder, 400, 5);

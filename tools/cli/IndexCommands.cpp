@@ -262,9 +262,11 @@ void add_index_commands(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("-o,--output", pre->output, "The index file to write (e.g. model.tpi)")->required();
-  command->add_option("--region-triangles", pre->region_triangles, "Target triangles per region")
+  command->add_option("--region-triangles", pre->region_triangles,
+                      "Target triangles per region; 0 (the default): 4096, or the model's triangles / 12,000 "
+                      "when larger, so that the coarse mesh stays near 100k tets")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::NonNegativeNumber);
   command->add_option("--memory", pre->memory,
                       "Working-memory budget (e.g. 512M, 4G); larger models spill to disk next to the output")
       ->capture_default_str();

@@ -24,11 +24,17 @@ enum class ShardChoice : std::uint8_t { automatic, grid, rtree };
 /// @throw InputError for anything but "auto", "grid", "rtree".
 ShardChoice parse_shard_choice(const std::string& text);
 
+/// The automatic region size: 4096 triangles (measured best on the 1M scene; at 100M it meets
+/// the index's 30 B and the resident shards' 40 B per triangle, which 2048 did not), or more
+/// for models beyond 49M triangles, so that the coarse mesh stays near 100k tets: its tables are
+/// read whole at open, and open to first answer must stay in milliseconds whatever the model
+/// (docs/BENCHMARKS.md, "Region size").
+std::size_t auto_region_triangles(std::uint64_t triangles);
+
 struct PreprocessOptions {
-  /// Target triangles per region (the leaf size of the adaptive split of centroids). 4096
-  /// measured best on the 1M scene and meets the index's 30 B and the resident shards' 40 B
-  /// per triangle at 100M (2048 did not); docs/BENCHMARKS.md, "Region size".
-  std::size_t region_triangles = 4096;
+  /// Target triangles per region (the leaf size of the adaptive split of centroids); 0: auto,
+  /// auto_region_triangles(triangles read).
+  std::size_t region_triangles = 0;
   /// Working-memory budget in bytes (the ingest's largest part file comes on top).
   std::uint64_t memory_bytes = std::uint64_t(1) << 30;
   /// Worker threads; 0: all cores.
@@ -61,6 +67,7 @@ struct PreprocessSummary {
   std::uint64_t parts = 0;
   std::uint64_t triangles_read = 0;        ///< kept triangles, as read and placed
   std::uint64_t degenerate_dropped = 0;    ///< by the readers and the placement
+  std::uint64_t region_triangles = 0;      ///< the target used (the option, or the automatic one)
   std::uint64_t sites = 0;
   std::uint64_t regions = 0;               ///< tets of the coarse mesh
   std::uint64_t empty_regions = 0;         ///< tets without triangles (no shard)
