@@ -72,7 +72,7 @@ bench: build
 	  $(BUILD)/bench/tetrapage_bench_$$b --benchmark_out=$(BUILD)/bench-results/$$b.json \
 	    --benchmark_out_format=json || exit 1; \
 	done
-	$(MAKE) --no-print-directory bench-study bench-accuracy bench-scale
+	$(MAKE) --no-print-directory bench-study bench-accuracy bench-peers bench-scale
 
 # The study's flight benchmark: its environment groups x its six objects, the four methods, the
 # hybrid (in memory and paged under 1 MiB) and the peers; tables and plots for docs/BENCHMARKS.md.
@@ -81,8 +81,8 @@ bench-study: build
 	$(BUILD)/bench/tetrapage_bench_study --out $(BUILD)/bench-results/study --memory 1M $(STUDY_FLAGS)
 
 # The out-of-core scale series (issue 8): generated scenes of SCALE_SIZES triangles and a terrain,
-# preprocessed and flown under budgets from 64 MiB to everything resident; scale.md and plots.
-# The 100M scene needs about 10 GB of disk and an hour.
+# preprocessed (automatic region size) and flown under budgets from 64 MiB to everything
+# resident; scale.md and plots. The 100M scene needs about 10 GB of disk and half an hour.
 SCALE_SIZES ?= 1000000 10000000 50000000 100000000
 bench-scale: build
 	TETRAPAGE=$(TETRAPAGE) TERRAIN=10000000 bench/scripts/scale_series.sh $(BUILD)/bench-results/scale $(SCALE_SIZES)
