@@ -38,6 +38,8 @@ Vec3 centre_in_mesh_box(const geometry::Box& box, const CollisionIndex& index) {
 
 // Hill-climbing pays off on objects with many hull vertices; tiny ones are placed whole.
 constexpr std::size_t kHillClimbMinimum = 32;
+// Hulls of at most this many facets also prune by their planes (ObjectModel::hull_planes).
+constexpr std::size_t kPruningPlanes = 24;
 
 // How far the placement (apply_pose) may move a vertex, relative to the object's radius plus
 // the translation's magnitude, taken far beyond the few ulps it really moves: a vertex deeper
@@ -77,6 +79,33 @@ void distinct_triangle_vertices(const TriangleSoup& object, std::vector<Kernel::
         points.emplace_back(object.vertices[v][0], object.vertices[v][1], object.vertices[v][2]);
 }
 
+// The facets' planes of a hull (outward unit normal n and offset: n.x <= offset inside, up to
+// rounding), skipping facets without area.
+std::vector<std::pair<Vec3, double>> facet_planes(const std::vector<Kernel::Point_3>& hull_points,
+                                                  const std::vector<std::array<std::size_t, 3>>& faces) {
+  std::vector<std::pair<Vec3, double>> planes;
+  if (faces.empty()) return planes;
+  Vec3 centre{0, 0, 0};
+  for (const auto& p : hull_points)
+    for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
+  for (const auto& f : faces) {
+    const geometry::Point a = to_point(hull_points[f[0]]), b = to_point(hull_points[f[1]]),
+                          c = to_point(hull_points[f[2]]);
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    Vec3 n{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(length > 0)) continue;
+    for (auto& x : n) x /= length;
+    double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
+    if (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2] > offset) {
+      for (auto& x : n) x = -x;
+      offset = -offset;
+    }
+    planes.push_back({n, offset});
+  }
+  return planes;
+}
+
 }  // namespace
 
 /// The solid standing for the object in one step: a box, or a convex hull as triangles (CGAL's
@@ -103,9 +132,11 @@ void build_hull_graph(ObjectModel& model, const TriangleSoup& object) {
   std::vector<Kernel::Point_3> points;
   std::map<std::array<double, 3>, std::uint32_t> id_of;
   distinct_triangle_vertices(object, points, id_of);
+  bool few_facets = points.size() < kHillClimbMinimum;
   if (points.size() >= kHillClimbMinimum) {
     CGAL::Surface_mesh<Kernel::Point_3> hull;
     CGAL::convex_hull_3(points.begin(), points.end(), hull);
+    few_facets = hull.number_of_faces() <= kPruningPlanes;
     if (hull.number_of_faces() > 0) {
       std::map<CGAL::Surface_mesh<Kernel::Point_3>::Vertex_index, std::uint32_t> position;
       for (const auto v : hull.vertices()) {
@@ -124,6 +155,24 @@ void build_hull_graph(ObjectModel& model, const TriangleSoup& object) {
   if (model.hull_vertices.empty()) {
     // No usable hull: every vertex, no graph (world_box scans them all).
     for (const auto& [point, id] : id_of) model.hull_vertices.push_back(id);
+  }
+  if (few_facets && points.size() >= 4) {
+    // A hull of few facets prunes cheaply: what lies beyond one of its planes misses the
+    // object. Only for a hull with volume (its centre well inside every plane).
+    std::vector<Kernel::Point_3> hull_points;
+    std::vector<std::array<std::size_t, 3>> faces;
+    hull_of(points, hull_points, faces);
+    if (faces.size() <= kPruningPlanes) {
+      auto planes = facet_planes(hull_points, faces);
+      Vec3 centre{0, 0, 0};
+      for (const auto& p : hull_points)
+        for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
+      const bool solid = !planes.empty() && std::all_of(planes.begin(), planes.end(), [&](const auto& plane) {
+        const auto& [n, offset] = plane;
+        return offset - (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2]) > 1e-9 * model.radius;
+      });
+      if (solid) model.hull_planes = std::move(planes);
+    }
   }
 }
 
@@ -166,27 +215,7 @@ void FlyingObject::prepare_hull_candidates() {
   std::vector<std::array<std::size_t, 3>> faces;
   if (points.size() >= 4) hull_of(points, hull_points, faces);
   // Outward unit normals of a hull with volume; a flat or tiny object keeps every vertex.
-  std::vector<std::pair<Vec3, double>> planes;
-  if (!faces.empty()) {
-    Vec3 centre{0, 0, 0};
-    for (const auto& p : hull_points)
-      for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
-    for (const auto& f : faces) {
-      const geometry::Point a = to_point(hull_points[f[0]]), b = to_point(hull_points[f[1]]),
-                            c = to_point(hull_points[f[2]]);
-      const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-      Vec3 n{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-      const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-      if (!(length > 0)) continue;
-      for (auto& x : n) x /= length;
-      double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-      if (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2] > offset) {
-        for (auto& x : n) x = -x;
-        offset = -offset;
-      }
-      planes.push_back({n, offset});
-    }
-  }
+  const std::vector<std::pair<Vec3, double>> planes = facet_planes(hull_points, faces);
   std::vector<bool> on_hull(model_->mesh.vertices.size(), false);
   for (const auto& p : hull_points) {
     const std::uint32_t id = id_of.at({p.x(), p.y(), p.z()});
@@ -548,6 +577,17 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   const double surface_test_extent =
       0.1 * std::max({model_->box.hi[0] - model_->box.lo[0], model_->box.hi[1] - model_->box.lo[1],
                       model_->box.hi[2] - model_->box.lo[2]});
+  // A box in the object's frame wholly beyond one of the hull's planes misses the object and
+  // its hull (the margin covers the planes' rounding, far beyond it).
+  const double plane_margin = model_->radius * 0x1p-30;
+  auto beyond_hull = [&](const geometry::Box& b) {
+    for (const auto& [n, offset] : model_->hull_planes) {
+      double lowest = 0;
+      for (int a = 0; a < 3; ++a) lowest += n[a] * (n[a] > 0 ? b.lo[a] : b.hi[a]);
+      if (lowest > offset + plane_margin) return true;
+    }
+    return false;
+  };
   auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
     Vec3 c, h;
@@ -565,6 +605,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       in_frame.lo[a] = x - e - reach - margin;
       in_frame.hi[a] = x + e + reach + margin;
     }
+    if (beyond_hull(in_frame)) return false;
     if (!near_surface_only || triangles < kSurfaceTestTriangles || std::max({h[0], h[1], h[2]}) > surface_test_extent)
       return true;
     bool near_surface = false;
@@ -585,7 +626,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
       const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-      if ((own_frame && !geometry::boxes_overlap(query, model_->box)) ||
+      if ((own_frame && (!geometry::boxes_overlap(query, model_->box) || beyond_hull(query))) ||
           !geometry::triangle_intersects_box(environment, box))
         return;
       ++counters.candidates;

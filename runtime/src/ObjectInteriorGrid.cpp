@@ -32,7 +32,9 @@ ObjectInteriorGrid::Side parity(const geometry::ObjectBVH& bvh, const Vec3& p) {
 }  // namespace
 
 ObjectInteriorGrid::ObjectInteriorGrid(const geometry::ObjectBVH& bvh) : box_(bvh.bounds()) {
-  n_ = std::clamp<std::size_t>(std::size_t(3 * std::cbrt(double(bvh.triangle_count()))), 4, 48);
+  // At least 16 cells a side: coarser grids left most points near small objects undecided
+  // (4-triangle object on the 10M scene: +9 % steps/s with 16 instead of 4).
+  n_ = std::clamp<std::size_t>(std::size_t(3 * std::cbrt(double(bvh.triangle_count()))), 16, 48);
   for (int a = 0; a < 3; ++a) {
     cuts_[a].resize(n_ + 1);
     for (std::size_t i = 0; i <= n_; ++i) cuts_[a][i] = box_.lo[a] + (box_.hi[a] - box_.lo[a]) * double(i) / double(n_);

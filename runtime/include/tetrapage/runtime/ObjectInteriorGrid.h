@@ -48,7 +48,7 @@ class ObjectInteriorGrid {
 
   ObjectInteriorGrid() = default;
   /// Builds the grid over the closed object `bvh` (its triangles, object frame), about
-  /// 3 * cbrt(triangles) cells per axis (4 to 48).
+  /// 3 * cbrt(triangles) cells per axis (16 to 48).
   explicit ObjectInteriorGrid(const geometry::ObjectBVH& bvh);
 
   /// The side of every point within `margin` (per coordinate) of `x` (object frame), or

@@ -7,6 +7,7 @@
 /// several) share one model, and a model can be built while an index opens.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "tetrapage/formats/TriangleSoup.h"
@@ -33,6 +34,10 @@ class ObjectModel {
   /// (CSR, indices into hull_vertices). Without a usable 3D hull, every vertex and no graph.
   std::vector<std::uint32_t> hull_vertices;
   std::vector<std::uint32_t> hull_offsets, hull_neighbours;
+  /// For a hull of at most 24 facets with volume: each facet's outward unit normal n and offset
+  /// (n.x <= offset holds the object, up to rounding), a cheap test that prunes what lies
+  /// beyond; empty otherwise.
+  std::vector<std::pair<Vec3, double>> hull_planes;
 };
 
 }  // namespace tetrapage
