@@ -701,7 +701,7 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
   const auto start = Clock::now();
   // The object inside an obstacle: with no surface contact, one vertex decides for all.
   if (index_->has_interiors()) {
-    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(model_->mesh.triangles[0][0]));
+    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(model_->mesh.triangles[0][0]), interior_memo_);
     if (inside.containment == ObstacleContainment::inside) {
       result.collides = true;
       result.containment = Containment::object_inside_obstacle;

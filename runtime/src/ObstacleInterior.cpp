@@ -67,33 +67,30 @@ bool on_closed_surface(const CollisionIndex& index, const Shard& shard, const ge
   return on;
 }
 
-}  // namespace
-
-ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
-                                  const geometry::Point& p) {
-  ObstacleQuery answer;
-  if (!index.has_interiors()) return answer;
-  const TetMesh& mesh = index.mesh();
-  const WalkResult located = locate_point(mesh, hint_tet, p);
-  if (located.tet == TetMesh::no_neighbour) {
+// The answer of a decided point from the closed parts holding it.
+ObstacleQuery decided(ObstacleQuery answer, const std::vector<std::uint32_t>& parts) {
+  if (parts.empty()) {
     answer.containment = ObstacleContainment::outside;
-    return answer;
+  } else {
+    answer.containment = ObstacleContainment::inside;
+    answer.part = *std::min_element(parts.begin(), parts.end());
   }
-  hint_tet = answer.tet = located.tet;
-  if (!index.interior_decided(located.tet)) return answer;
-  const auto stored = index.interior_parts(located.tet);
-  std::vector<std::uint32_t> parts(stored.begin(), stored.end());
-  const auto finish = [&] {
-    if (parts.empty()) {
-      answer.containment = ObstacleContainment::outside;
-    } else {
-      answer.containment = ObstacleContainment::inside;
-      answer.part = *std::min_element(parts.begin(), parts.end());
-    }
-    return answer;
-  };
-  const std::uint32_t shard_id = index.shard_of_tet(located.tet);
-  const geometry::Point& reference = index.reference_point(located.tet);
+  return answer;
+}
+
+// From the tet's reference point (the tet holds p); `parts` receives the closed parts holding
+// p when the answer is inside or outside.
+ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet, const geometry::Point& p,
+                             std::vector<std::uint32_t>& parts) {
+  ObstacleQuery answer;
+  answer.tet = tet;
+  if (!index.interior_decided(tet)) return answer;
+  const TetMesh& mesh = index.mesh();
+  const auto stored = index.interior_parts(tet);
+  parts.assign(stored.begin(), stored.end());
+  const auto finish = [&] { return decided(answer, parts); };
+  const std::uint32_t shard_id = index.shard_of_tet(tet);
+  const geometry::Point& reference = index.reference_point(tet);
   geometry::Box reach;
   reach.extend(reference);
   reach.extend(p);
@@ -110,7 +107,7 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
     answer.containment = ObstacleContainment::on_surface;
     return answer;
   }
-  const auto corners = mesh.corners(located.tet);
+  const auto corners = mesh.corners(tet);
   for (const auto& w : kBendWeights) {
     geometry::Point bend{};
     for (int a = 0; a < 3; ++a)
@@ -127,6 +124,55 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
       return finish();
   }
   answer.containment = ObstacleContainment::unknown;
+  return answer;
+}
+
+}  // namespace
+
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
+                                  const geometry::Point& p) {
+  ObstacleMemo memo;
+  return locate_in_obstacles(index, hint_tet, p, memo);
+}
+
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
+                                  const geometry::Point& p, ObstacleMemo& memo) {
+  ObstacleQuery answer;
+  if (!index.has_interiors()) return answer;
+  const WalkResult located = locate_point(index.mesh(), hint_tet, p);
+  if (located.tet == TetMesh::no_neighbour) {
+    memo.valid = false;
+    answer.containment = ObstacleContainment::outside;
+    return answer;
+  }
+  hint_tet = answer.tet = located.tet;
+  if (memo.valid && memo.tet == located.tet) {
+    // Both points lie in the convex tet, so the segment between them does too, and every
+    // triangle it can cross is in the tet's shard.
+    answer.paths_tried = 1;
+    if (memo.point == p) return decided(answer, memo.parts);
+    const std::uint32_t shard_id = index.shard_of_tet(located.tet);
+    geometry::Box reach;
+    reach.extend(memo.point);
+    reach.extend(p);
+    if (shard_id == TetMesh::no_neighbour || !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
+      memo.point = p;
+      return decided(answer, memo.parts);
+    }
+    const auto pin = index.cache().acquire(shard_id);
+    std::vector<std::uint32_t>& parts = memo.parts;
+    const std::vector<std::uint32_t> before = parts;
+    if (count_crossings(index, *pin, {memo.point, p}, parts, answer.triangle_tests)) {
+      memo.point = p;
+      return decided(answer, parts);
+    }
+    parts = before;  // a degenerate short path: decide from the reference point
+  }
+  answer = from_reference(index, located.tet, p, memo.parts);
+  memo.valid = answer.containment == ObstacleContainment::inside ||
+               answer.containment == ObstacleContainment::outside;
+  memo.tet = located.tet;
+  memo.point = p;
   return answer;
 }
 

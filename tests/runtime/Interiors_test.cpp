@@ -191,6 +191,44 @@ TEST(Interiors, RandomPointsAgreeWithParityOverWholeClosedMeshes) {
   expect_points_agree(model());
 }
 
+TEST(Interiors, AMovingPointDecidedFromItsLastAnswerAgreesWithTheOracle) {
+  // A random walk of short steps: most points share their tet with the one before, and are
+  // decided by parity along the step (ObstacleMemo) rather than from the reference point.
+  const Model& m = model();
+  const ReferenceCollider oracle(m.environment, tetra_object(0.01));
+  const CollisionIndex index(m.index);
+  Random random(23);
+  const BoundingBox box = m.environment.bounds();
+  geometry::Point p{};
+  std::uint32_t hint = 0, plain_hint = 0;
+  ObstacleMemo memo;
+  int inside = 0, from_memo = 0, wrong = 0;
+  const int steps = 20000;
+  for (int i = 0; i < steps; ++i) {
+    // Every 50 steps a jump to a random point of the box, then short steps from there.
+    for (int a = 0; a < 3; ++a)
+      p[a] = i % 50 == 0 ? random.uniform(box.lo[a], box.hi[a])
+                         : std::clamp(p[a] + random.uniform(-0.002, 0.002) * (box.hi[a] - box.lo[a]), box.lo[a],
+                                      box.hi[a]);
+    const bool same_tet = memo.valid;
+    const std::uint32_t memo_tet = memo.tet;
+    const ObstacleQuery answer = locate_in_obstacles(index, hint, p, memo);
+    from_memo += same_tet && answer.tet == memo_tet;
+    const ObstacleQuery plain = locate_in_obstacles(index, plain_hint, p);
+    EXPECT_EQ(answer.containment, plain.containment) << "step " << i;
+    if (answer.containment != ObstacleContainment::inside && answer.containment != ObstacleContainment::outside)
+      continue;
+    EXPECT_EQ(answer.part, plain.part) << "step " << i;
+    const bool oracle_inside = oracle.inside_environment(p);
+    inside += oracle_inside;
+    if ((answer.containment == ObstacleContainment::inside) != oracle_inside && ++wrong <= 5)
+      ADD_FAILURE() << "step " << i << ": point (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(inside, steps / 50) << "the walk must visit interiors";
+  EXPECT_GT(from_memo, steps / 2) << "most steps must be decided from the last answer";
+}
+
 TEST(Interiors, ClassifiedInBatchesUnderASmallBudgetTheAnswersAreTheSame) {
   // Batches of a third of the model, or of the largest part if that is more (parts go whole).
   const Model& whole = model();

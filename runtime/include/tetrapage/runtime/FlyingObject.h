@@ -21,6 +21,7 @@
 #include "tetrapage/runtime/BoxSearch.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/ObjectModel.h"
+#include "tetrapage/runtime/ObstacleInterior.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
 
@@ -179,6 +180,7 @@ class FlyingObject {
   // the object's box (only those can lie inside the object).
   std::vector<std::pair<geometry::Point, std::uint32_t>> enclosed_;
   std::uint32_t interior_tet_ = 0;  ///< where the last containment walk ended
+  ObstacleMemo interior_memo_;      ///< the last containment answer, for the next step's
   std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
   // The solids' vertex candidates (prepared on the first hull or swept query): the vertices of
   // the object's own hull, then the other vertices by their depth inside it (ascending). A

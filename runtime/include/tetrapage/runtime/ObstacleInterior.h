@@ -9,6 +9,7 @@
 /// edge or vertex, or lies in its plane, is bent through another point strictly inside the tet
 /// (parity along a closed surface does not depend on the path).
 #include <cstdint>
+#include <vector>
 
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
@@ -35,5 +36,19 @@ struct ObstacleQuery {
 /// @throw InputError for a non-finite p or a hint out of range; what the shard cache throws.
 ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
                                   const geometry::Point& p);
+
+/// The last point decided inside or outside, with its tet and the closed parts holding it:
+/// a point of the same tet is then decided from it (parity along the short segment between
+/// them) instead of from the tet's reference point, whose segment meets far more triangles.
+struct ObstacleMemo {
+  bool valid = false;
+  std::uint32_t tet = 0;
+  geometry::Point point{};
+  std::vector<std::uint32_t> parts;
+};
+
+/// The same answer, using and updating `memo` (one per moving point, e.g. per flying object).
+ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
+                                  const geometry::Point& p, ObstacleMemo& memo);
 
 }  // namespace tetrapage
