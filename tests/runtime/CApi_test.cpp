@@ -4,6 +4,8 @@
 // random poses. The index is built once by preprocess from a few hundred triangles (stored in
 // double precision, so the stored coordinates are the input's).
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -134,7 +136,10 @@ std::set<ContactKey> contact_set(const std::vector<Contact>& contacts) {
 class CApiTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    folder_ = fs::path(TETRAPAGE_TEST_TMP) / "capi";
+    // ctest runs each test in its own process, two at a time: one folder per process, or two
+    // set-ups write the same files at once and a failed set-up skips the tests silently.
+    folder_ = fs::path(TETRAPAGE_TEST_TMP) / ("capi-" + std::to_string(::getpid()));
+    fs::remove_all(folder_);
     fs::create_directories(folder_);
     // Two subdivided boxes and a thin slab between them: 2 * 192 + 48 = 432 triangles, on
     // dyadic coordinates.
@@ -155,6 +160,8 @@ class CApiTest : public ::testing::Test {
     preprocess({folder_ / "environment.obj"}, index_path_, options);
     write_mesh(folder_ / "object.obj", small_object());
   }
+
+  static void TearDownTestSuite() { fs::remove_all(folder_); }
 
   void SetUp() override {
     ASSERT_EQ(tetrapage_open(index_path_.c_str(), kBudget, &index_), TETRAPAGE_OK) << tetrapage_last_error();
