@@ -1,17 +1,13 @@
 #include "tetrapage/runtime/FlyingObject.h"
 
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/Surface_mesh.h>
-#include <CGAL/convex_hull_3.h>
-
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <map>
 
-#include <tbb/parallel_invoke.h>
-
+#include "ConvexHull.h"
 #include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
@@ -23,7 +19,11 @@ namespace tetrapage {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using hull::Kernel;
+using hull::distinct_triangle_vertices;
+using hull::facet_planes;
+using hull::hull_of;
+using hull::to_point;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -36,75 +36,10 @@ Vec3 centre_in_mesh_box(const geometry::Box& box, const CollisionIndex& index) {
   return centre;
 }
 
-// Hill-climbing pays off on objects with many hull vertices; tiny ones are placed whole.
-constexpr std::size_t kHillClimbMinimum = 32;
-// Hulls of at most this many facets also prune by their planes (ObjectModel::hull_planes).
-constexpr std::size_t kPruningPlanes = 24;
-
 // How far the placement (apply_pose) may move a vertex, relative to the object's radius plus
 // the translation's magnitude, taken far beyond the few ulps it really moves: a vertex deeper
 // inside the object's hull than this cannot reach the hull of the placed hull vertices.
 constexpr double kPlacementReach = 0x1p-36;
-
-geometry::Point to_point(const Kernel::Point_3& p) { return {p.x(), p.y(), p.z()}; }
-
-// The convex hull of the points as vertices and triangles (outward, coplanar facets
-// triangulated; nothing for fewer than three non-collinear points). Through a Surface_mesh:
-// CGAL 5.5's indexed-triangle-set output crashed on some inputs.
-void hull_of(const std::vector<Kernel::Point_3>& points, std::vector<Kernel::Point_3>& vertices,
-             std::vector<std::array<std::size_t, 3>>& faces) {
-  CGAL::Surface_mesh<Kernel::Point_3> hull;
-  CGAL::convex_hull_3(points.begin(), points.end(), hull);
-  vertices.clear();
-  faces.clear();
-  for (const auto v : hull.vertices()) vertices.push_back(hull.point(v));
-  for (const auto f : hull.faces()) {
-    std::array<std::size_t, 3> corners{};
-    int k = 0;
-    for (const auto v : CGAL::vertices_around_face(hull.halfedge(f), hull)) {
-      if (k == 3) break;
-      corners[k++] = std::size_t(v.idx());
-    }
-    if (k == 3) faces.push_back(corners);
-  }
-}
-
-// The object's distinct vertex positions that some triangle uses, as CGAL points, and the first
-// vertex id of each position.
-void distinct_triangle_vertices(const TriangleSoup& object, std::vector<Kernel::Point_3>& points,
-                                std::map<std::array<double, 3>, std::uint32_t>& id_of) {
-  for (const auto& t : object.triangles)
-    for (const auto v : t)
-      if (id_of.emplace(object.vertices[v], v).second)
-        points.emplace_back(object.vertices[v][0], object.vertices[v][1], object.vertices[v][2]);
-}
-
-// The facets' planes of a hull (outward unit normal n and offset: n.x <= offset inside, up to
-// rounding), skipping facets without area.
-std::vector<std::pair<Vec3, double>> facet_planes(const std::vector<Kernel::Point_3>& hull_points,
-                                                  const std::vector<std::array<std::size_t, 3>>& faces) {
-  std::vector<std::pair<Vec3, double>> planes;
-  if (faces.empty()) return planes;
-  Vec3 centre{0, 0, 0};
-  for (const auto& p : hull_points)
-    for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
-  for (const auto& f : faces) {
-    const geometry::Point a = to_point(hull_points[f[0]]), b = to_point(hull_points[f[1]]),
-                          c = to_point(hull_points[f[2]]);
-    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    Vec3 n{u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-    const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(length > 0)) continue;
-    for (auto& x : n) x /= length;
-    double offset = n[0] * a[0] + n[1] * a[1] + n[2] * a[2];
-    if (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2] > offset) {
-      for (auto& x : n) x = -x;
-      offset = -offset;
-    }
-    planes.push_back({n, offset});
-  }
-  return planes;
-}
 
 }  // namespace
 
@@ -122,78 +57,6 @@ struct FlyingObject::Solid {
   std::vector<Kernel::Point_3> points, hull_points;
   std::vector<std::array<std::size_t, 3>> hull_faces;
 };
-
-namespace {
-
-// The hull's vertex graph of a model (ObjectModel::hull_vertices, hull_offsets, hull_neighbours).
-void build_hull_graph(ObjectModel& model, const TriangleSoup& object) {
-  // The hull's vertex graph, for hill-climbing the world box. Vertices not on any triangle
-  // do not matter; a flat object has no 3D hull and is placed whole.
-  std::vector<Kernel::Point_3> points;
-  std::map<std::array<double, 3>, std::uint32_t> id_of;
-  distinct_triangle_vertices(object, points, id_of);
-  bool few_facets = points.size() < kHillClimbMinimum;
-  if (points.size() >= kHillClimbMinimum) {
-    CGAL::Surface_mesh<Kernel::Point_3> hull;
-    CGAL::convex_hull_3(points.begin(), points.end(), hull);
-    few_facets = hull.number_of_faces() <= kPruningPlanes;
-    if (hull.number_of_faces() > 0) {
-      std::map<CGAL::Surface_mesh<Kernel::Point_3>::Vertex_index, std::uint32_t> position;
-      for (const auto v : hull.vertices()) {
-        const auto& p = hull.point(v);
-        position[v] = std::uint32_t(model.hull_vertices.size());
-        model.hull_vertices.push_back(id_of.at({p.x(), p.y(), p.z()}));
-      }
-      model.hull_offsets.push_back(0);
-      for (const auto v : hull.vertices()) {
-        for (const auto h : CGAL::halfedges_around_target(hull.halfedge(v), hull))
-          model.hull_neighbours.push_back(position.at(hull.source(h)));
-        model.hull_offsets.push_back(std::uint32_t(model.hull_neighbours.size()));
-      }
-    }
-  }
-  if (model.hull_vertices.empty()) {
-    // No usable hull: every vertex, no graph (world_box scans them all).
-    for (const auto& [point, id] : id_of) model.hull_vertices.push_back(id);
-  }
-  if (few_facets && points.size() >= 4) {
-    // A hull of few facets prunes cheaply: what lies beyond one of its planes misses the
-    // object. Only for a hull with volume (its centre well inside every plane).
-    std::vector<Kernel::Point_3> hull_points;
-    std::vector<std::array<std::size_t, 3>> faces;
-    hull_of(points, hull_points, faces);
-    if (faces.size() <= kPruningPlanes) {
-      auto planes = facet_planes(hull_points, faces);
-      Vec3 centre{0, 0, 0};
-      for (const auto& p : hull_points)
-        for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
-      const bool solid = !planes.empty() && std::all_of(planes.begin(), planes.end(), [&](const auto& plane) {
-        const auto& [n, offset] = plane;
-        return offset - (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2]) > 1e-9 * model.radius;
-      });
-      if (solid) model.hull_planes = std::move(planes);
-    }
-  }
-}
-
-}  // namespace
-
-ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mesh) {
-  for (const auto& v : mesh.vertices) {
-    radius = std::max(radius, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
-    box.extend(v);
-  }
-  // The interior grid and the hull are independent: build them side by side (opening an
-  // index and placing a large object must take milliseconds).
-  tbb::parallel_invoke(
-      [&] {
-        EdgeParity parity;
-        for (std::size_t t = 0; t < mesh.triangle_count(); ++t) parity.add_triangle(mesh.corners(t));
-        closed = parity.closed();
-        if (closed) interior_grid = ObjectInteriorGrid(bvh);
-      },
-      [&] { build_hull_graph(*this, mesh); });
-}
 
 FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
     : FlyingObject(std::move(index), std::make_shared<const ObjectModel>(std::move(object))) {}

@@ -24,8 +24,8 @@ class ObjectModel {
   /// Read-only after construction (models are shared as std::shared_ptr<const ObjectModel>).
   const TriangleSoup mesh;
   const geometry::ObjectBVH bvh;
-  double radius = 0;   ///< largest |x| over the vertices (object frame)
-  BoundingBox box;     ///< of the vertices (object frame)
+  double radius = 0;  ///< largest |x| over the vertices (object frame)
+  BoundingBox box;    ///< of the vertices (object frame)
   /// Every edge is used an even number of times (EdgeParity): only then can an obstacle lie
   /// inside the object.
   bool closed = false;

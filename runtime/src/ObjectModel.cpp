@@ -1,0 +1,102 @@
+#include "tetrapage/runtime/ObjectModel.h"
+
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/convex_hull_3.h>
+
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "ConvexHull.h"
+#include "tetrapage/formats/EdgeParity.h"
+
+namespace tetrapage {
+namespace {
+
+using hull::distinct_triangle_vertices;
+using hull::facet_planes;
+using hull::hull_of;
+using hull::Kernel;
+using hull::to_point;
+
+// Hill-climbing pays off on objects with many hull vertices; tiny ones are placed whole.
+constexpr std::size_t kHillClimbMinimum = 32;
+// Hulls of at most this many facets also prune by their planes (ObjectModel::hull_planes).
+constexpr std::size_t kPruningPlanes = 24;
+
+// The hull's vertex graph of a model (ObjectModel::hull_vertices, hull_offsets, hull_neighbours).
+void build_hull_graph(ObjectModel& model, const TriangleSoup& object) {
+  // The hull's vertex graph, for hill-climbing the world box. Vertices not on any triangle
+  // do not matter; a flat object has no 3D hull and is placed whole.
+  std::vector<Kernel::Point_3> points;
+  std::map<std::array<double, 3>, std::uint32_t> id_of;
+  distinct_triangle_vertices(object, points, id_of);
+  bool few_facets = points.size() < kHillClimbMinimum;
+  if (points.size() >= kHillClimbMinimum) {
+    CGAL::Surface_mesh<Kernel::Point_3> hull;
+    CGAL::convex_hull_3(points.begin(), points.end(), hull);
+    few_facets = hull.number_of_faces() <= kPruningPlanes;
+    if (hull.number_of_faces() > 0) {
+      std::map<CGAL::Surface_mesh<Kernel::Point_3>::Vertex_index, std::uint32_t> position;
+      for (const auto v : hull.vertices()) {
+        const auto& p = hull.point(v);
+        position[v] = std::uint32_t(model.hull_vertices.size());
+        model.hull_vertices.push_back(id_of.at({p.x(), p.y(), p.z()}));
+      }
+      model.hull_offsets.push_back(0);
+      for (const auto v : hull.vertices()) {
+        for (const auto h : CGAL::halfedges_around_target(hull.halfedge(v), hull))
+          model.hull_neighbours.push_back(position.at(hull.source(h)));
+        model.hull_offsets.push_back(std::uint32_t(model.hull_neighbours.size()));
+      }
+    }
+  }
+  if (model.hull_vertices.empty()) {
+    // No usable hull: every vertex, no graph (world_box scans them all).
+    for (const auto& [point, id] : id_of) model.hull_vertices.push_back(id);
+  }
+  if (few_facets && points.size() >= 4) {
+    // A hull of few facets prunes cheaply: what lies beyond one of its planes misses the
+    // object. Only for a hull with volume (its centre well inside every plane).
+    std::vector<Kernel::Point_3> hull_points;
+    std::vector<std::array<std::size_t, 3>> faces;
+    hull_of(points, hull_points, faces);
+    if (faces.size() <= kPruningPlanes) {
+      auto planes = facet_planes(hull_points, faces);
+      Vec3 centre{0, 0, 0};
+      for (const auto& p : hull_points)
+        for (int a = 0; a < 3; ++a) centre[a] += to_point(p)[a] / double(hull_points.size());
+      const bool solid =
+          !planes.empty() && std::all_of(planes.begin(), planes.end(), [&](const auto& plane) {
+            const auto& [n, offset] = plane;
+            return offset - (n[0] * centre[0] + n[1] * centre[1] + n[2] * centre[2]) >
+                   1e-9 * model.radius;
+          });
+      if (solid) model.hull_planes = std::move(planes);
+    }
+  }
+}
+
+}  // namespace
+
+ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mesh) {
+  for (const auto& v : mesh.vertices) {
+    radius = std::max(radius, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
+    box.extend(v);
+  }
+  // The interior grid and the hull are independent: build them side by side (opening an
+  // index and placing a large object must take milliseconds).
+  tbb::parallel_invoke(
+      [&] {
+        EdgeParity parity;
+        for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+          parity.add_triangle(mesh.corners(t));
+        closed = parity.closed();
+        if (closed) interior_grid = ObjectInteriorGrid(bvh);
+      },
+      [&] { build_hull_graph(*this, mesh); });
+}
+
+}  // namespace tetrapage
