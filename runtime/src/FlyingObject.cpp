@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <map>
 
 #include "ConvexHull.h"
 #include "tetrapage/formats/Error.h"
@@ -20,8 +19,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using hull::Kernel;
-using hull::distinct_triangle_vertices;
-using hull::facet_planes;
 using hull::hull_of;
 using hull::to_point;
 
@@ -69,33 +66,6 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, std::sha
   world_step_.assign(model_->mesh.vertices.size(), ~std::uint64_t{0});
 }
 
-void FlyingObject::prepare_hull_candidates() {
-  hull_candidates_ready_ = true;
-  std::vector<Kernel::Point_3> points;
-  std::map<std::array<double, 3>, std::uint32_t> id_of;
-  distinct_triangle_vertices(model_->mesh, points, id_of);
-  std::vector<Kernel::Point_3> hull_points;
-  std::vector<std::array<std::size_t, 3>> faces;
-  if (points.size() >= 4) hull_of(points, hull_points, faces);
-  // Outward unit normals of a hull with volume; a flat or tiny object keeps every vertex.
-  const std::vector<std::pair<Vec3, double>> planes = facet_planes(hull_points, faces);
-  std::vector<bool> on_hull(model_->mesh.vertices.size(), false);
-  for (const auto& p : hull_points) {
-    const std::uint32_t id = id_of.at({p.x(), p.y(), p.z()});
-    on_hull[id] = true;
-    hull_candidates_.push_back(id);
-  }
-  for (const auto& [point, id] : id_of) {
-    if (on_hull[id]) continue;
-    // The distance to the hull's boundary: the nearest facet plane (0 without a 3D hull).
-    double depth = planes.empty() ? 0.0 : 1e300;
-    for (const auto& [n, offset] : planes)
-      depth = std::min(depth, offset - (n[0] * point[0] + n[1] * point[1] + n[2] * point[2]));
-    near_hull_.emplace_back(std::max(depth, 0.0), id);
-  }
-  std::sort(near_hull_.begin(), near_hull_.end());
-}
-
 void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
   solid.built = true;
   solid.faces.clear();
@@ -109,7 +79,7 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
     return;
   }
   solid.kind = Solid::Kind::hull;
-  if (!hull_candidates_ready_) prepare_hull_candidates();
+  const ObjectModel::HullCandidates& candidates = model_->hull_candidates();
   // The hull candidates at each pose: the object's hull vertices and the vertices within the
   // placement's reach of its surface.
   auto magnitude = [&](const Vec3& t) {
@@ -124,8 +94,8 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
       const Vec3 p = current ? world_vertex(v) : apply_pose(previous_rotation_, previous_translation_, model_->mesh.vertices[v]);
       solid.points.emplace_back(p[0], p[1], p[2]);
     };
-    for (const auto v : hull_candidates_) add(v);
-    for (const auto& [depth, v] : near_hull_) {
+    for (const auto v : candidates.on_hull) add(v);
+    for (const auto& [depth, v] : candidates.near_hull) {
       if (depth > reach) break;
       add(v);
     }

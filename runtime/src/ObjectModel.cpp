@@ -99,4 +99,33 @@ ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mes
       [&] { build_hull_graph(*this, mesh); });
 }
 
+const ObjectModel::HullCandidates& ObjectModel::hull_candidates() const {
+  std::call_once(hull_candidates_once_, [this] {
+    std::vector<Kernel::Point_3> points;
+    std::map<std::array<double, 3>, std::uint32_t> id_of;
+    distinct_triangle_vertices(mesh, points, id_of);
+    std::vector<Kernel::Point_3> hull_points;
+    std::vector<std::array<std::size_t, 3>> faces;
+    if (points.size() >= 4) hull_of(points, hull_points, faces);
+    // Outward unit normals of a hull with volume; a flat or tiny object keeps every vertex.
+    const std::vector<std::pair<Vec3, double>> planes = facet_planes(hull_points, faces);
+    std::vector<bool> on_hull(mesh.vertices.size(), false);
+    for (const auto& p : hull_points) {
+      const std::uint32_t id = id_of.at({p.x(), p.y(), p.z()});
+      on_hull[id] = true;
+      hull_candidates_.on_hull.push_back(id);
+    }
+    for (const auto& [point, id] : id_of) {
+      if (on_hull[id]) continue;
+      // The distance to the hull's boundary: the nearest facet plane (0 without a 3D hull).
+      double depth = planes.empty() ? 0.0 : 1e300;
+      for (const auto& [n, offset] : planes)
+        depth = std::min(depth, offset - (n[0] * point[0] + n[1] * point[1] + n[2] * point[2]));
+      hull_candidates_.near_hull.emplace_back(std::max(depth, 0.0), id);
+    }
+    std::sort(hull_candidates_.near_hull.begin(), hull_candidates_.near_hull.end());
+  });
+  return hull_candidates_;
+}
+
 }  // namespace tetrapage

@@ -160,13 +160,11 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
       return decided(answer, memo.parts);
     }
     const auto pin = index.cache().acquire(shard_id);
-    std::vector<std::uint32_t>& parts = memo.parts;
-    const std::vector<std::uint32_t> before = parts;
-    if (count_crossings(index, *pin, {memo.point, p}, parts, answer.triangle_tests)) {
+    if (count_crossings(index, *pin, {memo.point, p}, memo.parts, answer.triangle_tests)) {
       memo.point = p;
-      return decided(answer, parts);
+      return decided(answer, memo.parts);
     }
-    parts = before;  // a degenerate short path: decide from the reference point
+    // A degenerate short path: decide from the reference point (which resets memo.parts).
   }
   answer = from_reference(index, located.tet, p, memo.parts);
   memo.valid = answer.containment == ObstacleContainment::inside ||

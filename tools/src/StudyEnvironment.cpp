@@ -17,27 +17,18 @@ std::string to_string(EnvironmentKind kind) {
 }
 
 void generate_environment(EnvironmentKind kind, std::uint64_t triangles, std::uint64_t seed, MeshWriter& writer) {
+  // Every generator's options start with the size and the seed.
+  const auto sized = [&](auto options) {
+    options.triangles = triangles;
+    options.seed = seed;
+    return options;
+  };
   switch (kind) {
-    case EnvironmentKind::tetras: {
-      TetrasOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_tetras(options, writer);
-      return;
-    }
-    case EnvironmentKind::terrain: {
-      TerrainOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_terrain(options, writer);
-      return;
-    }
+    case EnvironmentKind::tetras: generate_tetras(sized(TetrasOptions{}), writer); return;
+    case EnvironmentKind::terrain: generate_terrain(sized(TerrainOptions{}), writer); return;
     case EnvironmentKind::scene: {
       static const MeshLibrary library = MeshLibrary::load_default();
-      SceneOptions options;
-      options.triangles = triangles;
-      options.seed = seed;
-      generate_scene(library, options, writer);
+      generate_scene(library, sized(SceneOptions{}), writer);
       return;
     }
   }

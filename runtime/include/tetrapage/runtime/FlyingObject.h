@@ -169,7 +169,6 @@ class FlyingObject {
   // The solid that stands for the object in this step (shape hull or box, or swept), built on
   // the first candidate that needs it; does an environment triangle collide with it?
   struct Solid;
-  void prepare_hull_candidates();
   void build_solid(const QueryOptions& options, Solid& solid);
   static bool solid_collides(const Solid& solid, const geometry::Triangle& environment,
                              const geometry::Accuracy& accuracy, double reach);
@@ -182,13 +181,6 @@ class FlyingObject {
   std::uint32_t interior_tet_ = 0;  ///< where the last containment walk ended
   ObstacleMemo interior_memo_;      ///< the last containment answer, for the next step's
   std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
-  // The solids' vertex candidates (prepared on the first hull or swept query): the vertices of
-  // the object's own hull, then the other vertices by their depth inside it (ascending). A
-  // vertex deeper than the placement's rounding stays inside the hull of the placed
-  // candidates, so the hull of the placed candidates is the hull of all placed vertices.
-  bool hull_candidates_ready_ = false;
-  std::vector<std::uint32_t> hull_candidates_;
-  std::vector<std::pair<double, std::uint32_t>> near_hull_;
   // The previous query's pose and world box (before the accuracy's growth), for swept motion.
   bool previous_valid_ = false;
   std::array<double, 9> previous_rotation_{};
