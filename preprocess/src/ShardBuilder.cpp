@@ -348,7 +348,7 @@ class PayloadWriter {
   std::vector<std::byte>& out_;
 };
 
-void check_input(const ShardTriangles& region, const ShardLayout& layout) {
+void check_region(const ShardTriangles& region) {
   const std::size_t n = region.triangles.size();
   if (n == 0) throw InputError("shard region has no triangles");
   if (region.ids.size() != n || region.parts.size() != n)
@@ -361,6 +361,9 @@ void check_input(const ShardTriangles& region, const ShardLayout& layout) {
     if (!geometry::is_finite(region.triangles[t]))
       throw InputError("shard region triangle " + std::to_string(t) + " (id " +
                        std::to_string(region.ids[t]) + ") has a non-finite coordinate");
+}
+
+void check_layout(const ShardLayout& layout) {
   if (layout.rtree_fanout < 2 || layout.rtree_fanout > shard_format::kMaxFanout)
     throw InputError("R-tree fanout " + std::to_string(layout.rtree_fanout) + " is not in 2.." +
                      std::to_string(shard_format::kMaxFanout));
@@ -380,14 +383,65 @@ void check_input(const ShardTriangles& region, const ShardLayout& layout) {
 
 }  // namespace
 
+/// What every layout of one region shares: the stored geometry and the per-triangle tables.
+struct StoredRegion::Tables {
+  ShardTriangles region;
+  StoredPrecision precision;
+  StoredGeometry g;
+  Box bounds;                 ///< of the stored triangles
+  std::vector<Box> boxes;     ///< per triangle, relative (stored) coordinates
+  std::vector<std::uint32_t> palette;       ///< the distinct part ids, sorted
+  std::vector<std::uint32_t> part_indices;  ///< per triangle, into palette
+  std::uint64_t id_base = 0;
+  std::uint8_t id_bytes = 4;
+};
+
+StoredRegion::StoredRegion(const ShardTriangles& region, StoredPrecision precision) {
+  check_region(region);
+  auto tables = std::make_unique<Tables>();
+  Tables& d = *tables;
+  d.region = region;
+  d.precision = precision;
+  d.g = store(region.triangles, precision);
+  const auto n = std::uint32_t(region.triangles.size());
+  for (const Triangle& t : d.g.triangles) d.bounds.extend(geometry::box_of(t));
+  d.boxes.resize(n);
+  for (std::uint32_t t = 0; t < n; ++t)
+    for (const std::uint32_t v : d.g.corners[t]) d.boxes[t].extend(d.g.relative[v]);
+  d.palette.assign(region.parts.begin(), region.parts.end());
+  std::sort(d.palette.begin(), d.palette.end());
+  d.palette.erase(std::unique(d.palette.begin(), d.palette.end()), d.palette.end());
+  d.part_indices.resize(n);
+  for (std::uint32_t t = 0; t < n; ++t)
+    d.part_indices[t] = std::uint32_t(
+        std::lower_bound(d.palette.begin(), d.palette.end(), region.parts[t]) - d.palette.begin());
+  const auto [id_min, id_max] = std::minmax_element(region.ids.begin(), region.ids.end());
+  d.id_base = *id_min;
+  d.id_bytes = *id_max - d.id_base <= 0xffff'ffffu ? 4 : 8;
+  tables_ = std::move(tables);
+}
+
+StoredRegion::~StoredRegion() = default;
+StoredRegion::StoredRegion(StoredRegion&&) noexcept = default;
+StoredRegion& StoredRegion::operator=(StoredRegion&&) noexcept = default;
+
+double StoredRegion::max_rounding_distance() const { return tables_->g.max_rounding_distance; }
+
 BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPrecision precision,
                        const ShardLayout& layout) {
+  check_layout(layout);  // before the region's work
+  return StoredRegion(region, precision).build(kind, layout);
+}
+
+BuiltShard StoredRegion::build(ShardKind kind, const ShardLayout& layout) const {
   namespace sf = shard_format;
-  check_input(region, layout);
+  check_layout(layout);
+  const Tables& d = *tables_;
+  const ShardTriangles& region = d.region;
+  const StoredPrecision precision = d.precision;
+  const StoredGeometry& g = d.g;
+  const Box& bounds = d.bounds;
   const auto n = std::uint32_t(region.triangles.size());
-  const StoredGeometry g = store(region.triangles, precision);
-  Box bounds;
-  for (const Triangle& t : g.triangles) bounds.extend(geometry::box_of(t));
 
   BuiltShard built;
   built.kind = kind;
@@ -402,11 +456,8 @@ BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPreci
   std::vector<RtreeNode> nodes;
   GridIndex grid;
   if (kind == ShardKind::rtree) {
-    std::vector<Box> boxes(n);
-    for (std::uint32_t t = 0; t < n; ++t)
-      for (const std::uint32_t v : g.corners[t]) boxes[t].extend(g.relative[v]);
     const std::uint32_t leaf = layout.rtree_leaf_size == 0 ? 8 : layout.rtree_leaf_size;
-    RtreeBuilder tree(boxes, leaf, layout.rtree_fanout);
+    RtreeBuilder tree(d.boxes, leaf, layout.rtree_fanout);
     tree.build();
     order = tree.order();
     nodes = std::move(tree.nodes());
@@ -436,18 +487,25 @@ BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPreci
   const auto vertex_count = std::uint32_t(vertex_order.size());
   built.vertex_count = vertex_count;
 
-  std::vector<std::uint32_t> palette(region.parts.begin(), region.parts.end());
-  std::sort(palette.begin(), palette.end());
-  palette.erase(std::unique(palette.begin(), palette.end()), palette.end());
-  const auto [id_min, id_max] = std::minmax_element(region.ids.begin(), region.ids.end());
-  const std::uint64_t id_base = *id_min;
-  const std::uint8_t id_bytes = *id_max - id_base <= 0xffff'ffffu ? 4 : 8;
+  const std::vector<std::uint32_t>& palette = d.palette;
+  const std::uint64_t id_base = d.id_base;
+  const std::uint8_t id_bytes = d.id_bytes;
   const std::uint8_t index_bytes = vertex_count <= 65536 ? 2 : 4;
   const std::uint8_t part_bytes =
       palette.size() == 1 ? 0 : (palette.size() <= 256 ? 1 : (palette.size() <= 65536 ? 2 : 4));
   const std::uint8_t reference_bytes = kind == ShardKind::grid ? (n <= 65536 ? 2 : 4) : 0;
 
   std::vector<std::byte>& out = built.payload;
+  {  // one allocation: appends then never move the payload
+    const std::size_t real = precision == StoredPrecision::float32 ? 4 : 8;
+    const std::size_t structure = kind == ShardKind::grid
+                                      ? 4 * grid.cell_offsets.size()
+                                      : nodes.size() * (6 * real + 8);
+    out.reserve(sf::kHeaderBytes + 3 * real * vertex_count +
+                std::size_t(n) * (3 * index_bytes + id_bytes + part_bytes) +
+                4 * palette.size() + structure + reference_bytes * grid.references.size() +
+                8 * 8);
+  }
   out.assign(sf::kHeaderBytes, std::byte{0});
   PayloadWriter w(out);
   std::memcpy(out.data(), sf::kMagic.data(), 4);
@@ -509,8 +567,7 @@ BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPreci
   begin_section();  // part indices
   if (part_bytes > 0)
     for (const std::uint32_t t : order) {
-      const auto i = std::uint32_t(
-          std::lower_bound(palette.begin(), palette.end(), region.parts[t]) - palette.begin());
+      const std::uint32_t i = d.part_indices[t];
       if (part_bytes == 1)
         w.append<std::uint8_t>(std::uint8_t(i));
       else if (part_bytes == 2)

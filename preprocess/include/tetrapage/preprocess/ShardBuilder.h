@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -52,6 +53,31 @@ struct BuiltShard {
   std::uint64_t grid_references = 0;                 ///< grid: (triangle, cell) pairs
   std::uint32_t rtree_leaf_size = 0;                 ///< R-tree: the leaf size used
   std::uint32_t rtree_nodes = 0;                     ///< R-tree: node count
+};
+
+/// A region's triangles as a shard stores them (relative, deduplicated, rounded to the
+/// precision), prepared once so that several layouts of one region can be built from them
+/// (the cost model tries six). Holds views of `region`: its spans must outlive this object.
+class StoredRegion {
+ public:
+  /// @throw InputError if the region is empty, the spans differ in size, a coordinate is not
+  ///   finite, there are 2^32 triangles or more, or float32 is asked for coordinates beyond
+  ///   float's range.
+  StoredRegion(const ShardTriangles& region, StoredPrecision precision);
+  ~StoredRegion();
+  StoredRegion(StoredRegion&&) noexcept;
+  StoredRegion& operator=(StoredRegion&&) noexcept;
+
+  /// The shard of this region with the given index kind and layout (as build_shard).
+  /// @throw InputError if a layout value is out of range.
+  BuiltShard build(ShardKind kind, const ShardLayout& layout = {}) const;
+
+  /// The largest distance between an input vertex and its stored vertex.
+  double max_rounding_distance() const;
+
+ private:
+  struct Tables;
+  std::unique_ptr<const Tables> tables_;
 };
 
 /// Builds the payload of a shard holding `region`'s triangles, in the order the index needs

@@ -60,7 +60,8 @@ struct ShardCostReport {
 
 /// Estimates, for `region` queried by cubes of side query_extent centred on sampled triangles,
 /// each kind's cost: it builds the candidate layouts (grids of 1/4, 1 and 4 cells per
-/// triangle; R-tree leaves of 4, 8 and 16), runs the sampled queries and counts.
+/// triangle; R-tree leaves of 16, 8 and 4, the smaller only while they are cheaper), runs the
+/// sampled queries and counts.
 /// @throw InputError as build_shard, or if query_extent is negative or not finite.
 ShardCostReport estimate_shard_costs(const ShardTriangles& region, double query_extent,
                                      StoredPrecision precision, const ShardCostModel& model);
