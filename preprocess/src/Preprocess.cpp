@@ -4,6 +4,8 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
 #include <tbb/parallel_sort.h>
 #include <unistd.h>
 
@@ -13,6 +15,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -110,6 +113,50 @@ struct Ingest {
   std::vector<std::uint64_t> part_first, part_last;  // record indices (contiguous when last - first + 1 == count)
 };
 
+// One input soup (a manifest's part, or a mesh file) with what can be computed off the
+// ingest's serial path: per soup part, edge parity and bounds.
+struct LoadedSoup {
+  TriangleSoup soup;
+  std::uint64_t degenerate_dropped = 0;
+  std::uint64_t files_read = 0;
+  std::vector<EdgeParity> parity;
+  std::vector<BoundingBox> bounds;
+};
+
+LoadedSoup load_soup(const std::filesystem::path& input, const Manifest* manifest,
+                     std::size_t manifest_part) {
+  LoadedSoup loaded;
+  if (manifest) {
+    // One part at a time: the ingest holds a few part files, never the assembly.
+    Manifest single;
+    single.path = manifest->path;
+    single.units = manifest->units;
+    single.parts = {manifest->parts[manifest_part]};
+    std::vector<ReadReport> reports;
+    loaded.soup = load_assembly(single, &reports);
+    for (const auto& report : reports) {
+      loaded.degenerate_dropped += report.degenerate_dropped;
+      ++loaded.files_read;
+    }
+  } else {
+    ReadReport report;
+    loaded.soup = read_mesh(input, &report);
+    loaded.degenerate_dropped = report.degenerate_dropped;
+    loaded.files_read = 1;
+  }
+  const TriangleSoup& soup = loaded.soup;
+  const std::size_t parts = std::max<std::size_t>(soup.part_names.size(), 1);
+  loaded.parity.resize(parts);
+  loaded.bounds.resize(parts);
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    const std::size_t part = soup.part_of.empty() ? 0 : soup.part_of[t];
+    const auto corners = soup.corners(t);
+    loaded.parity[part].add_triangle(corners);
+    for (const auto& p : corners) loaded.bounds[part].extend(p);
+  }
+  return loaded;
+}
+
 void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
             const std::filesystem::path& spill_folder, Ingest& in, PreprocessSummary& summary) {
   const std::uint64_t held_limit = options.memory_bytes / 4;
@@ -119,13 +166,17 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   std::mt19937_64 random(0x7e7a9a9e);
   std::vector<TriangleRecord> block;
 
-  auto add_soup = [&](const TriangleSoup& soup) {
+  // In input order (ids, part numbers and the sample do not depend on the threads).
+  auto add_soup = [&](LoadedSoup& loaded) {
+    const TriangleSoup& soup = loaded.soup;
+    summary.degenerate_dropped += loaded.degenerate_dropped;
+    summary.files_read += loaded.files_read;
     const auto part_offset = std::uint32_t(in.part_names.size());
     for (const auto& name : soup.part_names) in.part_names.push_back(name);
     if (soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
-    in.part_parity.resize(in.part_names.size());
+    in.part_parity.insert(in.part_parity.end(), loaded.parity.begin(), loaded.parity.end());
+    in.part_bounds.insert(in.part_bounds.end(), loaded.bounds.begin(), loaded.bounds.end());
     in.part_triangles.resize(in.part_names.size());
-    in.part_bounds.resize(in.part_names.size());
     in.part_first.resize(in.part_names.size(), ~std::uint64_t{0});
     in.part_last.resize(in.part_names.size(), 0);
     // Records go out in blocks, so that the held records never pass the limit by more than a
@@ -144,9 +195,7 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
       record.triangle = soup.corners(t);
       record.id = in.seen;
       record.part = part_offset + (soup.part_of.empty() ? 0 : soup.part_of[t]);
-      in.part_parity[record.part].add_triangle(record.triangle);
       ++in.part_triangles[record.part];
-      for (const auto& p : record.triangle) in.part_bounds[record.part].extend(p);
       if (in.part_first[record.part] == ~std::uint64_t{0}) in.part_first[record.part] = in.seen;
       in.part_last[record.part] = in.seen;
       for (const auto& p : record.triangle) in.bounds.extend(p);
@@ -164,31 +213,47 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     flush();
   };
 
-  Progress progress("reading parts", inputs.size(), options.progress);
+  // The soups to load, in order: each manifest part, or a mesh file.
+  std::vector<Manifest> manifests;
+  manifests.reserve(inputs.size());
+  struct Job {
+    const std::filesystem::path* input;
+    const Manifest* manifest;
+    std::size_t part;
+  };
+  std::vector<Job> jobs;
   for (const auto& input : inputs) {
     if (is_manifest_path(input)) {
-      const Manifest manifest = read_manifest(input);
-      for (const auto& part : manifest.parts) {
-        // One part at a time: the ingest holds one part file, never the assembly.
-        Manifest single = manifest;
-        single.parts = {part};
-        std::vector<ReadReport> reports;
-        const TriangleSoup soup = load_assembly(single, &reports);
-        for (const auto& report : reports) {
-          summary.degenerate_dropped += report.degenerate_dropped;
-          ++summary.files_read;
-        }
-        add_soup(soup);
-      }
+      manifests.push_back(read_manifest(input));
+      for (std::size_t p = 0; p < manifests.back().parts.size(); ++p)
+        jobs.push_back({&input, &manifests.back(), p});
     } else {
-      ReadReport report;
-      const TriangleSoup soup = read_mesh(input, &report);
-      summary.degenerate_dropped += report.degenerate_dropped;
-      ++summary.files_read;
-      add_soup(soup);
+      jobs.push_back({&input, nullptr, 0});
     }
-    progress.advance();
   }
+  // Parsing, edge parity and bounds run on all threads, a few soups at once; the records are
+  // appended in input order on one.
+  Progress progress("reading parts", jobs.size(), options.progress);
+  std::size_t next = 0;
+  const std::size_t in_flight = std::size_t(tbb::this_task_arena::max_concurrency()) + 1;
+  tbb::parallel_pipeline(
+      in_flight,
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                          [&](tbb::flow_control& control) -> std::size_t {
+                                            if (next == jobs.size()) control.stop();
+                                            return next++;
+                                          }) &
+          tbb::make_filter<std::size_t, std::shared_ptr<LoadedSoup>>(
+              tbb::filter_mode::parallel,
+              [&](std::size_t j) {
+                const Job& job = jobs[j];
+                return std::make_shared<LoadedSoup>(load_soup(*job.input, job.manifest, job.part));
+              }) &
+          tbb::make_filter<std::shared_ptr<LoadedSoup>, void>(
+              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<LoadedSoup>& loaded) {
+                add_soup(*loaded);
+                progress.advance();
+              }));
   progress.finish();
   summary.triangles_read = in.seen;
   summary.parts = in.part_names.size();
