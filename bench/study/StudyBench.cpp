@@ -36,7 +36,6 @@
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/study/BoxMethods.h"
 #include "tetrapage/study/MeshMethod.h"
-#include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/LatencySummary.h"
 #include "tetrapage/tools/MeshLibrary.h"
@@ -169,7 +168,7 @@ Environment load_environment(const EnvironmentSpec& spec, const Options& o, cons
     PreprocessOptions p;
     p.precision = StoredPrecision::float64;
     p.region_triangles = std::max<std::size_t>(64, env.soup.triangle_count() / 64);
-    p.interior_classifier = embree_interior_classifier();
+    p.interiors = true;
     const auto start = Clock::now();
     const PreprocessSummary summary = preprocess({env.file}, env.index, p);
     env.record["hybrid"] = {{"preprocess_seconds", seconds_since(start)},

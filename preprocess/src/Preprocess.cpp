@@ -29,6 +29,7 @@
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/preprocess/CoarseMesh.h"
+#include "tetrapage/preprocess/RayParity.h"
 #include "tetrapage/preprocess/RecordSpill.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
 #include "tetrapage/preprocess/ShardCostModel.h"
@@ -261,8 +262,8 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
 }
 
 // The interiors: each tet's reference point classified against the closed parts, as CSR
-// tables by tet (see docs/FORMAT.md). Needs the closed parts' triangles in the classifier at
-// once: skipped, and said, when they would not fit the budget.
+// tables by tet (see docs/FORMAT.md), exactly, by vertical ray parity (RayParity.h) over one
+// stream of the records per pass.
 struct Interiors {
   std::vector<std::uint8_t> part_closed;
   std::vector<double> reference_points;  // 3 per tet; NaN for a tet without one
@@ -283,26 +284,10 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     closed[p] = in.part_parity[p].closed();
     summary.closed_parts += closed[p];
   }
-  if (!options.interior_classifier) return result;
+  if (!options.interiors) return result;
   if (summary.closed_parts == 0) {
     summary.interiors = "none closed";
     return result;
-  }
-  // Parts go to the classifier in batches that fit half the budget, each part whole; a tet's
-  // reference point is classified only against the batch parts whose box holds it (outside a
-  // part's box is outside the part). A part larger than a batch, or whose triangles are not
-  // contiguous in the input, stays unclassified: the index then marks it open.
-  const std::uint64_t per_triangle = options.interior_classifier()->bytes_per_triangle();
-  const std::uint64_t batch_capacity = std::max<std::uint64_t>(
-      1, options.memory_bytes / 2 / std::max<std::uint64_t>(per_triangle, 1));
-  std::uint64_t too_large = 0;
-  for (std::size_t p = 0; p < parts; ++p) {
-    if (!closed[p]) continue;
-    const bool contiguous = in.part_last[p] - in.part_first[p] + 1 == in.part_triangles[p];
-    if (in.part_triangles[p] > batch_capacity || !contiguous) {
-      closed[p] = false;
-      ++too_large;
-    }
   }
   const std::size_t tet_count = mesh.tet_count();
   std::vector<Vec3> points(tet_count);
@@ -317,95 +302,83 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       result.reference_points[3 * t + a] =
           reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
   });
-  std::vector<std::uint32_t> by_x;  // the tets of a pass, by their reference point's x
+  // A pass classifies against as many parts as its (point, part) pairs allow: a quarter of the
+  // budget (RayParity holds 29 bytes per pair, the plan as much again).
+  const std::uint64_t pairs_per_pass =
+      options.interior_pairs_per_pass != 0
+          ? options.interior_pairs_per_pass
+          : std::max<std::uint64_t>(1, options.memory_bytes / 4 / 64);
   std::vector<std::vector<std::uint32_t>> inside(tet_count);
-  std::vector<bool> undecided(tet_count, false);
-  std::unique_ptr<InteriorClassifier> classifier;
-  std::vector<std::uint32_t> batch_parts;
-  std::uint64_t batch_triangles = 0;
-  std::vector<std::array<Vec3, 3>> run;
-  std::vector<Vec3> batch_points;
-  std::vector<std::uint32_t> batch_tets;
-  std::vector<PointInterior> answers;
-  std::uint64_t batches = 0;
-  auto classify_batch = [&] {
-    if (batch_parts.empty()) return;
-    ++batches;
-    batch_points.clear();
-    batch_tets.clear();
-    BoundingBox hull;
-    for (const std::uint32_t p : batch_parts)
-      hull.extend(in.part_bounds[p].lo), hull.extend(in.part_bounds[p].hi);
-    auto first = std::lower_bound(by_x.begin(), by_x.end(), hull.lo[0],
-                                  [&](std::uint32_t t, double x) { return points[t][0] < x; });
-    for (auto it = first; it != by_x.end() && points[*it][0] <= hull.hi[0]; ++it) {
-      const Vec3& q = points[*it];
-      for (const std::uint32_t p : batch_parts) {
-        const BoundingBox& b = in.part_bounds[p];
-        if (q[0] >= b.lo[0] && q[0] <= b.hi[0] && q[1] >= b.lo[1] && q[1] <= b.hi[1] &&
-            q[2] >= b.lo[2] && q[2] <= b.hi[2]) {
-          batch_points.push_back(q);
-          batch_tets.push_back(*it);
-          break;
-        }
-      }
-    }
-    classifier->classify(batch_points, answers);
-    for (std::size_t i = 0; i < batch_tets.size(); ++i) {
-      if (!answers[i].decided)
-        undecided[batch_tets[i]] = true;
-      else
-        inside[batch_tets[i]].insert(inside[batch_tets[i]].end(), answers[i].parts.begin(),
-                                     answers[i].parts.end());
-    }
-    for (const std::uint32_t p : batch_parts) result.part_closed[p] = 1;
-    classifier.reset();
-    batch_parts.clear();
-    batch_triangles = 0;
-  };
-  // One pass over the records classifies the given tets' reference points against every part.
-  auto classify_pass = [&](std::vector<std::uint32_t> tets, bool show_progress) {
-    by_x = std::move(tets);
-    std::sort(by_x.begin(), by_x.end(),
+  std::vector<std::uint8_t> undecided(tet_count, 0);
+  std::uint64_t passes = 0;
+  // Classifies the given tets' reference points against every closed part whose box holds them
+  // (outside a part's box is outside the part).
+  auto classify = [&](std::vector<std::uint32_t> tets, bool show_progress) {
+    std::sort(tets.begin(), tets.end(),
               [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
-    for (const std::uint32_t t : by_x) inside[t].clear(), undecided[t] = false;
-    Progress progress("classifying interiors", in.seen, options.progress && show_progress);
-    in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
-      for (std::size_t i = 0; i < block.size();) {
-        std::size_t j = i;
-        run.clear();
-        const std::uint32_t part = block[i].part;
-        while (j < block.size() && block[j].part == part) run.push_back(block[j++].triangle);
-        i = j;
-        if (!closed[part]) continue;
-        if (batch_parts.empty() || batch_parts.back() != part) {
-          // A new part starts: the batch must hold it whole.
-          if (batch_triangles + in.part_triangles[part] > batch_capacity) classify_batch();
-          batch_parts.push_back(part);
-          batch_triangles += in.part_triangles[part];
-        }
-        if (!classifier) classifier = options.interior_classifier();
-        classifier->add_triangles(part, run);
+    for (const std::uint32_t t : tets) inside[t].clear(), undecided[t] = 0;
+    std::vector<std::vector<std::uint32_t>> of_part(parts);
+    std::vector<std::vector<std::uint32_t>> pass_parts(1);
+    std::uint64_t pass_pairs = 0;
+    for (std::size_t p = 0; p < parts; ++p) {
+      if (!closed[p]) continue;
+      const BoundingBox& b = in.part_bounds[p];
+      auto it = std::lower_bound(tets.begin(), tets.end(), b.lo[0],
+                                 [&](std::uint32_t t, double x) { return points[t][0] < x; });
+      for (; it != tets.end() && points[*it][0] <= b.hi[0]; ++it) {
+        const Vec3& q = points[*it];
+        if (q[1] >= b.lo[1] && q[1] <= b.hi[1] && q[2] >= b.lo[2] && q[2] <= b.hi[2])
+          of_part[p].push_back(*it);
       }
-      progress.advance(block.size());
-    });
-    classify_batch();
+      if (of_part[p].empty()) continue;
+      if (pass_pairs > 0 && pass_pairs + of_part[p].size() > pairs_per_pass) {
+        pass_parts.emplace_back();
+        pass_pairs = 0;
+      }
+      pass_parts.back().push_back(std::uint32_t(p));
+      pass_pairs += of_part[p].size();
+    }
+    if (pass_parts.back().empty()) pass_parts.pop_back();
+    Progress progress("classifying interiors", in.seen * pass_parts.size(),
+                      options.progress && show_progress);
+    for (const auto& pass : pass_parts) {
+      ++passes;
+      std::vector<std::vector<std::uint32_t>> asked(parts);
+      for (const std::uint32_t p : pass) asked[p] = std::move(of_part[p]);
+      RayParity parity(points, asked);
+      asked.clear();
+      in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 2048),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                            for (std::size_t i = range.begin(); i < range.end(); ++i)
+                              if (parity.wanted(block[i].part))
+                                parity.add_triangle(block[i].part, block[i].triangle);
+                          });
+        progress.advance(block.size());
+      });
+      parity.for_each_answer([&](std::uint32_t t, std::uint32_t p, bool odd, bool on_surface) {
+        if (on_surface)
+          undecided[t] = 1;
+        else if (odd)
+          inside[t].push_back(p);
+      });
+    }
     progress.finish();
   };
   std::vector<std::uint32_t> all(tet_count);
   for (std::size_t t = 0; t < tet_count; ++t) all[t] = std::uint32_t(t);
-  classify_pass(std::move(all), true);
-  const std::uint64_t first_pass_batches = batches;
-  // An undecided point (rays through edges) is replaced by another point strictly inside its
-  // tet and classified again, in a pass of its own over the records (a tet's point must be
-  // the same for every batch).
+  classify(std::move(all), true);
+  const std::uint64_t first_passes = passes;
+  // A reference point on a closed part's surface is replaced by another point strictly inside
+  // its tet and classified again, in passes of its own (a tet's point must be the same for
+  // every part).
   constexpr std::array<std::array<double, 4>, 3> kOtherPoints{
       {{0.31, 0.23, 0.27, 0.19}, {0.17, 0.37, 0.21, 0.25}, {0.29, 0.13, 0.39, 0.19}}};
   std::uint64_t moved = 0;
   for (const auto& w : kOtherPoints) {
     std::vector<std::uint32_t> retry;
     for (std::size_t t = 0; t < tet_count; ++t) {
-      if (!undecided[t]) continue;
+      if (undecided[t] == 0) continue;
       const auto c = mesh.corners(t);
       Vec3 q;
       for (int a = 0; a < 3; ++a)
@@ -418,14 +391,14 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       ++moved;
     }
     if (retry.empty()) break;
-    classify_pass(std::move(retry), false);
+    classify(std::move(retry), false);
   }
-  batches = first_pass_batches;
 
+  for (std::size_t p = 0; p < parts; ++p) result.part_closed[p] = closed[p] ? 1 : 0;
   result.offsets.reserve(tet_count + 1);
   result.offsets.push_back(0);
   for (std::size_t t = 0; t < tet_count; ++t) {
-    if (!has_point[t] || undecided[t]) {
+    if (!has_point[t] || undecided[t] != 0) {
       result.parts.push_back(kInteriorUndecided);
       ++summary.interior_undecided;
     } else {
@@ -437,14 +410,10 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   }
   result.stored = true;
   summary.interiors =
-      "stored (" + std::to_string(batches) + (batches == 1 ? " batch" : " batches") + ")";
+      "stored (" + std::to_string(first_passes) + (first_passes == 1 ? " pass" : " passes") + ")";
   if (moved > 0)
     summary.interiors +=
-        "; " + std::to_string(moved) + " reference points moved and classified again";
-  if (too_large > 0)
-    summary.interiors +=
-        "; " + std::to_string(too_large) +
-        " closed parts left open (larger than half --memory can classify, or not contiguous)";
+        "; " + std::to_string(moved) + " reference points on a surface moved and classified again";
   return result;
 }
 

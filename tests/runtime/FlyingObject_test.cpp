@@ -17,7 +17,6 @@
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
-#include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
@@ -75,7 +74,7 @@ World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triang
   options.region_triangles = region_triangles;
   options.precision = StoredPrecision::float64;
   // Interiors too: the oracle counts an object inside a closed obstacle as a collision.
-  options.interior_classifier = embree_interior_classifier();
+  options.interiors = true;
   preprocess({world.environment_path}, world.index_path, options);
   return world;
 }

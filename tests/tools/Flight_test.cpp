@@ -20,7 +20,6 @@
 #include "tetrapage/formats/Pose.h"
 #include <nlohmann/json.hpp>
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/RuntimeJudge.h"
 
 #include "BoxSoup.h"
@@ -248,7 +247,7 @@ TEST(BilliardFlight, TheRuntimeJudgeFliesTheOraclesFlight) {
   PreprocessOptions options;
   options.region_triangles = 16;
   options.precision = StoredPrecision::float64;
-  options.interior_classifier = embree_interior_classifier();
+  options.interiors = true;
   preprocess({folder / "boxes.ply"}, folder / "boxes.tpi", options);
   const ReferenceCollider oracle(environment, object);
   RuntimeJudge judge(std::make_shared<const CollisionIndex>(folder / "boxes.tpi"), object);

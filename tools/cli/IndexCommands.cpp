@@ -18,7 +18,6 @@
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
-#include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
 #include "tetrapage/tools/StabbingNumbers.h"
 
@@ -48,7 +47,7 @@ void run_preprocess(const PreprocessArguments& args) {
   options.precision = parse_stored_precision(args.precision);
   options.query_extent = args.query_extent;
   options.progress = true;
-  if (args.interiors == "on") options.interior_classifier = embree_interior_classifier();
+  options.interiors = args.interiors == "on";
   const PreprocessSummary summary = preprocess(args.inputs, args.output, options);
   std::fputs(summary.to_text().c_str(), stdout);
   if (!args.report.empty()) write_report(args.report, nlohmann::json::parse(summary.to_json()));
@@ -282,9 +281,8 @@ void add_index_commands(CLI::App& app) {
                       "Side of the query boxes the cost model plans for (0: 5% of the model's size)")
       ->capture_default_str();
   command->add_option("--interiors", pre->interiors,
-                      "Classify each region's reference point against the closed parts (Embree ray parity)\n"
-                      "so that the runtime reports an object inside an obstacle; parts go in batches that fit\n"
-                      "half of --memory (about 190 B a triangle); a larger single part is left open, with a note")
+                      "Classify each region's reference point against the closed parts (exact ray parity,\n"
+                      "one pass over the triangles) so that the runtime reports an object inside an obstacle")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
   command->add_option("--report", pre->report, "Write the summary as JSON");

@@ -152,12 +152,6 @@ EmbreeInteriorClassifier::EmbreeInteriorClassifier(unsigned rays)
     : impl_(std::make_unique<Impl>(rays)) {}
 EmbreeInteriorClassifier::~EmbreeInteriorClassifier() = default;
 
-std::uint64_t EmbreeInteriorClassifier::bytes_per_triangle() const {
-  // Held until the build: 72 (double corners) + 4 (part); then Embree's three float vertices
-  // (36), index (12) and its BVH (about 2 node slots per triangle at medium quality).
-  return 76 + 36 + 12 + 64;
-}
-
 void EmbreeInteriorClassifier::add_triangles(std::uint32_t part,
                                              std::span<const std::array<Vec3, 3>> triangles) {
   impl_->add(part, triangles);
@@ -166,10 +160,6 @@ void EmbreeInteriorClassifier::add_triangles(std::uint32_t part,
 void EmbreeInteriorClassifier::classify(std::span<const Vec3> points,
                                         std::vector<PointInterior>& out) {
   impl_->classify(points, out);
-}
-
-InteriorClassifierFactory embree_interior_classifier(unsigned rays) {
-  return [rays] { return std::make_unique<EmbreeInteriorClassifier>(rays); };
 }
 
 }  // namespace tetrapage

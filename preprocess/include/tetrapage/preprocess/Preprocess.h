@@ -5,7 +5,7 @@
 /// build a grid or R-tree shard per non-empty tet, and write one HDF5 index under a temporary
 /// name, renamed only when complete.
 ///
-/// Memory: the ingest holds one part file at a time plus a bounded sample of centroids; the
+/// Memory: the ingest holds a few part files at a time plus a bounded sample of centroids; the
 /// stages after sampling stream over spill files in blocks and process the tets in buckets
 /// sized from --memory, so the working memory follows the budget, not the model.
 
@@ -15,7 +15,6 @@
 #include <vector>
 
 #include "tetrapage/runtime/ShardKind.h"
-#include "tetrapage/preprocess/InteriorClassifier.h"
 
 namespace tetrapage {
 
@@ -48,10 +47,13 @@ struct PreprocessOptions {
   bool progress = false;
   /// Where spill files go; empty: next to the output.
   std::filesystem::path spill_folder;
-  /// The ray-shooting engine that classifies each tet's reference point against the closed
-  /// parts (InteriorClassifier.h); empty: interiors are not stored, and the runtime then
-  /// reports only touching surfaces.
-  InteriorClassifierFactory interior_classifier;
+  /// Store the interiors: each tet's reference point classified, exactly, against every
+  /// closed part (RayParity.h); false: not stored, and the runtime then reports only touching
+  /// surfaces.
+  bool interiors = false;
+  /// (point, part) pairs classified per pass over the triangles; 0: as many as a quarter of
+  /// memory_bytes holds. Tests set it small to exercise several passes.
+  std::uint64_t interior_pairs_per_pass = 0;
 };
 
 /// Time and peak resident memory of one stage.
