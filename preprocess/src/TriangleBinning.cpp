@@ -7,6 +7,7 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/TriangleTetrahedron.h"
 
 namespace tetrapage {
@@ -22,6 +23,19 @@ void bin_triangle(const TetMesh& mesh, const geometry::Triangle& triangle,
     throw InputError(text);
   }
   scratch.hint = located.tet;
+  // Most triangles lie strictly inside one tet (a region holds thousands): all three corners in
+  // its open interior put the whole triangle there (the tet is convex), and the closed
+  // neighbours meet it only on their common faces.
+  if (located.location.position == geometry::TetrahedronPosition::inside) {
+    const auto corners = mesh.corners(located.tet);
+    if (geometry::locate_in_tetrahedron(triangle[1], corners).position ==
+            geometry::TetrahedronPosition::inside &&
+        geometry::locate_in_tetrahedron(triangle[2], corners).position ==
+            geometry::TetrahedronPosition::inside) {
+      tets.push_back(located.tet);
+      return;
+    }
+  }
   const geometry::Box box = geometry::box_of(triangle);
   const std::size_t first = tets.size();
   auto& queue = scratch.queue;
