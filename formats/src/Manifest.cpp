@@ -309,6 +309,33 @@ TriangleSoup load_assembly(const Manifest& manifest, std::vector<ReadReport>* re
   return assembly;
 }
 
+std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& inputs) {
+  std::vector<InputPiece> pieces;
+  for (const auto& input : inputs) {
+    if (!is_manifest_path(input)) {
+      pieces.push_back({input, nullptr, 0});
+      continue;
+    }
+    const auto manifest = std::make_shared<const Manifest>(read_manifest(input));
+    for (std::size_t p = 0; p < manifest->parts.size(); ++p) pieces.push_back({input, manifest, p});
+  }
+  return pieces;
+}
+
+TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports) {
+  if (!piece.manifest) {
+    ReadReport report;
+    TriangleSoup soup = read_mesh(piece.input, &report);
+    if (reports != nullptr) reports->push_back(std::move(report));
+    return soup;
+  }
+  Manifest single;
+  single.path = piece.manifest->path;
+  single.units = piece.manifest->units;
+  single.parts = {piece.manifest->parts.at(piece.part)};
+  return load_assembly(single, reports);
+}
+
 TriangleSoup load_inputs(const std::vector<std::filesystem::path>& inputs,
                          std::vector<ReadReport>* reports, Progress& progress) {
   TriangleSoup all;

@@ -124,26 +124,13 @@ struct LoadedSoup {
   std::vector<BoundingBox> bounds;
 };
 
-LoadedSoup load_soup(const std::filesystem::path& input, const Manifest* manifest,
-                     std::size_t manifest_part) {
+LoadedSoup load_soup(const InputPiece& piece) {
   LoadedSoup loaded;
-  if (manifest) {
-    // One part at a time: the ingest holds a few part files, never the assembly.
-    Manifest single;
-    single.path = manifest->path;
-    single.units = manifest->units;
-    single.parts = {manifest->parts[manifest_part]};
-    std::vector<ReadReport> reports;
-    loaded.soup = load_assembly(single, &reports);
-    for (const auto& report : reports) {
-      loaded.degenerate_dropped += report.degenerate_dropped;
-      ++loaded.files_read;
-    }
-  } else {
-    ReadReport report;
-    loaded.soup = read_mesh(input, &report);
-    loaded.degenerate_dropped = report.degenerate_dropped;
-    loaded.files_read = 1;
+  std::vector<ReadReport> reports;
+  loaded.soup = load_input_piece(piece, &reports);
+  for (const auto& report : reports) {
+    loaded.degenerate_dropped += report.degenerate_dropped;
+    ++loaded.files_read;
   }
   const TriangleSoup& soup = loaded.soup;
   const std::size_t parts = std::max<std::size_t>(soup.part_names.size(), 1);
@@ -214,24 +201,8 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     flush();
   };
 
-  // The soups to load, in order: each manifest part, or a mesh file.
-  std::vector<Manifest> manifests;
-  manifests.reserve(inputs.size());
-  struct Job {
-    const std::filesystem::path* input;
-    const Manifest* manifest;
-    std::size_t part;
-  };
-  std::vector<Job> jobs;
-  for (const auto& input : inputs) {
-    if (is_manifest_path(input)) {
-      manifests.push_back(read_manifest(input));
-      for (std::size_t p = 0; p < manifests.back().parts.size(); ++p)
-        jobs.push_back({&input, &manifests.back(), p});
-    } else {
-      jobs.push_back({&input, nullptr, 0});
-    }
-  }
+  // One part file at a time per thread: the ingest never holds the assembly.
+  const std::vector<InputPiece> jobs = input_pieces(inputs);
   // Parsing, edge parity and bounds run on all threads, a few soups at once; the records are
   // appended in input order on one.
   Progress progress("reading parts", jobs.size(), options.progress);
@@ -246,10 +217,7 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
                                           }) &
           tbb::make_filter<std::size_t, std::shared_ptr<LoadedSoup>>(
               tbb::filter_mode::parallel,
-              [&](std::size_t j) {
-                const Job& job = jobs[j];
-                return std::make_shared<LoadedSoup>(load_soup(*job.input, job.manifest, job.part));
-              }) &
+              [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); }) &
           tbb::make_filter<std::shared_ptr<LoadedSoup>, void>(
               tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<LoadedSoup>& loaded) {
                 add_soup(*loaded);

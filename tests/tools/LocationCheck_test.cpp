@@ -37,6 +37,7 @@
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/StabbingNumbers.h"
 #include "tetrapage/tools/TetrasGenerator.h"
+#include "RunCli.h"
 
 namespace tetrapage {
 namespace {
@@ -409,23 +410,11 @@ INSTANTIATE_TEST_SUITE_P(Models, LocationCheckTest,
                          ::testing::Values(Model::scene, Model::tetras, Model::far_tetras),
                          [](const auto& param_info) { return model_name(param_info.param); });
 
-// Runs the command line, returns its exit status and stdout.
-int run(const std::string& arguments, std::string& out) {
-  const std::string command = std::string(TETRAPAGE_CLI) + " " + arguments + " 2>/dev/null";
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return -1;
-  char buffer[4096];
-  out.clear();
-  while (std::size_t n = fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
-  const int status = pclose(pipe);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 TEST(LocationCheckCommand, PrintsDisagreementsAndExitsZero) {
   const Indexed& model = indexed(Model::tetras);
   const fs::path report = model.index.parent_path() / "check.json";
   std::string out;
-  ASSERT_EQ(run("check-location " + model.index.string() + " --points 4000 --seed 2 --report " +
+  ASSERT_EQ(test::run_cli("check-location " + model.index.string() + " --points 4000 --seed 2 --report " +
                     report.string(),
                 out),
             0)
@@ -438,7 +427,7 @@ TEST(LocationCheckCommand, PrintsDisagreementsAndExitsZero) {
   EXPECT_GT(json.at("points_per_second").get<double>(), 0);
 
   const fs::path inspect = model.index.parent_path() / "inspect.json";
-  ASSERT_EQ(run("inspect " + model.index.string() + " --stabbing-segments 500 --report " +
+  ASSERT_EQ(test::run_cli("inspect " + model.index.string() + " --stabbing-segments 500 --report " +
                     inspect.string(),
                 out),
             0)
@@ -452,7 +441,7 @@ TEST(LocationCheckCommand, PrintsDisagreementsAndExitsZero) {
             figures.at("stabbing_number_embree").get<double>());
   EXPECT_GT(figures.at("stabbing_number_walk").get<double>(), 0);
 
-  ASSERT_EQ(run("inspect " + model.index.string() + " --stabbing-segments 0", out), 0);
+  ASSERT_EQ(test::run_cli("inspect " + model.index.string() + " --stabbing-segments 0", out), 0);
   EXPECT_EQ(out.find("stabbing number"), std::string::npos) << out;
 }
 

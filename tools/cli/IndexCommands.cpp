@@ -18,7 +18,11 @@
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/Progress.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
+#include "tetrapage/tools/IndexAudit.h"
+#include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/StabbingNumbers.h"
 
 namespace tetrapage::cli {
@@ -238,13 +242,67 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
   return problems;
 }
 
-void run_validate(const std::filesystem::path& index) {
-  const IndexReader reader(index);
-  const auto problems = validate_index(reader);
+struct ValidateArguments {
+  std::filesystem::path index;
+  std::vector<std::filesystem::path> inputs;
+  bool full = false;
+  std::uint32_t sample = 256;
+  std::uint32_t boxes = 16;
+  std::uint64_t seed = 1;
+};
+
+// `count` distinct values below `n` (all of them when count >= n), sorted.
+std::vector<std::uint32_t> sample_below(std::uint32_t n, std::uint32_t count, bool all, std::uint64_t seed) {
+  std::vector<std::uint32_t> chosen(n);
+  for (std::uint32_t i = 0; i < n; ++i) chosen[i] = i;
+  if (all || count >= n) return chosen;
+  Random random(seed);
+  for (std::uint32_t i = 0; i < count; ++i) std::swap(chosen[i], chosen[i + random.below(n - i)]);
+  chosen.resize(count);
+  std::sort(chosen.begin(), chosen.end());
+  return chosen;
+}
+
+void run_validate(const ValidateArguments& args) {
+  const IndexReader reader(args.index);
+  auto problems = validate_index(reader);
   for (const auto& p : problems) std::printf("problem: %s\n", p.c_str());
   if (!problems.empty())
-    throw FormatError(index.string() + ": invalid index (" + std::to_string(problems.size()) + " problems)");
-  std::printf("%s: valid (%u shards, %llu triangles)\n", index.c_str(), reader.shard_count(),
+    throw FormatError(args.index.string() + ": invalid index (" + std::to_string(problems.size()) + " problems)");
+  // Against brute force: a sample of tets against the model, a sample of shards against random
+  // boxes (everything with --full).
+  const std::uint32_t tet_count = reader.read_mesh().tet_count();
+  AuditFindings findings;
+  {
+    const auto shards = sample_below(reader.shard_count(), args.sample, args.full, args.seed + 1);
+    Progress progress("checking shard queries", shards.size(), true);
+    audit_shard_queries(reader, shards, args.boxes, args.seed, findings, progress);
+    progress.finish();
+  }
+  std::vector<std::filesystem::path> inputs = args.inputs.empty() ? source_inputs(reader.header()) : args.inputs;
+  std::string missing;
+  for (const auto& input : inputs)
+    if (!std::filesystem::exists(input)) missing = input.string();
+  const bool check_model = missing.empty() || !args.inputs.empty() || args.full;
+  if (check_model) {
+    const auto tets = sample_below(tet_count, args.sample, args.full, args.seed);
+    Progress progress("checking tets against the model", input_pieces(inputs).size(), true);
+    audit_binning(reader, inputs, tets, findings, progress);
+    progress.finish();
+  }
+  for (const auto& p : findings.problems) std::printf("problem: %s\n", p.c_str());
+  std::printf("shard queries: %llu shards x %u random boxes against brute force (CGAL exact), %llu mismatches\n",
+              (unsigned long long)findings.shards_checked, args.boxes, (unsigned long long)findings.mismatches);
+  if (check_model)
+    std::printf("binning: %llu tets against the model's %llu triangles (CGAL exact), %s\n",
+                (unsigned long long)findings.tets_checked, (unsigned long long)findings.triangles_read,
+                findings.mismatches == 0 ? "all equal" : "see the problems above");
+  else
+    std::printf("binning: not checked, input '%s' not found (give the inputs after the index)\n", missing.c_str());
+  if (findings.mismatches > 0)
+    throw FormatError(args.index.string() + ": invalid index (" + std::to_string(findings.mismatches) +
+                      " mismatches against brute force)");
+  std::printf("%s: valid (%u shards, %llu triangles)\n", args.index.c_str(), reader.shard_count(),
               (unsigned long long)reader.header().input_triangles);
 }
 
@@ -300,12 +358,24 @@ void add_index_commands(CLI::App& app) {
       ->capture_default_str();
   inspect_command->callback([inspect] { run_inspect(*inspect); });
 
-  auto index = std::make_shared<std::filesystem::path>();
+  auto valid = std::make_shared<ValidateArguments>();
   auto* validate = app.add_subcommand(
-      "validate", "Check an index from end to end: checksums, extents, mesh orientation and\n"
-                  "adjacency, shard tables, every shard decoded. Exit 0 only when valid.");
-  validate->add_option("index", *index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
-  validate->callback([index] { run_validate(*index); });
+      "validate",
+      "Check an index from end to end: checksums, extents, mesh orientation and adjacency, shard\n"
+      "tables, every shard decoded; then against brute force (CGAL's exact kernel): a sample of tets\n"
+      "hold exactly the model's triangles that meet them, and a sample of shards answer random boxes\n"
+      "with exactly the stored triangles that meet them (--full: every tet and shard). The model is\n"
+      "read from the files the index names, or from the INPUTs given. Exit 0 only when valid.");
+  validate->add_option("index", valid->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
+  validate->add_option("inputs", valid->inputs,
+                       "The model's files, in preprocess's order (default: those the index names; when they\n"
+                       "are missing, the binning check is skipped and said so, unless --full)")
+      ->check(CLI::ExistingFile);
+  validate->add_flag("--full", valid->full, "Check every tet and every shard, not a sample");
+  validate->add_option("--sample", valid->sample, "Tets and shards checked without --full")->capture_default_str();
+  validate->add_option("--boxes", valid->boxes, "Random query boxes per shard checked")->capture_default_str();
+  validate->add_option("--seed", valid->seed, "Seed of the samples and boxes")->capture_default_str();
+  validate->callback([valid] { run_validate(*valid); });
 }
 
 }  // namespace tetrapage::cli

@@ -12,6 +12,7 @@
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/tools/IndexAudit.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
 
@@ -32,13 +33,8 @@ void run_check_interiors(const InteriorCheckArguments& args) {
   if (!index->has_interiors())
     throw InputError(args.index.string() +
                      ": the index stores no interiors (preprocess it with --interiors on)");
-  std::vector<std::filesystem::path> inputs = args.inputs;
-  if (inputs.empty()) {
-    // The inputs preprocess read, in its order (so that part ids match).
-    std::istringstream source(index->header().source);
-    for (std::string line; std::getline(source, line);)
-      if (!line.empty()) inputs.emplace_back(line);
-  }
+  const std::vector<std::filesystem::path> inputs =
+      args.inputs.empty() ? source_inputs(index->header()) : args.inputs;
   TriangleSoup environment;
   for (const auto& input : inputs)
     environment.append(is_manifest_path(input) ? load_assembly(read_manifest(input))

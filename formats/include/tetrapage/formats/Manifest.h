@@ -19,6 +19,7 @@
 
 #include <array>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,22 @@ Manifest read_manifest(const std::filesystem::path& path);
 ///        overflows or the assembly has more than 2^32-1 vertices.
 TriangleSoup load_assembly(const Manifest& manifest, std::vector<ReadReport>* reports = nullptr,
                            Progress& progress = Progress::silent());
+
+/// One piece of a list of inputs, loadable on its own: a mesh file, or one part of a manifest
+/// (with its instances placed). Loading the pieces in order and appending them gives the soup
+/// load_inputs gives, triangle for triangle, while holding one piece at a time.
+struct InputPiece {
+  std::filesystem::path input;
+  std::shared_ptr<const Manifest> manifest;  ///< null for a mesh file
+  std::size_t part = 0;                      ///< the manifest's part
+};
+
+/// The pieces of `inputs`, in order (the manifests are read here).
+/// @throw as read_manifest.
+std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& inputs);
+
+/// Loads one piece; appends one report per file read. @throw as read_mesh and load_assembly.
+TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports = nullptr);
 
 /// Loads inputs that are mesh files or manifests (.json), in order, into one soup (parts
 /// appended in order, indices shifted).

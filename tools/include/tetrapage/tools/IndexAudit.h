@@ -1,0 +1,66 @@
+#pragma once
+/// @file IndexAudit.h
+/// What `validate` checks against brute force (issue 4, item 8): every chosen tet holds, by
+/// id, exactly the model's triangles that meet it, and every chosen shard's index returns, for
+/// random boxes, exactly the stored triangles that meet the box. The oracle is CGAL's exact
+/// kernel (do_intersect), sharing no code with preprocess's binning or the shard queries.
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/runtime/Shard.h"
+
+namespace tetrapage {
+
+/// What the audits checked and found wrong (at most 100 problems are kept; `mismatches` counts
+/// them all).
+struct AuditFindings {
+  std::uint64_t tets_checked = 0;
+  std::uint64_t triangles_read = 0;
+  std::uint64_t shards_checked = 0;
+  std::uint64_t boxes_checked = 0;
+  std::uint64_t mismatches = 0;
+  std::vector<std::string> problems;
+  void add(std::string problem);
+};
+
+/// The files an index was built from, in preprocess's order (its header's `source`).
+std::vector<std::filesystem::path> source_inputs(const IndexHeader& header);
+
+/// The model-wide ids of the triangles a tet holds.
+using StoredIds = std::function<std::vector<std::uint64_t>(std::uint32_t tet)>;
+
+/// Streams the model (`inputs`, the files the index was built from, in the same order, one
+/// piece at a time) and checks that each tet in `tets` holds exactly the triangles that meet
+/// its closed region, by model-wide id (the input order), and that the model has
+/// `input_triangles` triangles.
+/// @throw as load_input_piece for an unreadable input.
+void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, const StoredIds& stored,
+                   std::uint64_t input_triangles, const std::vector<std::filesystem::path>& inputs,
+                   AuditFindings& findings, Progress& progress = Progress::silent());
+
+/// The same for an index's tets and shards.
+void audit_binning(const IndexReader& index, const std::vector<std::filesystem::path>& inputs,
+                   std::span<const std::uint32_t> tets, AuditFindings& findings,
+                   Progress& progress = Progress::silent());
+
+/// `boxes` random boxes inside the shard's bounds (sides from a hundredth to half of its
+/// extent): the shard's query visits exactly the stored triangles that meet each box.
+/// `label` names the shard in problems.
+void audit_shard_queries(const Shard& shard, const std::string& label, std::uint32_t boxes,
+                         std::uint64_t seed, AuditFindings& findings);
+
+/// For each shard in `shards`, `boxes` random boxes inside the shard's bounds (sides from a
+/// hundredth to half of its extent): the shard's query visits exactly the stored triangles
+/// that meet the box.
+void audit_shard_queries(const IndexReader& index, std::span<const std::uint32_t> shards,
+                         std::uint32_t boxes, std::uint64_t seed, AuditFindings& findings,
+                         Progress& progress = Progress::silent());
+
+}  // namespace tetrapage
