@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <limits>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <sstream>
@@ -469,7 +470,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     });
     for (std::size_t t = 0; t < tet_count; ++t) order[t] = std::uint32_t(t);
     tbb::parallel_sort(order.begin(), order.end(),
-                       [&](std::uint32_t a, std::uint32_t b) { return code[a] < code[b]; });
+                       [&](std::uint32_t a, std::uint32_t b) { return code[a] < code[b] || (code[a] == code[b] && a < b); });
     for (std::size_t r = 0; r < tet_count; ++r) rank[order[r]] = std::uint32_t(r);
   }
 
@@ -478,21 +479,33 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   std::vector<std::uint32_t> bucket_of(tet_count, 0);
   std::size_t bucket_count = 1;
   {
+    StageClock clock(summary, "buckets");
     const double copies_per_sample = 1.5 * double(triangle_count) / double(in.sample.size());
     const double capacity = double(options.memory_bytes / 3) / double(sizeof(TriangleRecord));
     if (copies_per_sample * double(in.sample.size()) > capacity) {
+      // At most 2^18 of the sampled centroids (every stride-th) say enough about the loads.
+      const std::size_t stride = (in.sample.size() + (std::size_t(1) << 18) - 1) >> 18;
+      std::vector<std::pair<std::uint64_t, Vec3>> coded;
+      coded.reserve(in.sample.size() / stride + 1);
+      for (std::size_t i = 0; i < in.sample.size(); i += stride)
+        coded.emplace_back(morton_code(in.sample[i], mesh_box), in.sample[i]);
+      tbb::parallel_sort(coded.begin(), coded.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+      // Located in Morton order, each walk starting next to the last one, in fixed chunks (the
+      // counts do not depend on the threads).
+      std::vector<std::atomic<std::uint32_t>> located_here(tet_count);
+      constexpr std::size_t kChunk = 4096;
+      tbb::parallel_for(std::size_t(0), (coded.size() + kChunk - 1) / kChunk, [&](std::size_t chunk) {
+        std::uint32_t hint = 0;
+        for (std::size_t i = chunk * kChunk; i < std::min(coded.size(), (chunk + 1) * kChunk); ++i) {
+          const WalkResult located = locate_point(mesh, hint, coded[i].second);
+          if (located.tet == TetMesh::no_neighbour) continue;
+          hint = located.tet;
+          located_here[located.tet].fetch_add(1, std::memory_order_relaxed);
+        }
+      });
       std::vector<double> estimate(tet_count, 0.0);
-      // Located in Morton order, each walk starts next to the last one.
-      std::vector<std::pair<std::uint64_t, Vec3>> coded(in.sample.size());
-      for (std::size_t i = 0; i < in.sample.size(); ++i) coded[i] = {morton_code(in.sample[i], mesh_box), in.sample[i]};
-      std::sort(coded.begin(), coded.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-      std::uint32_t hint = 0;
-      for (const auto& [code, c] : coded) {
-        const WalkResult located = locate_point(mesh, hint, c);
-        if (located.tet == TetMesh::no_neighbour) continue;
-        hint = located.tet;
-        estimate[located.tet] += copies_per_sample;
-      }
+      for (std::size_t t = 0; t < tet_count; ++t)
+        estimate[t] = copies_per_sample * double(stride) * double(located_here[t].load());
       double load = 0;
       std::uint32_t bucket = 0;
       for (const std::uint32_t t : order) {
@@ -502,6 +515,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
       }
       bucket_count = bucket + 1;
     }
+    clock.stop();
   }
   summary.buckets = bucket_count;
   std::vector<Vec3>().swap(in.sample);
@@ -572,16 +586,34 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     const ShardCostModel cost_model;
     Progress progress("building shards", tet_count, options.progress);
     for (auto& bucket : buckets) {
-      std::vector<TriangleRecord> records = bucket.read_all();
+      const std::vector<TriangleRecord> records = bucket.read_all();
       bucket.clear();
-      tbb::parallel_sort(records.begin(), records.end(), [&](const TriangleRecord& a, const TriangleRecord& b) {
-        return rank[a.tet] != rank[b.tet] ? rank[a.tet] < rank[b.tet] : a.id < b.id;
-      });
+      // The records in (tet rank, id) order, as indices: a counting sort by rank (the records,
+      // 88 bytes each, stay where they are), then each tet's own by id, in parallel.
+      if (records.size() >= std::numeric_limits<std::uint32_t>::max())
+        throw InputError("a bucket of " + std::to_string(records.size()) +
+                         " triangle copies is beyond 2^32: give a smaller --memory, for more buckets");
+      std::vector<std::uint32_t> sorted(records.size());
       std::vector<std::size_t> group_start;
-      for (std::size_t i = 0; i < records.size(); ++i)
-        if (i == 0 || records[i].tet != records[i - 1].tet) group_start.push_back(i);
+      if (!records.empty()) {
+        std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
+        for (const TriangleRecord& r : records) {
+          lowest = std::min(lowest, rank[r.tet]);
+          highest = std::max(highest, rank[r.tet]);
+        }
+        std::vector<std::size_t> next(std::size_t(highest - lowest) + 2, 0);
+        for (const TriangleRecord& r : records) ++next[rank[r.tet] - lowest + 1];
+        std::partial_sum(next.begin(), next.end(), next.begin());
+        for (std::size_t k = 0; k + 1 < next.size(); ++k)
+          if (next[k + 1] > next[k]) group_start.push_back(next[k]);
+        for (std::size_t i = 0; i < records.size(); ++i) sorted[next[rank[records[i].tet] - lowest]++] = std::uint32_t(i);
+      }
       const std::size_t groups = group_start.size();
       group_start.push_back(records.size());
+      tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
+        std::sort(sorted.begin() + std::ptrdiff_t(group_start[g]), sorted.begin() + std::ptrdiff_t(group_start[g + 1]),
+                  [&](std::uint32_t a, std::uint32_t b) { return records[a].id < records[b].id; });
+      });
       std::vector<BuiltShard> built(groups);
       std::vector<EncodedShard> encoded(groups);
       tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
@@ -593,9 +625,10 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         ids.reserve(last - first);
         parts.reserve(last - first);
         for (std::size_t i = first; i < last; ++i) {
-          triangles.push_back(records[i].triangle);
-          ids.push_back(records[i].id);
-          parts.push_back(records[i].part);
+          const TriangleRecord& record = records[sorted[i]];
+          triangles.push_back(record.triangle);
+          ids.push_back(record.id);
+          parts.push_back(record.part);
         }
         const ShardTriangles region{triangles, ids, parts};
         if (options.shard == ShardChoice::automatic) {
@@ -609,12 +642,12 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         encoded[g] = encode_shard(built[g].payload, writer.options());
       });
       for (std::size_t g = 0; g < groups; ++g) {
-        const std::uint32_t tet = records[group_start[g]].tet;
+        const std::uint32_t tet = records[sorted[group_start[g]]].tet;
         // Stored vertices lie within the shard's rounding distance of the input ones: grow
         // the input box by it (and a few ulps) so the runtime can skip shards unread.
         BoundingBox bounds;
         for (std::size_t i = group_start[g]; i < group_start[g + 1]; ++i)
-          for (const auto& p : records[i].triangle) bounds.extend(p);
+          for (const auto& p : records[sorted[i]].triangle) bounds.extend(p);
         for (int a = 0; a < 3; ++a) {
           const double grow = built[g].max_rounding_distance +
                               0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
