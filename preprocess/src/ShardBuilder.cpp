@@ -427,6 +427,8 @@ StoredRegion& StoredRegion::operator=(StoredRegion&&) noexcept = default;
 
 double StoredRegion::max_rounding_distance() const { return tables_->g.max_rounding_distance; }
 
+std::span<const Triangle> StoredRegion::stored_triangles() const { return tables_->g.triangles; }
+
 BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPrecision precision,
                        const ShardLayout& layout) {
   check_layout(layout);  // before the region's work

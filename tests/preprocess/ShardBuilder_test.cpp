@@ -423,7 +423,7 @@ TEST(ShardCostModel, BothKindsFindTheSameCandidatesAndTheChoiceIsTheCheaper) {
   for (const Region& region : {soup(51, 1500, {0, 0, 0}, 1, 0.02), regions()[7]}) {
     const ShardCostModel model;
     const ShardCostReport report =
-        estimate_shard_costs(region.view(), 0.1, StoredPrecision::float32, model);
+        estimate_shard_costs(region.view(), 0.1, StoredPrecision::float32, model, GridTrials::always);
     // The model measures count-only queries: they must examine exactly the cells, nodes and
     // references a deciding query examines.
     for (const auto* estimate : {&report.grid, &report.rtree}) {
@@ -455,6 +455,35 @@ TEST(ShardCostModel, BothKindsFindTheSameCandidatesAndTheChoiceIsTheCheaper) {
   EXPECT_THROW(estimate_shard_costs(regions()[0].view(), -1, StoredPrecision::float32,
                                     ShardCostModel{}),
                InputError);
+}
+
+TEST(ShardCostModel, TheGridFloorIsBelowEveryGridAndSkippingByItChoosesTheSame) {
+  // Regions where grids win and where they lose, several query sizes, both precisions, and a
+  // model that pages rarely (the floor is then mostly its reference count).
+  std::vector<Region> all = regions();
+  for (std::uint64_t seed = 20; seed < 26; ++seed)
+    all.push_back(soup(seed, 400 + 300 * (seed % 3), {0, 0, 0}, 1, seed % 2 == 0 ? 0.002 : 0.3));
+  ShardCostModel rare_paging;
+  rare_paging.queries_per_page_in = 1e6;
+  int skipped = 0, grids = 0;
+  for (const Region& region : all)
+    for (const double extent : {0.0, 0.05, 0.5})
+      for (const StoredPrecision precision : {StoredPrecision::float32, StoredPrecision::float64})
+        for (const ShardCostModel& model : {ShardCostModel{}, rare_paging}) {
+          if (precision == StoredPrecision::float32 && region.name.find("1e+09") != std::string::npos) continue;
+          const ShardCostReport always =
+              estimate_shard_costs(region.view(), extent, precision, model, GridTrials::always);
+          const ShardCostReport pruned = estimate_shard_costs(region.view(), extent, precision, model);
+          ASSERT_TRUE(always.grid_measured);
+          EXPECT_LE(always.grid_floor_seconds, always.grid.total_seconds() * (1 + 1e-12)) << region.name;
+          EXPECT_EQ(always.grid_floor_seconds, pruned.grid_floor_seconds) << region.name;
+          EXPECT_EQ(pruned.chosen, always.chosen) << region.name << " extent " << extent;
+          EXPECT_EQ(pruned.chosen_estimate().built.payload, always.chosen_estimate().built.payload) << region.name;
+          skipped += !pruned.grid_measured;
+          grids += always.chosen == ShardKind::grid;
+        }
+  EXPECT_GT(skipped, 0) << "the floor must skip some grids";
+  EXPECT_GT(grids, 0) << "and some regions must choose a grid";
 }
 
 }  // namespace

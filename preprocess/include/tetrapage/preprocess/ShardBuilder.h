@@ -74,6 +74,8 @@ class StoredRegion {
 
   /// The largest distance between an input vertex and its stored vertex.
   double max_rounding_distance() const;
+  /// The triangles as stored (absolute coordinates), in the region's order.
+  std::span<const geometry::Triangle> stored_triangles() const;
 
  private:
   struct Tables;

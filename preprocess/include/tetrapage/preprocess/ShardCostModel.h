@@ -50,13 +50,20 @@ struct ShardCostEstimate {
 
 /// The estimates of both kinds (each with its best layout among a few tried) and the choice.
 struct ShardCostReport {
-  ShardCostEstimate grid;
+  ShardCostEstimate grid;   ///< measured only when grid_measured
   ShardCostEstimate rtree;
+  /// A lower bound of every grid layout's total_seconds(), computed without building one.
+  double grid_floor_seconds = 0;
+  bool grid_measured = true;
   ShardKind chosen = ShardKind::grid;
   const ShardCostEstimate& chosen_estimate() const {
     return chosen == ShardKind::grid ? grid : rtree;
   }
 };
+
+/// Whether the grid layouts are built and measured always, or only when their cost floor is
+/// below the best R-tree's cost (the choice is the same: a grid costs at least its floor).
+enum class GridTrials : std::uint8_t { always, when_they_can_win };
 
 /// Estimates, for `region` queried by cubes of side query_extent centred on sampled triangles,
 /// each kind's cost: it builds the candidate layouts (grids of 1/4, 1 and 4 cells per
@@ -64,6 +71,7 @@ struct ShardCostReport {
 /// sampled queries and counts.
 /// @throw InputError as build_shard, or if query_extent is negative or not finite.
 ShardCostReport estimate_shard_costs(const ShardTriangles& region, double query_extent,
-                                     StoredPrecision precision, const ShardCostModel& model);
+                                     StoredPrecision precision, const ShardCostModel& model,
+                                     GridTrials grid_trials = GridTrials::when_they_can_win);
 
 }  // namespace tetrapage
