@@ -257,21 +257,24 @@ class RtreeBuilder {
   RtreeBuilder(const std::vector<Box>& relative_boxes, std::uint32_t leaf_size,
                std::uint32_t fanout)
       : boxes_(relative_boxes), leaf_size_(leaf_size), fanout_(fanout) {
-    order_.resize(boxes_.size());
-    std::iota(order_.begin(), order_.end(), 0u);
-    centres_.reserve(boxes_.size());
-    for (const Box& b : boxes_) centres_.push_back(b.center());
+    items_.reserve(boxes_.size());
+    for (std::uint32_t t = 0; t < boxes_.size(); ++t) items_.push_back({boxes_[t].center(), t});
   }
 
   void build() {
-    const std::uint64_t n = order_.size();
+    const std::uint64_t n = items_.size();
     std::uint32_t height = 0;
     for (std::uint64_t capacity = leaf_size_; capacity < n; capacity *= fanout_) ++height;
     nodes_.resize(1);
     build_node(0, 0, std::uint32_t(n), height);
   }
 
-  const std::vector<std::uint32_t>& order() const { return order_; }
+  std::vector<std::uint32_t> order() const {
+    std::vector<std::uint32_t> order;
+    order.reserve(items_.size());
+    for (const Item& item : items_) order.push_back(item.triangle);
+    return order;
+  }
   std::vector<RtreeNode>& nodes() { return nodes_; }
 
  private:
@@ -279,7 +282,7 @@ class RtreeBuilder {
                   std::uint32_t height) {
     Box box;
     if (height == 0) {
-      for (std::uint32_t i = begin; i < end; ++i) box.extend(boxes_[order_[i]]);
+      for (std::uint32_t i = begin; i < end; ++i) box.extend(boxes_[items_[i].triangle]);
       nodes_[index] = {box, begin, (end - begin) | shard_format::kLeafFlag};
       return;
     }
@@ -306,22 +309,26 @@ class RtreeBuilder {
     const std::uint32_t left = groups / 2;
     const auto middle = std::uint32_t(begin + left * capacity);
     Box spread;
-    for (std::uint32_t i = begin; i < end; ++i) spread.extend(centres_[order_[i]]);
+    for (std::uint32_t i = begin; i < end; ++i) spread.extend(items_[i].centre);
     const Point size = spread.size();
     const int axis = size[0] >= size[1] ? (size[0] >= size[2] ? 0 : 2) : (size[1] >= size[2] ? 1 : 2);
-    std::nth_element(order_.begin() + begin, order_.begin() + middle, order_.begin() + end,
-                     [&](std::uint32_t a, std::uint32_t b) {
-                       const double ca = centres_[a][axis], cb = centres_[b][axis];
-                       return ca < cb || (ca == cb && a < b);
+    // The centres travel with the triangle numbers: the comparisons read memory in order.
+    std::nth_element(items_.begin() + begin, items_.begin() + middle, items_.begin() + end,
+                     [&](const Item& a, const Item& b) {
+                       const double ca = a.centre[axis], cb = b.centre[axis];
+                       return ca < cb || (ca == cb && a.triangle < b.triangle);
                      });
     split(begin, middle, left, capacity, out);
     split(middle, end, groups - left, capacity, out);
   }
 
+  struct Item {
+    Point centre;
+    std::uint32_t triangle;
+  };
   const std::vector<Box>& boxes_;
   std::uint32_t leaf_size_, fanout_;
-  std::vector<std::uint32_t> order_;
-  std::vector<Point> centres_;
+  std::vector<Item> items_;  ///< in tree order once built
   std::vector<RtreeNode> nodes_;
 };
 
