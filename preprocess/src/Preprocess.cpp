@@ -32,6 +32,7 @@
 #include "tetrapage/preprocess/CoarseMesh.h"
 #include "tetrapage/preprocess/RayParity.h"
 #include "tetrapage/preprocess/RecordSpill.h"
+#include "tetrapage/preprocess/SoupSpill.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
 #include "tetrapage/preprocess/ShardCostModel.h"
 #include "tetrapage/preprocess/TriangleBinning.h"
@@ -100,10 +101,10 @@ std::filesystem::path spill_path(const std::filesystem::path& folder, const std:
   return folder / (".tetrapage-spill-" + std::to_string(::getpid()) + "-" + what);
 }
 
-// Ingest: every part file read once, instances placed, triangles appended as records; a
+// Ingest: every part file read once, instances placed, soups kept compactly (SoupSpill); a
 // reservoir sample of centroids (Algorithm R, fixed seed) bounded by the memory budget.
 struct Ingest {
-  RecordSpill<TriangleRecord> records;
+  SoupSpill<TriangleRecord> records;
   std::vector<Vec3> sample;
   std::uint64_t seen = 0;
   BoundingBox bounds;
@@ -120,10 +121,8 @@ struct Ingest {
 struct LoadedSoup {
   std::uint64_t degenerate_dropped = 0;
   std::uint64_t files_read = 0;
-  std::vector<std::string> part_names;
-  // Per triangle: its record (id and part still local to the soup) and centroid.
-  std::vector<TriangleRecord> records;
-  std::vector<Vec3> centroids;
+  TriangleSoup soup;
+  std::vector<Vec3> centroids;  // per triangle
   // Per soup part.
   std::vector<EdgeParity> parity;
   std::vector<BoundingBox> bounds;
@@ -133,33 +132,28 @@ struct LoadedSoup {
 LoadedSoup load_soup(const InputPiece& piece) {
   LoadedSoup loaded;
   std::vector<ReadReport> reports;
-  TriangleSoup soup = load_input_piece(piece, &reports);
+  loaded.soup = load_input_piece(piece, &reports);
   for (const auto& report : reports) {
     loaded.degenerate_dropped += report.degenerate_dropped;
     ++loaded.files_read;
   }
+  const TriangleSoup& soup = loaded.soup;
   const std::size_t parts = std::max<std::size_t>(soup.part_names.size(), 1);
-  loaded.part_names = std::move(soup.part_names);
   loaded.parity.resize(parts);
   loaded.bounds.resize(parts);
   loaded.triangles.assign(parts, 0);
   loaded.first.assign(parts, ~std::uint64_t{0});
   loaded.last.assign(parts, 0);
-  loaded.records.resize(soup.triangle_count());
   loaded.centroids.resize(soup.triangle_count());
   for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
     const auto part = std::uint32_t(soup.part_of.empty() ? 0 : soup.part_of[t]);
-    TriangleRecord& record = loaded.records[t];
-    record.triangle = soup.corners(t);
-    record.id = t;
-    record.part = part;
-    record.tet = 0;
-    loaded.parity[part].add_triangle(record.triangle);
-    for (const auto& p : record.triangle) loaded.bounds[part].extend(p);
+    const auto corners = soup.corners(t);
+    loaded.parity[part].add_triangle(corners);
+    for (const auto& p : corners) loaded.bounds[part].extend(p);
     ++loaded.triangles[part];
     if (loaded.first[part] == ~std::uint64_t{0}) loaded.first[part] = t;
     loaded.last[part] = t;
-    loaded.centroids[t] = centroid(record.triangle);
+    loaded.centroids[t] = centroid(corners);
   }
   return loaded;
 }
@@ -172,14 +166,13 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   in.sample.reserve(std::min<std::size_t>(sample_capacity, 1 << 16));
   std::mt19937_64 random(0x7e7a9a9e);
 
-  // In input order (ids, part numbers and the sample do not depend on the threads); the
-  // records were made by the parsing threads, only their ids and parts are offset here.
+  // In input order (ids, part numbers and the sample do not depend on the threads).
   auto add_soup = [&](LoadedSoup& loaded) {
     summary.degenerate_dropped += loaded.degenerate_dropped;
     summary.files_read += loaded.files_read;
     const auto part_offset = std::uint32_t(in.part_names.size());
-    for (auto& name : loaded.part_names) in.part_names.push_back(std::move(name));
-    if (loaded.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
+    for (const auto& name : loaded.soup.part_names) in.part_names.push_back(name);
+    if (loaded.soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
     in.part_parity.insert(in.part_parity.end(), loaded.parity.begin(), loaded.parity.end());
     in.part_bounds.insert(in.part_bounds.end(), loaded.bounds.begin(), loaded.bounds.end());
     in.part_triangles.insert(in.part_triangles.end(), loaded.triangles.begin(), loaded.triangles.end());
@@ -189,10 +182,9 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
       in.part_last.push_back(any ? in.seen + loaded.last[p] : 0);
       in.bounds.extend(loaded.bounds[p]);
     }
-    for (TriangleRecord& record : loaded.records) {
-      record.id += in.seen;
-      record.part += part_offset;
-    }
+    in.records.append(loaded.soup, part_offset);
+    if (!in.records.spilled() && in.records.held_bytes() > held_limit)
+      in.records.spill_to(spill_path(spill_folder, "triangles"));
     for (std::size_t t = 0; t < loaded.centroids.size(); ++t, ++in.seen) {
       if (in.sample.size() < sample_capacity) {
         in.sample.push_back(loaded.centroids[t]);
@@ -201,21 +193,12 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
         if (slot < sample_capacity) in.sample[slot] = loaded.centroids[t];
       }
     }
-    // Records go out in blocks, so that the held records never pass the limit by more than a
-    // block before they spill.
-    constexpr std::size_t kBlock = 1 << 16;
-    const std::span<const TriangleRecord> records(loaded.records);
-    for (std::size_t first = 0; first < records.size(); first += kBlock) {
-      in.records.append(records.subspan(first, std::min(kBlock, records.size() - first)));
-      if (!in.records.spilled() && in.records.size() * sizeof(TriangleRecord) > held_limit)
-        in.records.spill_to(spill_path(spill_folder, "triangles"));
-    }
   };
 
   // One part file at a time per thread: the ingest never holds the assembly.
   const std::vector<InputPiece> jobs = input_pieces(inputs);
-  // Parsing, records, edge parity and bounds run on all threads, a few soups at once; the
-  // records are appended in input order on one.
+  // Parsing, edge parity, bounds and centroids run on all threads, a few soups at once; the
+  // soups are appended in input order on one.
   Progress progress("reading parts", jobs.size(), options.progress);
   std::size_t next = 0;
   const std::size_t in_flight = std::size_t(tbb::this_task_arena::max_concurrency()) + 1;

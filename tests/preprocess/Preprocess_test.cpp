@@ -175,7 +175,8 @@ TEST(Preprocess, TetrasWithFloatStorageAndForcedKinds) {
 TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
   const fs::path folder = test_folder("spill");
   // Under 87,381 triangles the sample (memory / 192 B) holds every centroid, so both runs build
-  // the same coarse mesh; 7 MB of records still exceed the 4 MiB held in memory.
+  // the same coarse mesh; the triangles' copies (7 MB as records) exceed a third of the budget,
+  // so they spill in several buckets.
   const fs::path input = make_scene(folder, 80000, 7);
   PreprocessOptions in_memory;
   in_memory.region_triangles = 4000;

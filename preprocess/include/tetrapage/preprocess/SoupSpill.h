@@ -1,0 +1,184 @@
+#pragma once
+/// @file SoupSpill.h
+/// The ingested triangles, in input order, held as the soups they came in: shared vertices,
+/// three indices and a part per triangle, about 30 bytes a triangle where a record with its
+/// corners is 88. In memory, or spilled to a temporary file when the budget says so (removed
+/// when the spill is destroyed, also on errors). The later passes read them back as records.
+
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/TriangleSoup.h"
+
+namespace tetrapage {
+
+/// Record: trivially copyable, with `triangle` (three corners), `id` and `part` members.
+template <class Record>
+class SoupSpill {
+  static_assert(std::is_trivially_copyable_v<Record>);
+
+ public:
+  SoupSpill() = default;
+  ~SoupSpill() { close_and_remove(); }
+  SoupSpill(SoupSpill&&) noexcept = default;
+  SoupSpill& operator=(SoupSpill&&) noexcept = default;
+
+  bool spilled() const { return bool(file_); }
+  /// Triangles appended.
+  std::uint64_t size() const { return count_; }
+  /// Bytes held in memory.
+  std::uint64_t held_bytes() const { return held_bytes_; }
+
+  /// Appends a soup's triangles; the first gets id size(), its part p becomes part_offset + p.
+  /// @throw IoError when a write fails (disk full).
+  void append(const TriangleSoup& soup, std::uint32_t part_offset) {
+    Piece piece;
+    piece.first_id = count_;
+    piece.part_offset = part_offset;
+    piece.vertices = soup.vertices;
+    piece.triangles = soup.triangles;
+    piece.part_of = soup.part_of;
+    count_ += soup.triangle_count();
+    if (file_) {
+      write(piece);
+      return;
+    }
+    held_bytes_ += piece.bytes();
+    pieces_.push_back(std::move(piece));
+  }
+
+  /// Moves what is held in memory to `file` and spills from now on.
+  /// @throw IoError when the file cannot be created or written.
+  void spill_to(std::filesystem::path file) {
+    if (file_) return;
+    path_ = std::move(file);
+    file_.reset(std::fopen(path_.c_str(), "w+b"));
+    if (!file_) throw IoError(path_.string() + ": cannot create a spill file");
+    for (const Piece& piece : pieces_) write(piece);
+    std::vector<Piece>().swap(pieces_);
+    held_bytes_ = 0;
+  }
+
+  /// Calls visit(std::span<const Record>) on consecutive blocks of at most block_records, in
+  /// input order (each record's `tet`, or any other member, is zero).
+  /// @throw IoError when the file cannot be read back.
+  template <class Visit>
+  void for_each_block(std::size_t block_records, Visit&& visit) {
+    if (block_records == 0) block_records = 1;
+    std::vector<Record> block;
+    auto emit = [&](const Piece& piece) {
+      const std::size_t n = piece.triangles.size();
+      for (std::size_t first = 0; first < n; first += block_records) {
+        const std::size_t count = std::min(block_records, n - first);
+        block.assign(count, Record{});
+        for (std::size_t i = 0; i < count; ++i) {
+          const std::size_t t = first + i;
+          const auto& corners = piece.triangles[t];
+          Record& record = block[i];
+          record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]],
+                             piece.vertices[corners[2]]};
+          record.id = piece.first_id + t;
+          record.part = piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
+        }
+        visit(std::span<const Record>(block));
+      }
+    };
+    if (!file_) {
+      for (const Piece& piece : pieces_) emit(piece);
+      return;
+    }
+    if (std::fflush(file_.get()) != 0 || std::fseek(file_.get(), 0, SEEK_SET) != 0)
+      throw IoError(path_.string() + ": cannot rewind the spill file");
+    Piece piece;
+    for (std::uint64_t read = 0; read < count_; read += piece.triangles.size()) {
+      read_piece(piece);
+      emit(piece);
+    }
+    if (std::fseek(file_.get(), 0, SEEK_END) != 0)
+      throw IoError(path_.string() + ": cannot seek the spill file");
+  }
+
+  /// Frees the triangles and removes the file.
+  void clear() {
+    close_and_remove();
+    std::vector<Piece>().swap(pieces_);
+    count_ = 0;
+    held_bytes_ = 0;
+  }
+
+ private:
+  struct Piece {
+    std::uint64_t first_id = 0;
+    std::uint32_t part_offset = 0;
+    std::vector<Vec3> vertices;
+    std::vector<TriangleIndices> triangles;
+    std::vector<std::uint32_t> part_of;  ///< empty: every triangle is the soup's part 0
+    std::uint64_t bytes() const {
+      return vertices.size() * sizeof(Vec3) + triangles.size() * sizeof(TriangleIndices) +
+             part_of.size() * sizeof(std::uint32_t);
+    }
+  };
+  struct Header {
+    std::uint64_t first_id, vertices, triangles, parts;
+    std::uint32_t part_offset, unused;
+  };
+
+  template <class T>
+  void write_array(const std::vector<T>& values) {
+    if (!values.empty() &&
+        std::fwrite(values.data(), sizeof(T), values.size(), file_.get()) != values.size())
+      throw IoError(path_.string() + ": cannot write to the spill file (disk full?)");
+  }
+  void write(const Piece& piece) {
+    const Header header{piece.first_id, piece.vertices.size(), piece.triangles.size(),
+                        piece.part_of.size(), piece.part_offset, 0};
+    if (std::fwrite(&header, sizeof header, 1, file_.get()) != 1)
+      throw IoError(path_.string() + ": cannot write to the spill file (disk full?)");
+    write_array(piece.vertices);
+    write_array(piece.triangles);
+    write_array(piece.part_of);
+  }
+  template <class T>
+  void read_array(std::vector<T>& values, std::uint64_t count) {
+    values.resize(count);
+    if (count > 0 && std::fread(values.data(), sizeof(T), count, file_.get()) != count)
+      throw IoError(path_.string() + ": the spill file ends early");
+  }
+  void read_piece(Piece& piece) {
+    Header header{};
+    if (std::fread(&header, sizeof header, 1, file_.get()) != 1)
+      throw IoError(path_.string() + ": the spill file ends early");
+    piece.first_id = header.first_id;
+    piece.part_offset = header.part_offset;
+    read_array(piece.vertices, header.vertices);
+    read_array(piece.triangles, header.triangles);
+    read_array(piece.part_of, header.parts);
+    for (const auto& corners : piece.triangles)
+      for (const std::uint32_t v : corners)
+        if (v >= piece.vertices.size()) throw IoError(path_.string() + ": the spill file is damaged");
+  }
+  void close_and_remove() {
+    if (!file_) return;
+    file_.reset();
+    std::error_code ignored;
+    std::filesystem::remove(path_, ignored);
+  }
+
+  struct FileCloser {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  std::filesystem::path path_;
+  std::unique_ptr<std::FILE, FileCloser> file_;
+  std::vector<Piece> pieces_;
+  std::uint64_t count_ = 0;
+  std::uint64_t held_bytes_ = 0;
+};
+
+}  // namespace tetrapage
