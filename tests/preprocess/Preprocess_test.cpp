@@ -174,17 +174,23 @@ TEST(Preprocess, TetrasWithFloatStorageAndForcedKinds) {
 // The budget forces spill files and several buckets; the index must be the same as in memory.
 TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
   const fs::path folder = test_folder("spill");
-  // Under 87,381 triangles the sample (memory / 192 B) holds every centroid, so both runs build
-  // the same coarse mesh; the triangles' copies (7 MB as records) exceed a third of the budget,
-  // so they spill in several buckets.
+  // Under 87,381 triangles the sample (memory / 192 B) holds every centroid, so all runs build
+  // the same coarse mesh. Under 16 MiB the triangles' copies (7 MB as records) exceed a third of
+  // the budget: several buckets, held as (id, tet) pairs while the soups are in memory, or
+  // spilled to disk with the soups when forced.
   const fs::path input = make_scene(folder, 80000, 7);
   PreprocessOptions in_memory;
   in_memory.region_triangles = 4000;
   in_memory.shard = ShardChoice::rtree;
   const PreprocessSummary a = preprocess({input}, folder / "memory.tpi", in_memory);
   EXPECT_FALSE(a.spilled);
+  EXPECT_EQ(a.buckets, 1u);
   PreprocessOptions small = in_memory;
   small.memory_bytes = 16 << 20;
+  const PreprocessSummary c = preprocess({input}, folder / "buckets.tpi", small);
+  EXPECT_FALSE(c.spilled);
+  EXPECT_GT(c.buckets, 1u);
+  small.force_spill = true;
   const PreprocessSummary b = preprocess({input}, folder / "spilled.tpi", small);
   EXPECT_TRUE(b.spilled);
   EXPECT_GT(b.buckets, 1u);
@@ -192,10 +198,14 @@ TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
   for (const auto& entry : fs::directory_iterator(folder))
     EXPECT_EQ(entry.path().filename().string().find(".tetrapage-spill"), std::string::npos) << entry.path();
 
-  const IndexReader ra(folder / "memory.tpi"), rb(folder / "spilled.tpi");
-  ASSERT_EQ(ra.shard_count(), rb.shard_count());
-  EXPECT_EQ(ra.read_table_uint32("tet_shard"), rb.read_table_uint32("tet_shard"));
-  for (std::uint32_t s = 0; s < ra.shard_count(); ++s) ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << "shard " << s;
+  const IndexReader ra(folder / "memory.tpi");
+  for (const char* other : {"buckets.tpi", "spilled.tpi"}) {
+    const IndexReader rb(folder / other);
+    ASSERT_EQ(ra.shard_count(), rb.shard_count()) << other;
+    EXPECT_EQ(ra.read_table_uint32("tet_shard"), rb.read_table_uint32("tet_shard")) << other;
+    for (std::uint32_t s = 0; s < ra.shard_count(); ++s)
+      ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << other << " shard " << s;
+  }
 }
 
 TEST(Preprocess, DeterministicBytes) {

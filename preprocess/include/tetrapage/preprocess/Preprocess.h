@@ -47,6 +47,9 @@ struct PreprocessOptions {
   bool progress = false;
   /// Where spill files go; empty: next to the output.
   std::filesystem::path spill_folder;
+  /// Spill the ingested triangles and the binned copies to disk whatever the budget (tests
+  /// compare such a run with one that holds them in memory).
+  bool force_spill = false;
   /// Store the interiors: each tet's reference point classified, exactly, against every
   /// closed part (RayParity.h); false: not stored, and the runtime then reports only touching
   /// surfaces.

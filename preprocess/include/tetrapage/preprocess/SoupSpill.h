@@ -5,6 +5,7 @@
 /// corners is 88. In memory, or spilled to a temporary file when the budget says so (removed
 /// when the spill is destroyed, also on errors). The later passes read them back as records.
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -39,6 +40,7 @@ class SoupSpill {
   /// Appends a soup's triangles; the first gets id size(), its part p becomes part_offset + p.
   /// @throw IoError when a write fails (disk full).
   void append(const TriangleSoup& soup, std::uint32_t part_offset) {
+    if (soup.triangle_count() == 0) return;
     Piece piece;
     piece.first_id = count_;
     piece.part_offset = part_offset;
@@ -52,6 +54,22 @@ class SoupSpill {
     }
     held_bytes_ += piece.bytes();
     pieces_.push_back(std::move(piece));
+  }
+
+  /// The record of triangle `id` (< size()), read in memory: only while not spilled().
+  Record record(std::uint64_t id) const {
+    // The last piece that starts at or before id.
+    const auto piece_it = std::upper_bound(pieces_.begin(), pieces_.end(), id,
+                                           [](std::uint64_t i, const Piece& p) { return i < p.first_id; }) -
+                          1;
+    const Piece& piece = *piece_it;
+    const std::size_t t = std::size_t(id - piece.first_id);
+    const auto& corners = piece.triangles[t];
+    Record record{};
+    record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]], piece.vertices[corners[2]]};
+    record.id = id;
+    record.part = piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
+    return record;
   }
 
   /// Moves what is held in memory to `file` and spills from now on.
