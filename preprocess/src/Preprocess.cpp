@@ -109,7 +109,6 @@ class CopyBucket {
   CopyBucket(std::filesystem::path file, const SoupSpill<TriangleRecord>& soups)
       : soups_(soups.spilled() ? nullptr : &soups),
         records_(soups_ != nullptr ? std::filesystem::path() : std::move(file)) {}
-  bool spilled() const { return records_.spilled(); }
   void append(std::span<const TriangleRecord> copies) {
     if (soups_ == nullptr) return records_.append(copies);
     for (const TriangleRecord& copy : copies) pairs_.push_back({copy.id, copy.tet});
@@ -146,7 +145,7 @@ class CopyBucket {
 // Ingest: every part file read once, instances placed, soups kept compactly (SoupSpill); a
 // reservoir sample of centroids (Algorithm R, fixed seed) bounded by the memory budget.
 struct Ingest {
-  SoupSpill<TriangleRecord> records;
+  SoupSpill<TriangleRecord> soups;
   std::vector<Vec3> sample;
   std::uint64_t seen = 0;
   BoundingBox bounds;
@@ -159,7 +158,7 @@ struct Ingest {
 };
 
 // One input soup (a manifest's part, or a mesh file) with what can be computed off the
-// ingest's serial path: per soup part, edge parity and bounds.
+// ingest's serial path: centroids, and per soup part edge parity, bounds and counts.
 struct LoadedSoup {
   std::uint64_t degenerate_dropped = 0;
   std::uint64_t files_read = 0;
@@ -224,9 +223,9 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
       in.part_last.push_back(any ? in.seen + loaded.last[p] : 0);
       in.bounds.extend(loaded.bounds[p]);
     }
-    in.records.append(loaded.soup, part_offset);
-    if (!in.records.spilled() && (in.records.held_bytes() > held_limit || options.force_spill))
-      in.records.spill_to(spill_path(spill_folder, "triangles"));
+    in.soups.append(loaded.soup, part_offset);
+    if (!in.soups.spilled() && (in.soups.held_bytes() > held_limit || options.force_spill))
+      in.soups.spill_to(spill_path(spill_folder, "triangles"));
     for (std::size_t t = 0; t < loaded.centroids.size(); ++t, ++in.seen) {
       if (in.sample.size() < sample_capacity) {
         in.sample.push_back(loaded.centroids[t]);
@@ -351,7 +350,7 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       for (const std::uint32_t p : pass) asked[p] = std::move(of_part[p]);
       RayParity parity(points, asked);
       asked.clear();
-      in.records.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+      in.soups.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 2048),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                             for (std::size_t i = range.begin(); i < range.end(); ++i)
@@ -562,8 +561,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   std::vector<CopyBucket> buckets;
   buckets.reserve(bucket_count);
   for (std::size_t b = 0; b < bucket_count; ++b)
-    buckets.emplace_back(spill_path(spill_folder, "bucket" + std::to_string(b)), in.records);
-  summary.spilled = in.records.spilled();
+    buckets.emplace_back(spill_path(spill_folder, "bucket" + std::to_string(b)), in.soups);
+  summary.spilled = in.soups.spilled();
   {
     StageClock clock(summary, "binning");
     struct ThreadState {
@@ -579,7 +578,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     const std::size_t block_records =
         std::max<std::size_t>(1024, options.memory_bytes / 12 / sizeof(TriangleRecord));
     Progress progress("binning triangles", triangle_count, options.progress);
-    in.records.for_each_block(block_records, [&](std::span<const TriangleRecord> block) {
+    in.soups.for_each_block(block_records, [&](std::span<const TriangleRecord> block) {
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 256),
                         [&](const tbb::blocked_range<std::size_t>& range) {
                           ThreadState& s = states.local();
@@ -604,7 +603,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     progress.finish();
     for (auto& s : states) summary.exact_tet_tests += s.scratch.tet_tests;
     // The soups go now, unless the buckets make their copies' records from them.
-    if (in.records.spilled()) in.records.clear();
+    if (in.soups.spilled()) in.soups.clear();
     clock.stop();
   }
 
@@ -708,7 +707,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
       progress.advance(groups);
     }
     progress.finish();
-    in.records.clear();
+    in.soups.clear();
     summary.empty_regions = tet_count - shard_tet.size();
     summary.duplication_factor = double(summary.stored_triangles) / double(triangle_count);
     clock.stop();
