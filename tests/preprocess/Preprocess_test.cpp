@@ -209,16 +209,37 @@ TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
 }
 
 TEST(Preprocess, DeterministicBytes) {
+  // A single file, and an assembly of many part files (the ingest parses several at once).
   const fs::path folder = test_folder("deterministic");
-  const fs::path input = make_scene(folder, 5000, 11);
-  PreprocessOptions options;
-  options.region_triangles = 500;
-  preprocess({input}, folder / "a.tpi", options);
-  options.threads = 1;
-  preprocess({input}, folder / "b.tpi", options);
-  const IndexReader a(folder / "a.tpi"), b(folder / "b.tpi");
-  ASSERT_EQ(a.shard_count(), b.shard_count());
-  for (std::uint32_t s = 0; s < a.shard_count(); ++s) ASSERT_EQ(a.read_shard(s), b.read_shard(s));
+  const fs::path assembly = folder / "scene.json";
+  {
+    static const MeshLibrary library = MeshLibrary::load_default();
+    SceneOptions scene;
+    scene.triangles = 20000;
+    scene.seed = 12;
+    MeshWriter writer(assembly);
+    generate_scene(library, scene, writer);
+    writer.commit();
+  }
+  for (const fs::path& input : {make_scene(folder, 5000, 11), assembly}) {
+    PreprocessOptions options;
+    options.region_triangles = 500;
+    options.interiors = true;
+    const PreprocessSummary all_threads = preprocess({input}, folder / "a.tpi", options);
+    options.threads = 1;
+    const PreprocessSummary one_thread = preprocess({input}, folder / "b.tpi", options);
+    EXPECT_EQ(all_threads.parts, one_thread.parts);
+    if (input == assembly) {
+      EXPECT_GT(all_threads.parts, 3u);
+    }
+    EXPECT_EQ(all_threads.closed_parts, one_thread.closed_parts);
+    const IndexReader a(folder / "a.tpi"), b(folder / "b.tpi");
+    ASSERT_EQ(a.shard_count(), b.shard_count()) << input;
+    for (std::uint32_t s = 0; s < a.shard_count(); ++s) ASSERT_EQ(a.read_shard(s), b.read_shard(s)) << input;
+    for (const char* table : {"tet_shard", "interior_parts"})
+      EXPECT_EQ(a.read_table_uint32(table), b.read_table_uint32(table)) << input << " " << table;
+    EXPECT_EQ(a.read_table_uint64("interior_offsets"), b.read_table_uint64("interior_offsets")) << input;
+  }
 }
 
 TEST(Preprocess, BadInputLeavesNothingBehind) {
