@@ -3,6 +3,15 @@
 namespace tetrapage::detail {
 
 void silence_hdf5_errors() {
+  // Before HDF5's first use in the process (when it is ours): no termination at exit. A file
+  // whose close failed (a full disk while flushing an abandoned index) stays half closed in
+  // HDF5, and its termination handler then crashes the process at exit (HDF5 1.10 closes the
+  // broken file again). Every file is closed by its handle anyway.
+  static const bool no_termination_at_exit = [] {
+    H5dont_atexit();
+    return true;
+  }();
+  (void)no_termination_at_exit;
   thread_local bool silenced = false;
   if (silenced) return;
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);

@@ -2,14 +2,12 @@
 // doubles), CGAL's reader as an independent check of what we write, determinism, and the
 // guarantee that a failed or abandoned write leaves nothing under the output name.
 
-#include <sys/resource.h>
-
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/polygon_soup_io.h>
 
-#include <csignal>
 #include <map>
 
+#include "../FileSizeLimit.h"
 #include "TestSupport.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshWriter.h"
@@ -227,34 +225,13 @@ TEST(MeshWriter, BadArgumentsAndFolders) {
   expect_error<InputError>([&] { write_mesh(folder / "x.obj", inconsistent); }, {"x.obj"});
 }
 
-/// Lowers the file size limit of this process for its lifetime: writes beyond it fail with
-/// EFBIG, as they would on a full disk (SIGXFSZ is ignored meanwhile).
-class FileSizeLimit {
- public:
-  explicit FileSizeLimit(rlim_t bytes) {
-    getrlimit(RLIMIT_FSIZE, &saved_);
-    previous_handler_ = std::signal(SIGXFSZ, SIG_IGN);
-    rlimit limited = saved_;
-    limited.rlim_cur = bytes;
-    setrlimit(RLIMIT_FSIZE, &limited);
-  }
-  ~FileSizeLimit() {
-    setrlimit(RLIMIT_FSIZE, &saved_);
-    std::signal(SIGXFSZ, previous_handler_);
-  }
-
- private:
-  rlimit saved_{};
-  void (*previous_handler_)(int) = nullptr;
-};
-
 TEST(MeshWriter, WriteFailureIsAnIoErrorNamingTheFile) {
   const auto folder = scratch_folder("disk_full");
   const TriangleSoup soup = random_soup(11, 1, 20000);  // well over the limit in every format
   for (const std::string extension : {".obj", ".ply", ".off", ".stl", ".glb"}) {
     const auto path = folder / ("full" + extension);
     {
-      FileSizeLimit limit(64 * 1024);
+      test::FileSizeLimit limit(64 * 1024);
       expect_error<IoError>([&] { write_mesh(path, soup); }, {path.string(), "too large"});
     }
     EXPECT_TRUE(folder_listing(folder).empty()) << extension;

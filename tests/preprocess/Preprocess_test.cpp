@@ -11,6 +11,11 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/IndexReader.h"
@@ -21,6 +26,7 @@
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/TetrasGenerator.h"
+#include "../FileSizeLimit.h"
 
 namespace tetrapage {
 namespace {
@@ -240,6 +246,75 @@ TEST(Preprocess, DeterministicBytes) {
       EXPECT_EQ(a.read_table_uint32(table), b.read_table_uint32(table)) << input << " " << table;
     EXPECT_EQ(a.read_table_uint64("interior_offsets"), b.read_table_uint64("interior_offsets")) << input;
   }
+}
+
+std::vector<std::string> listing(const fs::path& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+  return names;
+}
+
+TEST(Preprocess, AFullDiskOrAMissingFolderIsAClearErrorAndLeavesNothingBehind) {
+  const fs::path folder = test_folder("full-disk");
+  fs::create_directories(folder / "in");
+  fs::create_directories(folder / "out");
+  const fs::path input = make_scene(folder / "in", 80000, 7);
+  PreprocessOptions options;
+  options.precision = StoredPrecision::float64;  // an index of about 2 MB
+  options.memory_bytes = 16 << 20;
+  // 64 KiB: the spill files fail first (forced); 1 MiB: the index's temporary file fails.
+  for (const rlim_t limit : {rlim_t(64) << 10, rlim_t(1) << 20}) {
+    options.force_spill = limit < (rlim_t(1) << 20);
+    {
+      test::FileSizeLimit full(limit);
+      try {
+        preprocess({input}, folder / "out" / "model.tpi", options);
+        ADD_FAILURE() << "a " << limit << "-byte disk held the index";
+      } catch (const IoError& error) {
+        EXPECT_NE(std::string(error.what()).find(folder.string()), std::string::npos) << error.what();
+      } catch (const Error& error) {
+        EXPECT_NE(std::string(error.what()).find("model.tpi"), std::string::npos) << error.what();
+      }
+    }
+    EXPECT_EQ(listing(folder / "out"), std::vector<std::string>{}) << "limit " << limit;
+  }
+  // The output's folder is missing, or is a file.
+  EXPECT_THROW(preprocess({input}, folder / "missing" / "model.tpi", {}), Error);
+  EXPECT_THROW(preprocess({input}, input / "model.tpi", {}), Error);
+  EXPECT_FALSE(fs::exists(folder / "missing"));
+  EXPECT_EQ(listing(folder / "in"), std::vector<std::string>{"scene.ply"});
+}
+
+TEST(PreprocessCommand, KilledMidRunLeavesNoIndexUnderTheOutputName) {
+  const fs::path folder = test_folder("killed");
+  const fs::path input = make_scene(folder, 150000, 3);
+  const fs::path output = folder / "model.tpi";
+  int killed_while_running = 0;
+  for (const int milliseconds : {30, 100, 250, 500}) {
+    fs::remove(output);
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      const int null = ::open("/dev/null", O_WRONLY);
+      ::dup2(null, 1);
+      ::dup2(null, 2);
+      ::execl(TETRAPAGE_CLI, "tetrapage", "preprocess", input.c_str(), "-o", output.c_str(), "--memory", "16M",
+              static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(milliseconds));
+    ::kill(child, SIGKILL);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    if (WIFSIGNALED(status)) {
+      ++killed_while_running;
+      EXPECT_FALSE(fs::exists(output)) << "killed after " << milliseconds << " ms";
+    } else {
+      // It finished first: then the index is whole.
+      EXPECT_EQ(IndexReader(output).validate(), std::vector<std::string>{}) << milliseconds << " ms";
+    }
+  }
+  EXPECT_GT(killed_while_running, 1) << "the kills must land while preprocess runs";
 }
 
 TEST(Preprocess, BadInputLeavesNothingBehind) {
