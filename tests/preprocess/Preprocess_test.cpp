@@ -177,6 +177,39 @@ TEST(Preprocess, TetrasWithFloatStorageAndForcedKinds) {
   }
 }
 
+// Issue 4's extreme: a model around 1e9 with detail at 1e-3. Double storage keeps every
+// coordinate (the tets hold exactly what brute force finds, the stored corners equal the
+// input's); float storage rounds, and says by how much.
+TEST(Preprocess, AModelAt1e9WithDetailAt1e3) {
+  const fs::path folder = test_folder("far");
+  TriangleSoup soup = read_mesh(make_tetras(folder, 300, 8));
+  for (auto& v : soup.vertices)
+    for (auto& c : v) c = 1e9 + 0.02 * c;  // tetras of about 1e-3 in a box of 0.02 at 1e9
+  double shortest = 1e300;
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    const auto c = soup.corners(t);
+    for (int e = 0; e < 3; ++e)
+      shortest = std::min(shortest, std::hypot(c[e][0] - c[(e + 1) % 3][0], c[e][1] - c[(e + 1) % 3][1],
+                                               c[e][2] - c[(e + 1) % 3][2]));
+  }
+  EXPECT_LT(shortest, 2e-3);
+  EXPECT_GT(shortest, 1e-5);
+  const fs::path input = folder / "far.ply";
+  write_mesh(input, soup);
+  PreprocessOptions options;
+  options.region_triangles = 100;
+  options.precision = StoredPrecision::float64;
+  const PreprocessSummary exact = preprocess({input}, folder / "double.tpi", options);
+  EXPECT_EQ(exact.max_rounding_distance, 0.0);
+  expect_tets_match_brute_force(input, folder / "double.tpi", true);
+  options.precision = StoredPrecision::float32;
+  const PreprocessSummary rounded = preprocess({input}, folder / "float.tpi", options);
+  EXPECT_GT(rounded.max_rounding_distance, 0.0) << "float cannot hold 1e9 + detail exactly";
+  EXPECT_LT(rounded.max_rounding_distance, 1e-6) << "relative to each shard's origin, it keeps the detail";
+  EXPECT_NE(rounded.to_text().find("max rounding"), std::string::npos) << rounded.to_text();
+  expect_tets_match_brute_force(input, folder / "float.tpi", false);
+}
+
 // The budget forces spill files and several buckets; the index must be the same as in memory.
 TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
   const fs::path folder = test_folder("spill");
