@@ -360,15 +360,25 @@ TEST(Preprocess, BadInputLeavesNothingBehind) {
     std::ofstream obj(folder / "empty.obj");
     obj << "# nothing\n";
   }
+  {
+    std::ofstream obj(folder / "degenerate.obj");  // collinear corners, a repeated corner
+    obj << "v 0 0 0\nv 1 1 1\nv 2 2 2\nv 0 1 0\nf 1 2 3\nf 1 4 4\n";
+  }
   EXPECT_THROW(preprocess({folder / "missing.ply"}, folder / "out.tpi", {}), IoError);
   EXPECT_THROW(preprocess({folder / "nan.obj"}, folder / "out.tpi", {}), Error);
   EXPECT_THROW(preprocess({folder / "empty.obj"}, folder / "out.tpi", {}), Error);
+  try {
+    preprocess({folder / "degenerate.obj"}, folder / "out.tpi", {});
+    ADD_FAILURE() << "an all-degenerate model preprocessed";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("degenerate"), std::string::npos) << error.what();
+  }
   PreprocessOptions tiny;
   tiny.memory_bytes = 1000;
   EXPECT_THROW(preprocess({folder / "nan.obj"}, folder / "out.tpi", tiny), InputError);
   for (const auto& entry : fs::directory_iterator(folder)) {
     const std::string name = entry.path().filename().string();
-    EXPECT_TRUE(name == "nan.obj" || name == "empty.obj") << "left behind: " << name;
+    EXPECT_TRUE(name == "nan.obj" || name == "empty.obj" || name == "degenerate.obj") << "left behind: " << name;
   }
 }
 
