@@ -70,6 +70,23 @@ with open(f"{out}/scale.csv", "w") as f:
         f.write(",".join(str(r[k]) for k in keys) + "\n")
 print("\n".join(lines))
 
+# Issue 4's preprocess figures: throughput, index size and peak memory against --memory.
+pre_lines = ["| model | triangles | seconds | M triangles/s | index MiB | B/triangle | --memory MiB | peak RSS MiB | "
+             "stages (s) |", "|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+for d in sorted(glob.glob(f"{out}/*/"), key=lambda p: model_key(os.path.basename(p.rstrip("/")))):
+    try:
+        pre = json.load(open(f"{d}/preprocess.json"))
+    except FileNotFoundError:
+        continue
+    stages = ", ".join(f"{s['name']} {s['seconds']:.1f}" for s in pre.get("stages", []))
+    pre_lines.append(f"| {os.path.basename(d.rstrip('/'))} | {pre['triangles_read']:,} | {pre['seconds']:.1f} | "
+                     f"{pre['triangles_per_second'] / 1e6:.2f} | {mib(pre['bytes_written']):.0f} | "
+                     f"{pre['bytes_per_triangle']:.1f} | {mib(pre['memory_budget_bytes']):.0f} | "
+                     f"{mib(pre['peak_rss_bytes']):.0f} | {stages} |")
+open(f"{out}/preprocess.md", "w").write("\n".join(pre_lines) + "\n")
+print()
+print("\n".join(pre_lines))
+
 if not rows or shutil.which("gnuplot") is None:
     sys.exit(0)
 plots = f"{out}/plots"
