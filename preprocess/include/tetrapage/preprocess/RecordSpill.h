@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/preprocess/SpillFile.h"
 
 namespace tetrapage {
 
@@ -23,20 +24,9 @@ class RecordSpill {
  public:
   /// In memory when `file` is empty; otherwise spilled to `file` (created, truncated).
   /// @throw IoError when the file cannot be created.
-  explicit RecordSpill(std::filesystem::path file = {}) : path_(std::move(file)) {
-    if (path_.empty()) return;
-    file_.reset(std::fopen(path_.c_str(), "w+b"));
-    if (!file_) throw IoError(path_.string() + ": cannot create a spill file");
+  explicit RecordSpill(std::filesystem::path file = {}) {
+    if (!file.empty()) file_ = SpillFile(std::move(file));
   }
-  ~RecordSpill() {
-    if (file_) {
-      file_.reset();
-      std::error_code ignored;
-      std::filesystem::remove(path_, ignored);
-    }
-  }
-  RecordSpill(RecordSpill&&) noexcept = default;
-  RecordSpill& operator=(RecordSpill&&) noexcept = default;
 
   bool spilled() const { return bool(file_); }
 
@@ -44,9 +34,7 @@ class RecordSpill {
   /// @throw IoError when the file cannot be created or written.
   void spill_to(std::filesystem::path file) {
     if (file_) return;
-    path_ = std::move(file);
-    file_.reset(std::fopen(path_.c_str(), "w+b"));
-    if (!file_) throw IoError(path_.string() + ": cannot create a spill file");
+    file_ = SpillFile(std::move(file));
     std::vector<Record> held;
     held.swap(memory_);
     count_ = 0;
@@ -61,10 +49,7 @@ class RecordSpill {
       memory_.insert(memory_.end(), records.begin(), records.end());
       return;
     }
-    if (records.empty()) return;
-    if (std::fwrite(records.data(), sizeof(Record), records.size(), file_.get()) != records.size())
-      throw IoError(path_.string() + ": cannot write " + std::to_string(records.size()) +
-                    " records to the spill file (disk full?)");
+    file_.write(records.data(), sizeof(Record), records.size());
   }
   void append(const Record& record) { append(std::span<const Record>(&record, 1)); }
 
@@ -80,18 +65,15 @@ class RecordSpill {
             first, std::min(block_records, memory_.size() - first)));
       return;
     }
-    if (std::fflush(file_.get()) != 0 || std::fseek(file_.get(), 0, SEEK_SET) != 0)
-      throw IoError(path_.string() + ": cannot rewind the spill file");
+    file_.rewind();
     std::vector<Record> block(std::min<std::uint64_t>(block_records, count_));
     for (std::uint64_t left = count_; left > 0;) {
       const std::size_t n = std::size_t(std::min<std::uint64_t>(left, block.size()));
-      if (std::fread(block.data(), sizeof(Record), n, file_.get()) != n)
-        throw IoError(path_.string() + ": the spill file ends early");
+      file_.read(block.data(), sizeof(Record), n);
       visit(std::span<const Record>(block.data(), n));
       left -= n;
     }
-    if (std::fseek(file_.get(), 0, SEEK_END) != 0)
-      throw IoError(path_.string() + ": cannot seek the spill file");
+    file_.seek_end();
   }
 
   /// All records, read into memory (the caller knows they fit).
@@ -109,18 +91,11 @@ class RecordSpill {
   void clear() {
     count_ = 0;
     std::vector<Record>().swap(memory_);
-    if (file_) {
-      file_.reset(std::fopen(path_.c_str(), "w+b"));
-      if (!file_) throw IoError(path_.string() + ": cannot truncate the spill file");
-    }
+    if (file_) file_.truncate();
   }
 
  private:
-  struct FileCloser {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-  };
-  std::filesystem::path path_;
-  std::unique_ptr<std::FILE, FileCloser> file_;
+  SpillFile file_;
   std::vector<Record> memory_;
   std::uint64_t count_ = 0;
 };

@@ -17,6 +17,7 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/preprocess/SpillFile.h"
 
 namespace tetrapage {
 
@@ -26,11 +27,6 @@ class SoupSpill {
   static_assert(std::is_trivially_copyable_v<Record>);
 
  public:
-  SoupSpill() = default;
-  ~SoupSpill() { close_and_remove(); }
-  SoupSpill(SoupSpill&&) noexcept = default;
-  SoupSpill& operator=(SoupSpill&&) noexcept = default;
-
   bool spilled() const { return bool(file_); }
   /// Triangles appended.
   std::uint64_t size() const { return count_; }
@@ -76,9 +72,7 @@ class SoupSpill {
   /// @throw IoError when the file cannot be created or written.
   void spill_to(std::filesystem::path file) {
     if (file_) return;
-    path_ = std::move(file);
-    file_.reset(std::fopen(path_.c_str(), "w+b"));
-    if (!file_) throw IoError(path_.string() + ": cannot create a spill file");
+    file_ = SpillFile(std::move(file));
     for (const Piece& piece : pieces_) write(piece);
     std::vector<Piece>().swap(pieces_);
     held_bytes_ = 0;
@@ -112,20 +106,18 @@ class SoupSpill {
       for (const Piece& piece : pieces_) emit(piece);
       return;
     }
-    if (std::fflush(file_.get()) != 0 || std::fseek(file_.get(), 0, SEEK_SET) != 0)
-      throw IoError(path_.string() + ": cannot rewind the spill file");
+    file_.rewind();
     Piece piece;
     for (std::uint64_t read = 0; read < count_; read += piece.triangles.size()) {
       read_piece(piece);
       emit(piece);
     }
-    if (std::fseek(file_.get(), 0, SEEK_END) != 0)
-      throw IoError(path_.string() + ": cannot seek the spill file");
+    file_.seek_end();
   }
 
   /// Frees the triangles and removes the file.
   void clear() {
-    close_and_remove();
+    file_ = SpillFile();
     std::vector<Piece>().swap(pieces_);
     count_ = 0;
     held_bytes_ = 0;
@@ -150,15 +142,12 @@ class SoupSpill {
 
   template <class T>
   void write_array(const std::vector<T>& values) {
-    if (!values.empty() &&
-        std::fwrite(values.data(), sizeof(T), values.size(), file_.get()) != values.size())
-      throw IoError(path_.string() + ": cannot write to the spill file (disk full?)");
+    file_.write(values.data(), sizeof(T), values.size());
   }
   void write(const Piece& piece) {
     const Header header{piece.first_id, piece.vertices.size(), piece.triangles.size(),
                         piece.part_of.size(), piece.part_offset, 0};
-    if (std::fwrite(&header, sizeof header, 1, file_.get()) != 1)
-      throw IoError(path_.string() + ": cannot write to the spill file (disk full?)");
+    file_.write(&header, sizeof header, 1);
     write_array(piece.vertices);
     write_array(piece.triangles);
     write_array(piece.part_of);
@@ -166,13 +155,11 @@ class SoupSpill {
   template <class T>
   void read_array(std::vector<T>& values, std::uint64_t count) {
     values.resize(count);
-    if (count > 0 && std::fread(values.data(), sizeof(T), count, file_.get()) != count)
-      throw IoError(path_.string() + ": the spill file ends early");
+    file_.read(values.data(), sizeof(T), count);
   }
   void read_piece(Piece& piece) {
     Header header{};
-    if (std::fread(&header, sizeof header, 1, file_.get()) != 1)
-      throw IoError(path_.string() + ": the spill file ends early");
+    file_.read(&header, sizeof header, 1);
     piece.first_id = header.first_id;
     piece.part_offset = header.part_offset;
     read_array(piece.vertices, header.vertices);
@@ -180,20 +167,10 @@ class SoupSpill {
     read_array(piece.part_of, header.parts);
     for (const auto& corners : piece.triangles)
       for (const std::uint32_t v : corners)
-        if (v >= piece.vertices.size()) throw IoError(path_.string() + ": the spill file is damaged");
-  }
-  void close_and_remove() {
-    if (!file_) return;
-    file_.reset();
-    std::error_code ignored;
-    std::filesystem::remove(path_, ignored);
+        if (v >= piece.vertices.size()) file_.damaged();
   }
 
-  struct FileCloser {
-    void operator()(std::FILE* f) const { std::fclose(f); }
-  };
-  std::filesystem::path path_;
-  std::unique_ptr<std::FILE, FileCloser> file_;
+  SpillFile file_;
   std::vector<Piece> pieces_;
   std::uint64_t count_ = 0;
   std::uint64_t held_bytes_ = 0;
