@@ -650,61 +650,83 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         std::sort(sorted.begin() + std::ptrdiff_t(group_start[g]), sorted.begin() + std::ptrdiff_t(group_start[g + 1]),
                   [&](std::uint32_t a, std::uint32_t b) { return records[a].id < records[b].id; });
       });
-      std::vector<BuiltShard> built(groups);
-      std::vector<EncodedShard> encoded(groups);
-      tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
-        const std::size_t first = group_start[g], last = group_start[g + 1];
-        std::vector<geometry::Triangle> triangles;
-        std::vector<std::uint64_t> ids;
-        std::vector<std::uint32_t> parts;
-        triangles.reserve(last - first);
-        ids.reserve(last - first);
-        parts.reserve(last - first);
-        for (std::size_t i = first; i < last; ++i) {
-          const TriangleRecord& record = records[sorted[i]];
-          triangles.push_back(record.triangle);
-          ids.push_back(record.id);
-          parts.push_back(record.part);
-        }
-        const ShardTriangles region{triangles, ids, parts};
-        if (options.shard == ShardChoice::automatic) {
-          ShardCostReport costs = estimate_shard_costs(region, query_extent, options.precision, cost_model);
-          built[g] = std::move(costs.chosen == ShardKind::grid ? costs.grid.built : costs.rtree.built);
-        } else {
-          built[g] = build_shard(region, options.shard == ShardChoice::grid ? ShardKind::grid : ShardKind::rtree,
-                                 options.precision);
-        }
-        // Compressed here, in parallel: the writer then only appends.
-        encoded[g] = encode_shard(built[g].payload, writer.options());
-      });
-      for (std::size_t g = 0; g < groups; ++g) {
-        const std::uint32_t tet = records[sorted[group_start[g]]].tet;
-        // Stored vertices lie within the shard's rounding distance of the input ones: grow
-        // the input box by it (and a few ulps) so the runtime can skip shards unread.
+      // Built and compressed on all threads, appended in order on one while the others build
+      // on: a pipeline with a few shards in flight (the bucket's shards are never all held).
+      struct Ready {
+        BuiltShard built;  // its payload freed once encoded
+        std::uint64_t payload_bytes = 0;
+        EncodedShard encoded;
         BoundingBox bounds;
-        for (std::size_t i = group_start[g]; i < group_start[g + 1]; ++i)
-          for (const auto& p : records[sorted[i]].triangle) bounds.extend(p);
-        for (int a = 0; a < 3; ++a) {
-          const double grow = built[g].max_rounding_distance +
-                              0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
-          bounds.lo[a] -= grow;
-          bounds.hi[a] += grow;
-        }
-        shard_bounds.insert(shard_bounds.end(), {bounds.lo[0], bounds.lo[1], bounds.lo[2], bounds.hi[0],
-                                                 bounds.hi[1], bounds.hi[2]});
-        const std::uint32_t shard = writer.append_encoded_shard(encoded[g]);
-        encoded[g] = EncodedShard{};
-        tet_shard[tet] = shard;
-        shard_tet.push_back(tet);
-        shard_kind.push_back(std::uint8_t(built[g].kind));
-        shard_triangles.push_back(built[g].triangle_count);
-        summary.stored_triangles += built[g].triangle_count;
-        summary.shard_payload_bytes += built[g].payload.size();
-        summary.max_rounding_distance = std::max(summary.max_rounding_distance, built[g].max_rounding_distance);
-        (built[g].kind == ShardKind::grid ? summary.grid_shards : summary.rtree_shards) += 1;
-        std::vector<std::byte>().swap(built[g].payload);
-      }
-      progress.advance(groups);
+        std::uint32_t tet = 0;
+      };
+      std::size_t next_group = 0;
+      tbb::parallel_pipeline(
+          4 * std::size_t(tbb::this_task_arena::max_concurrency()),
+          tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                              [&](tbb::flow_control& control) -> std::size_t {
+                                                if (next_group == groups) control.stop();
+                                                return next_group++;
+                                              }) &
+              tbb::make_filter<std::size_t, std::shared_ptr<Ready>>(
+                  tbb::filter_mode::parallel,
+                  [&](std::size_t g) {
+                    auto ready = std::make_shared<Ready>();
+                    const std::size_t first = group_start[g], last = group_start[g + 1];
+                    std::vector<geometry::Triangle> triangles;
+                    std::vector<std::uint64_t> ids;
+                    std::vector<std::uint32_t> parts;
+                    triangles.reserve(last - first);
+                    ids.reserve(last - first);
+                    parts.reserve(last - first);
+                    for (std::size_t i = first; i < last; ++i) {
+                      const TriangleRecord& record = records[sorted[i]];
+                      triangles.push_back(record.triangle);
+                      ids.push_back(record.id);
+                      parts.push_back(record.part);
+                      for (const auto& p : record.triangle) ready->bounds.extend(p);
+                    }
+                    ready->tet = records[sorted[first]].tet;
+                    const ShardTriangles region{triangles, ids, parts};
+                    if (options.shard == ShardChoice::automatic) {
+                      ShardCostReport costs =
+                          estimate_shard_costs(region, query_extent, options.precision, cost_model);
+                      ready->built = std::move(costs.chosen == ShardKind::grid ? costs.grid.built : costs.rtree.built);
+                    } else {
+                      ready->built = build_shard(
+                          region, options.shard == ShardChoice::grid ? ShardKind::grid : ShardKind::rtree,
+                          options.precision);
+                    }
+                    ready->encoded = encode_shard(ready->built.payload, writer.options());
+                    ready->payload_bytes = ready->built.payload.size();
+                    std::vector<std::byte>().swap(ready->built.payload);
+                    return ready;
+                  }) &
+              tbb::make_filter<std::shared_ptr<Ready>, void>(
+                  tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Ready>& ready) {
+                    const BuiltShard& built = ready->built;
+                    // Stored vertices lie within the shard's rounding distance of the input
+                    // ones: grow the input box by it (and a few ulps) so the runtime can skip
+                    // shards unread.
+                    BoundingBox bounds = ready->bounds;
+                    for (int a = 0; a < 3; ++a) {
+                      const double grow = built.max_rounding_distance +
+                                          0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
+                      bounds.lo[a] -= grow;
+                      bounds.hi[a] += grow;
+                    }
+                    shard_bounds.insert(shard_bounds.end(), {bounds.lo[0], bounds.lo[1], bounds.lo[2], bounds.hi[0],
+                                                             bounds.hi[1], bounds.hi[2]});
+                    const std::uint32_t shard = writer.append_encoded_shard(ready->encoded);
+                    tet_shard[ready->tet] = shard;
+                    shard_tet.push_back(ready->tet);
+                    shard_kind.push_back(std::uint8_t(built.kind));
+                    shard_triangles.push_back(built.triangle_count);
+                    summary.stored_triangles += built.triangle_count;
+                    summary.shard_payload_bytes += ready->payload_bytes;
+                    summary.max_rounding_distance = std::max(summary.max_rounding_distance, built.max_rounding_distance);
+                    (built.kind == ShardKind::grid ? summary.grid_shards : summary.rtree_shards) += 1;
+                    progress.advance();
+                  }));
     }
     progress.finish();
     in.soups.clear();
