@@ -8,7 +8,7 @@
 #   bench/scripts/scale_series.sh OUT_DIR [SIZE...]        (default sizes: 1000000 10000000)
 #   OBJECTS="4 15000" STEPS=10000 TERRAIN=10000000 bench/scripts/scale_series.sh out/scale 100000000
 #
-# Writes OUT_DIR/scale.md (Markdown), OUT_DIR/scale.csv and OUT_DIR/plots/*.png (scale_table.py),
+# Writes OUT_DIR/scale.md (Markdown), OUT_DIR/preprocess.md, OUT_DIR/scale.csv and OUT_DIR/plots/*.png (scale_table.py),
 # from the JSON reports beside them.
 set -euo pipefail
 OUT=${1:?usage: scale_series.sh OUT_DIR [SIZE...]}

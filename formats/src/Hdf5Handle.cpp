@@ -2,7 +2,7 @@
 
 namespace tetrapage::detail {
 
-void silence_hdf5_errors() {
+void enter_hdf5() {
   // Before HDF5's first use in the process (when it is ours): no termination at exit. A file
   // whose close failed (a full disk while flushing an abandoned index) stays half closed in
   // HDF5, and its termination handler then crashes the process at exit (HDF5 1.10 closes the

@@ -9,10 +9,11 @@
 
 namespace tetrapage::detail {
 
-/// Turns off HDF5's automatic printing of its error stack for the calling thread. HDF5's
-/// thread-safe build keeps one error stack per thread, so every entry point that calls HDF5
-/// must call this first (it is cheap after the first call on a thread).
-void silence_hdf5_errors();
+/// Every entry point that calls HDF5 calls this first (cheap after the first call on a
+/// thread). Once per process, before HDF5's first use, it asks HDF5 not to terminate at exit
+/// (see Hdf5Handle.cpp); once per thread, it turns off HDF5's automatic printing of its error
+/// stack (HDF5's thread-safe build keeps one error stack per thread).
+void enter_hdf5();
 
 /// The innermost message of the calling thread's HDF5 error stack ("" when empty), then
 /// clears the stack.

@@ -291,7 +291,7 @@ struct IndexReader::Impl {
 
   template <class T>
   std::vector<T> read_table(std::string_view name) const {
-    detail::silence_hdf5_errors();
+    detail::enter_hdf5();
     if (!std::binary_search(tables.begin(), tables.end(), name))
       format_error("table '/tables/" + std::string(name) + "' is missing");
     return read_dataset<T>("/tables/" + std::string(name), 0);
@@ -475,7 +475,7 @@ struct IndexReader::Impl {
 };
 
 IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   Impl& r = *impl_;
   r.path = path;
   r.descriptor = Descriptor(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
@@ -595,7 +595,7 @@ const IndexHeader& IndexReader::header() const { return impl_->header; }
 std::uint64_t IndexReader::file_bytes() const { return impl_->file_bytes; }
 
 TetMesh IndexReader::read_mesh() const {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   const Impl& r = *impl_;
   const auto vertices = r.read_dataset<double>("/mesh/vertices", 3);
   const auto tets = r.read_dataset<std::uint32_t>("/mesh/tets", 4);
@@ -691,7 +691,7 @@ std::vector<std::byte> IndexReader::read_shard(std::uint32_t shard) const {
 }
 
 std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard) const {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   const Impl& r = *impl_;
   r.check_shard(shard);
   std::vector<std::byte> payload(r.sizes[shard]);
@@ -711,7 +711,7 @@ std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard)
 }
 
 std::vector<std::string> IndexReader::validate() const {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   const Impl& r = *impl_;
   std::vector<std::string> problems = r.extent_problems();
   if (problems.empty()) {

@@ -213,7 +213,7 @@ struct IndexWriter::Impl {
 
 IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
     : impl_(std::make_unique<Impl>()) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   Impl& w = *impl_;
   w.path = std::move(path);
   w.temporary = w.path;
@@ -253,7 +253,7 @@ IndexWriter::IndexWriter(IndexWriter&&) noexcept = default;
 IndexWriter& IndexWriter::operator=(IndexWriter&&) noexcept = default;
 
 void IndexWriter::write_mesh(const TetMesh& mesh) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   Impl& w = *impl_;
   w.ensure_writable("write the mesh");
   if (w.mesh_written)
@@ -292,19 +292,19 @@ void IndexWriter::write_mesh(const TetMesh& mesh) {
 }
 
 void IndexWriter::write_table(std::string_view name, std::span<const std::uint8_t> values) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   impl_->write_table(name, values);
 }
 void IndexWriter::write_table(std::string_view name, std::span<const std::uint32_t> values) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   impl_->write_table(name, values);
 }
 void IndexWriter::write_table(std::string_view name, std::span<const std::uint64_t> values) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   impl_->write_table(name, values);
 }
 void IndexWriter::write_table(std::string_view name, std::span<const double> values) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   impl_->write_table(name, values);
 }
 
@@ -340,7 +340,7 @@ std::uint32_t IndexWriter::append_shard(std::span<const std::byte> payload) {
 }
 
 std::uint32_t IndexWriter::append_encoded_shard(const EncodedShard& encoded) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   Impl& w = *impl_;
   w.ensure_writable("append a shard");
   if (w.offsets.size() >= 0xffffffffu)
@@ -382,7 +382,7 @@ const std::filesystem::path& IndexWriter::path() const { return impl_->path; }
 const std::filesystem::path& IndexWriter::temporary_path() const { return impl_->temporary; }
 
 std::uint64_t IndexWriter::commit(const IndexHeader& header) {
-  detail::silence_hdf5_errors();
+  detail::enter_hdf5();
   Impl& w = *impl_;
   w.ensure_writable("commit");
   const std::string where = "index '" + w.path.string() + "'";

@@ -37,6 +37,7 @@
 #include "tetrapage/preprocess/ShardCostModel.h"
 #include "tetrapage/preprocess/TriangleBinning.h"
 #include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 
 namespace tetrapage {
@@ -107,14 +108,15 @@ std::filesystem::path spill_path(const std::filesystem::path& folder, const std:
 class CopyBucket {
  public:
   CopyBucket(std::filesystem::path file, const SoupSpill<TriangleRecord>& soups)
-      : soups_(soups.spilled() ? nullptr : &soups),
-        records_(soups_ != nullptr ? std::filesystem::path() : std::move(file)) {}
+      : soups_(soups.spilled() ? nullptr : &soups) {
+    if (soups_ == nullptr) records_.emplace(std::move(file));
+  }
   void append(std::span<const TriangleRecord> copies) {
-    if (soups_ == nullptr) return records_.append(copies);
+    if (records_) return records_->append(copies);
     for (const TriangleRecord& copy : copies) pairs_.push_back({copy.id, copy.tet});
   }
   std::vector<TriangleRecord> read_all() {
-    if (soups_ == nullptr) return records_.read_all();
+    if (records_) return records_->read_all();
     std::vector<TriangleRecord> records(pairs_.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs_.size(), 4096),
                       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -126,7 +128,7 @@ class CopyBucket {
     return records;
   }
   void clear() {
-    records_.clear();
+    records_.reset();  // removes the file
     std::vector<Pair>().swap(pairs_);
   }
 
@@ -138,7 +140,7 @@ class CopyBucket {
   };
 #pragma pack(pop)
   const SoupSpill<TriangleRecord>* soups_;
-  RecordSpill<TriangleRecord> records_;
+  std::optional<RecordSpill<TriangleRecord>> records_;  ///< when the soups are spilled
   std::vector<Pair> pairs_;
 };
 
@@ -152,13 +154,11 @@ struct Ingest {
   std::vector<std::string> part_names;
   // Per part: whether its surface is closed, and its triangle count.
   std::vector<EdgeParity> part_parity;
-  std::vector<std::uint64_t> part_triangles;
   std::vector<BoundingBox> part_bounds;
-  std::vector<std::uint64_t> part_first, part_last;  // record indices (contiguous when last - first + 1 == count)
 };
 
 // One input soup (a manifest's part, or a mesh file) with what can be computed off the
-// ingest's serial path: centroids, and per soup part edge parity, bounds and counts.
+// ingest's serial path: centroids, and per soup part edge parity and bounds.
 struct LoadedSoup {
   std::uint64_t degenerate_dropped = 0;
   std::uint64_t files_read = 0;
@@ -167,7 +167,6 @@ struct LoadedSoup {
   // Per soup part.
   std::vector<EdgeParity> parity;
   std::vector<BoundingBox> bounds;
-  std::vector<std::uint64_t> triangles, first, last;  // count, first and last local index
 };
 
 LoadedSoup load_soup(const InputPiece& piece) {
@@ -182,18 +181,12 @@ LoadedSoup load_soup(const InputPiece& piece) {
   const std::size_t parts = std::max<std::size_t>(soup.part_names.size(), 1);
   loaded.parity.resize(parts);
   loaded.bounds.resize(parts);
-  loaded.triangles.assign(parts, 0);
-  loaded.first.assign(parts, ~std::uint64_t{0});
-  loaded.last.assign(parts, 0);
   loaded.centroids.resize(soup.triangle_count());
   for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
     const auto part = std::uint32_t(soup.part_of.empty() ? 0 : soup.part_of[t]);
     const auto corners = soup.corners(t);
     loaded.parity[part].add_triangle(corners);
     for (const auto& p : corners) loaded.bounds[part].extend(p);
-    ++loaded.triangles[part];
-    if (loaded.first[part] == ~std::uint64_t{0}) loaded.first[part] = t;
-    loaded.last[part] = t;
     loaded.centroids[t] = centroid(corners);
   }
   return loaded;
@@ -216,13 +209,7 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     if (loaded.soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
     in.part_parity.insert(in.part_parity.end(), loaded.parity.begin(), loaded.parity.end());
     in.part_bounds.insert(in.part_bounds.end(), loaded.bounds.begin(), loaded.bounds.end());
-    in.part_triangles.insert(in.part_triangles.end(), loaded.triangles.begin(), loaded.triangles.end());
-    for (std::size_t p = 0; p < loaded.triangles.size(); ++p) {
-      const bool any = loaded.triangles[p] > 0;
-      in.part_first.push_back(any ? in.seen + loaded.first[p] : ~std::uint64_t{0});
-      in.part_last.push_back(any ? in.seen + loaded.last[p] : 0);
-      in.bounds.extend(loaded.bounds[p]);
-    }
+    for (const BoundingBox& b : loaded.bounds) in.bounds.extend(b);
     in.soups.append(loaded.soup, part_offset);
     if (!in.soups.spilled() && (in.soups.held_bytes() > held_limit || options.force_spill))
       in.soups.spill_to(spill_path(spill_folder, "triangles"));
@@ -328,11 +315,8 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       const BoundingBox& b = in.part_bounds[p];
       auto it = std::lower_bound(tets.begin(), tets.end(), b.lo[0],
                                  [&](std::uint32_t t, double x) { return points[t][0] < x; });
-      for (; it != tets.end() && points[*it][0] <= b.hi[0]; ++it) {
-        const Vec3& q = points[*it];
-        if (q[1] >= b.lo[1] && q[1] <= b.hi[1] && q[2] >= b.lo[2] && q[2] <= b.hi[2])
-          of_part[p].push_back(*it);
-      }
+      for (; it != tets.end() && points[*it][0] <= b.hi[0]; ++it)
+        if (geometry::box_contains(b, points[*it])) of_part[p].push_back(*it);
       if (of_part[p].empty()) continue;
       if (pass_pairs > 0 && pass_pairs + of_part[p].size() > pairs_per_pass) {
         pass_parts.emplace_back();

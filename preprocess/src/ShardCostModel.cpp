@@ -7,6 +7,7 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/geometry/Box.h"
 
 namespace tetrapage {
 
@@ -71,12 +72,8 @@ double grid_cost_floor(const StoredRegion& region, const ShardCostEstimate& rtre
   std::uint64_t references = 0;
   for (const geometry::Box& q : queries)
     for (const geometry::Triangle& t : triangles)
-      for (const geometry::Point& p : t)
-        if (p[0] >= q.lo[0] && p[0] <= q.hi[0] && p[1] >= q.lo[1] && p[1] <= q.hi[1] && p[2] >= q.lo[2] &&
-            p[2] <= q.hi[2]) {
-          ++references;
-          break;
-        }
+      references += geometry::box_contains(q, t[0]) || geometry::box_contains(q, t[1]) ||
+                    geometry::box_contains(q, t[2]);
   const double real_bytes = rtree.built.precision == StoredPrecision::float32 ? 4 : 8;
   const double node_bytes = double(rtree.built.rtree_nodes) * (6 * real_bytes + 8);
   const double reference_bytes = triangles.size() <= 65536 ? 2 : 4;

@@ -1,9 +1,8 @@
 // The preprocess pipeline end to end: every tet's triangle set equals brute force (CGAL's
-// exact-construction kernel as the independent oracle), stored coordinates keep the promised
-// rounding, a run that spills to disk under a small budget writes the same index as one in
-// memory, and bad input leaves nothing behind.
+// exact-construction kernel as the independent oracle, through validate's audit), stored
+// coordinates keep the promised rounding, a run that spills to disk under a small budget
+// writes the same index as one in memory, and bad input leaves nothing behind.
 
-#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,6 +22,8 @@
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/tools/IndexAudit.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/TetrasGenerator.h"
@@ -31,7 +32,6 @@
 namespace tetrapage {
 namespace {
 
-using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
 namespace fs = std::filesystem;
 
 fs::path test_folder(const std::string& name) {
@@ -64,67 +64,46 @@ fs::path make_tetras(const fs::path& folder, std::uint64_t count, std::uint64_t 
   return path;
 }
 
-Epeck::Point_3 to_epeck(const Vec3& p) { return {p[0], p[1], p[2]}; }
-
-// Each tet's shard holds exactly the triangles that meet the tet (Epeck do_intersect over all
-// pairs whose boxes overlap), with their input ids, and stored coordinates within the
-// recorded rounding distance of the input (equal in double precision).
+// Each tet's shard holds exactly the triangles that meet the tet (validate's audit: CGAL's
+// exact do_intersect over the model, tools/IndexAudit.h), with their input ids and parts, and
+// stored coordinates within the recorded rounding distance of the input (equal in double
+// precision).
 void expect_tets_match_brute_force(const fs::path& input, const fs::path& index_path, bool exact_coordinates) {
   const TriangleSoup soup = read_mesh(input);
   const IndexReader index(index_path);
   const TetMesh mesh = index.read_mesh();
-  const auto tet_shard = index.read_table_uint32("tet_shard");
-  ASSERT_EQ(tet_shard.size(), mesh.tet_count());
   EXPECT_EQ(index.header().input_triangles, soup.triangle_count());
   const double rounding = index.header().max_rounding_distance;
   if (exact_coordinates) {
     EXPECT_EQ(rounding, 0.0);
   }
+  std::vector<std::uint32_t> tets(mesh.tet_count());
+  for (std::uint32_t t = 0; t < tets.size(); ++t) tets[t] = t;
+  AuditFindings findings;
+  audit_binning(index, input_pieces({input}), tets, findings);
+  EXPECT_EQ(findings.tets_checked, mesh.tet_count());
+  EXPECT_EQ(findings.mismatches, 0u) << index_path;
+  for (std::size_t p = 0; p < std::min<std::size_t>(findings.problems.size(), 4); ++p)
+    ADD_FAILURE() << findings.problems[p];
 
-  std::vector<BoundingBox> triangle_boxes(soup.triangle_count());
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
-    for (const auto& p : soup.corners(t)) triangle_boxes[t].extend(p);
-
-  std::uint64_t stored = 0, mismatched_tets = 0;
-  for (std::uint32_t tet = 0; tet < mesh.tet_count(); ++tet) {
-    const auto corners = mesh.corners(tet);
-    const BoundingBox tet_box = mesh.bounds(tet);
-    const Epeck::Tetrahedron_3 tetrahedron(to_epeck(corners[0]), to_epeck(corners[1]), to_epeck(corners[2]),
-                                           to_epeck(corners[3]));
-    std::set<std::uint64_t> expected;
-    for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
-      const auto& b = triangle_boxes[t];
-      if (b.lo[0] > tet_box.hi[0] || b.hi[0] < tet_box.lo[0] || b.lo[1] > tet_box.hi[1] ||
-          b.hi[1] < tet_box.lo[1] || b.lo[2] > tet_box.hi[2] || b.hi[2] < tet_box.lo[2])
-        continue;
-      const auto c = soup.corners(t);
-      if (CGAL::do_intersect(Epeck::Triangle_3(to_epeck(c[0]), to_epeck(c[1]), to_epeck(c[2])), tetrahedron))
-        expected.insert(t);
-    }
-    std::set<std::uint64_t> got;
-    if (tet_shard[tet] != TetMesh::no_neighbour) {
-      const Shard shard = Shard::decode(index.read_shard(tet_shard[tet]));
-      for (std::uint32_t local = 0; local < shard.triangle_count(); ++local) {
-        const std::uint64_t id = shard.triangle_id(local);
-        got.insert(id);
-        ASSERT_LT(id, soup.triangle_count());
-        EXPECT_EQ(shard.part_id(local), soup.part_of.empty() ? 0u : soup.part_of[id]);
-        // Stored vertices: the same triangle up to the recorded rounding (as a set of
-        // corners: a shard may start a triangle at another corner).
-        const auto input_corners = soup.corners(id);
-        const auto stored_triangle = shard.triangle(local);
-        for (const auto& p : stored_triangle) {
-          double best = 1e300;
-          for (const auto& q : input_corners)
-            best = std::min(best, std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]));
-          EXPECT_LE(best, rounding * (1 + 1e-12)) << "tet " << tet << " triangle " << id;  // hypot vs sqrt: an ulp
-        }
+  std::uint64_t stored = 0;
+  for (std::uint32_t s = 0; s < index.shard_count(); ++s) {
+    const Shard shard = Shard::decode(index.read_shard(s));
+    for (std::uint32_t local = 0; local < shard.triangle_count(); ++local) {
+      const std::uint64_t id = shard.triangle_id(local);
+      ASSERT_LT(id, soup.triangle_count());
+      EXPECT_EQ(shard.part_id(local), soup.part_of.empty() ? 0u : soup.part_of[id]);
+      // Stored vertices: the same triangle up to the recorded rounding (as a set of corners: a
+      // shard may start a triangle at another corner).
+      const auto input_corners = soup.corners(id);
+      for (const auto& p : shard.triangle(local)) {
+        double best = 1e300;
+        for (const auto& q : input_corners)
+          best = std::min(best, std::hypot(p[0] - q[0], p[1] - q[1], p[2] - q[2]));
+        EXPECT_LE(best, rounding * (1 + 1e-12)) << "shard " << s << " triangle " << id;  // hypot vs sqrt: an ulp
       }
-      stored += shard.triangle_count();
     }
-    if (got != expected) ++mismatched_tets;
-    EXPECT_EQ(got, expected) << "tet " << tet << " of " << index_path;
-    if (mismatched_tets > 3) break;
+    stored += shard.triangle_count();
   }
   EXPECT_EQ(stored, index.header().stored_triangles);
 }

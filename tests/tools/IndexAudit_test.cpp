@@ -60,7 +60,7 @@ TEST(IndexAudit, AGoodIndexPassesInFull) {
   const TetMesh mesh = reader.read_mesh();
   ASSERT_GT(mesh.tet_count(), 30u);
   AuditFindings findings;
-  audit_binning(reader, {indexed().scene}, all_below(std::uint32_t(mesh.tet_count())), findings);
+  audit_binning(reader, input_pieces({indexed().scene}), all_below(std::uint32_t(mesh.tet_count())), findings);
   audit_shard_queries(reader, all_below(reader.shard_count()), 24, 3, findings);
   EXPECT_EQ(findings.mismatches, 0u);
   for (const auto& p : findings.problems) ADD_FAILURE() << p;
@@ -86,12 +86,12 @@ TEST(IndexAudit, ATetThatLostATriangleAndAForeignModelAreFound) {
   };
   const auto tets = all_below(std::uint32_t(mesh.tet_count()));
   AuditFindings findings;
-  audit_binning(mesh, tets, stored, reader.header().input_triangles, {indexed().scene}, findings);
+  audit_binning(mesh, tets, stored, reader.header().input_triangles, input_pieces({indexed().scene}), findings);
   ASSERT_EQ(findings.mismatches, 1u);
   EXPECT_EQ(findings.problems.at(0).rfind("tet " + std::to_string(victim) + " holds ", 0), 0u) << findings.problems[0];
 
   AuditFindings foreign;
-  audit_binning(mesh, tets, stored, reader.header().input_triangles + 1, {indexed().scene}, foreign);
+  audit_binning(mesh, tets, stored, reader.header().input_triangles + 1, input_pieces({indexed().scene}), foreign);
   ASSERT_GE(foreign.problems.size(), 1u);
   EXPECT_NE(foreign.problems[0].find("not its model"), std::string::npos) << foreign.problems[0];
 }

@@ -251,14 +251,10 @@ struct ValidateArguments {
   std::uint64_t seed = 1;
 };
 
-// `count` distinct values below `n` (all of them when count >= n), sorted.
+// `count` distinct values below `n` (all of them when count >= n or `all`), sorted.
 std::vector<std::uint32_t> sample_below(std::uint32_t n, std::uint32_t count, bool all, std::uint64_t seed) {
-  std::vector<std::uint32_t> chosen(n);
-  for (std::uint32_t i = 0; i < n; ++i) chosen[i] = i;
-  if (all || count >= n) return chosen;
   Random random(seed);
-  for (std::uint32_t i = 0; i < count; ++i) std::swap(chosen[i], chosen[i + random.below(n - i)]);
-  chosen.resize(count);
+  std::vector<std::uint32_t> chosen = random_subset(n, all ? n : std::min(count, n), random);
   std::sort(chosen.begin(), chosen.end());
   return chosen;
 }
@@ -271,7 +267,7 @@ void run_validate(const ValidateArguments& args) {
     throw FormatError(args.index.string() + ": invalid index (" + std::to_string(problems.size()) + " problems)");
   // Against brute force: a sample of tets against the model, a sample of shards against random
   // boxes (everything with --full).
-  const std::uint32_t tet_count = reader.read_mesh().tet_count();
+  const auto tet_count = std::uint32_t(reader.header().region_count);
   AuditFindings findings;
   {
     const auto shards = sample_below(reader.shard_count(), args.sample, args.full, args.seed + 1);
@@ -286,8 +282,9 @@ void run_validate(const ValidateArguments& args) {
   const bool check_model = missing.empty() || !args.inputs.empty() || args.full;
   if (check_model) {
     const auto tets = sample_below(tet_count, args.sample, args.full, args.seed);
-    Progress progress("checking tets against the model", input_pieces(inputs).size(), true);
-    audit_binning(reader, inputs, tets, findings, progress);
+    const std::vector<InputPiece> model = input_pieces(inputs);
+    Progress progress("checking tets against the model", model.size(), true);
+    audit_binning(reader, model, tets, findings, progress);
     progress.finish();
   }
   for (const auto& p : findings.problems) std::printf("problem: %s\n", p.c_str());

@@ -12,6 +12,7 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {
@@ -20,12 +21,6 @@ namespace {
 using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
 
 Epeck::Point_3 to_epeck(const Vec3& p) { return {p[0], p[1], p[2]}; }
-
-bool overlap(const BoundingBox& a, const BoundingBox& b) {
-  for (int k = 0; k < 3; ++k)
-    if (a.lo[k] > b.hi[k] || b.lo[k] > a.hi[k]) return false;
-  return true;
-}
 
 // A set of ids as (count, sum and xor of a mix of each id): equal sets give equal digests, and
 // unequal ones collide with probability about 2^-64.
@@ -53,7 +48,7 @@ struct IdDigest {
 class TetGrid {
  public:
   TetGrid(const TetMesh& mesh, std::span<const std::uint32_t> tets) {
-    for (const std::uint32_t t : tets) bounds_.extend(mesh.bounds(t).lo), bounds_.extend(mesh.bounds(t).hi);
+    for (const std::uint32_t t : tets) bounds_.extend(mesh.bounds(t));
     const auto side = std::uint32_t(std::clamp(std::cbrt(double(tets.size())), 1.0, 128.0));
     cells_ = {side, side, side};
     for (int k = 0; k < 3; ++k) size_[k] = std::max(bounds_.hi[k] - bounds_.lo[k], 1e-300) / side;
@@ -77,7 +72,7 @@ class TetGrid {
   template <class Visit>
   void for_each_near(const BoundingBox& box, Visit&& visit) const {
     for (const std::uint32_t i : everywhere_) visit(i);
-    if (!overlap(box, bounds_)) return;
+    if (!geometry::boxes_overlap(box, bounds_)) return;
     const auto [lo, hi] = range(box);
     for (std::uint32_t z = lo[2]; z <= hi[2]; ++z)
       for (std::uint32_t y = lo[1]; y <= hi[1]; ++y)
@@ -125,7 +120,7 @@ void AuditFindings::add(std::string problem) {
 }
 
 void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, const StoredIds& stored_ids,
-                   std::uint64_t input_triangles, const std::vector<std::filesystem::path>& inputs,
+                   std::uint64_t input_triangles, std::span<const InputPiece> model,
                    AuditFindings& findings, Progress& progress) {
   for (const std::uint32_t t : tets)
     if (t >= mesh.tet_count())
@@ -143,9 +138,8 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
   const TetGrid grid(mesh, tets);
 
   // The model, one piece at a time, with ids counted as preprocess counts them (input order).
-  const std::vector<InputPiece> pieces = input_pieces(inputs);
   std::uint64_t first_id = 0;
-  for (const InputPiece& piece : pieces) {
+  for (const InputPiece& piece : model) {
     const TriangleSoup soup = load_input_piece(piece);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, soup.triangle_count(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& range) {
@@ -161,7 +155,7 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
                           if (near.empty()) continue;
                           const Epeck::Triangle_3 triangle(to_epeck(c[0]), to_epeck(c[1]), to_epeck(c[2]));
                           for (const std::uint32_t i : near)
-                            if (overlap(box, boxes[i]) && CGAL::do_intersect(triangle, solids[i]))
+                            if (geometry::boxes_overlap(box, boxes[i]) && CGAL::do_intersect(triangle, solids[i]))
                               expected[i].add(first_id + t);
                         }
                       });
@@ -184,7 +178,7 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
   }
 }
 
-void audit_binning(const IndexReader& index, const std::vector<std::filesystem::path>& inputs,
+void audit_binning(const IndexReader& index, std::span<const InputPiece> model,
                    std::span<const std::uint32_t> tets, AuditFindings& findings, Progress& progress) {
   const TetMesh mesh = index.read_mesh();
   const auto tet_shard = index.read_table_uint32("tet_shard");
@@ -196,7 +190,7 @@ void audit_binning(const IndexReader& index, const std::vector<std::filesystem::
     for (std::uint32_t local = 0; local < decoded.triangle_count(); ++local) ids.push_back(decoded.triangle_id(local));
     return ids;
   };
-  audit_binning(mesh, tets, stored, index.header().input_triangles, inputs, findings, progress);
+  audit_binning(mesh, tets, stored, index.header().input_triangles, model, findings, progress);
 }
 
 void audit_shard_queries(const Shard& shard, const std::string& label, std::uint32_t boxes,
@@ -224,10 +218,9 @@ void audit_shard_queries(const Shard& shard, const std::string& label, std::uint
     shard.for_each_candidate(box, [&](std::uint32_t local) { got.push_back(local); });
     std::sort(got.begin(), got.end());
     expected.clear();
-    const BoundingBox query{box.lo, box.hi};
     const Epeck::Iso_cuboid_3 cuboid(to_epeck(box.lo), to_epeck(box.hi));
     for (std::uint32_t local = 0; local < n; ++local) {
-      if (!overlap(query, triangle_boxes[local])) continue;
+      if (!geometry::boxes_overlap(box, triangle_boxes[local])) continue;
       const auto& t = triangles[local];
       if (CGAL::do_intersect(Epeck::Triangle_3(to_epeck(t[0]), to_epeck(t[1]), to_epeck(t[2])), cuboid))
         expected.push_back(local);

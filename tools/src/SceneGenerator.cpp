@@ -21,19 +21,6 @@ std::array<double, 4> random_rotation(Random& random) {
   }
 }
 
-// Random choice of `count` distinct indices among [0, total), in draw order (partial
-// Fisher-Yates: one uniform draw per pick, no rejection).
-std::vector<std::uint32_t> random_subset(std::size_t total, std::size_t count, Random& random) {
-  std::vector<std::uint32_t> indices(total);
-  std::iota(indices.begin(), indices.end(), 0u);
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t j = i + random.below(total - i);
-    std::swap(indices[i], indices[j]);
-  }
-  indices.resize(count);
-  return indices;
-}
-
 void check_options(const SceneOptions& options) {
   if (options.triangles == 0 || options.triangles > max_scene_triangles)
     throw InputError("scene: --triangles " + std::to_string(options.triangles) +

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/runtime/Shard.h"
 
@@ -36,17 +37,17 @@ std::vector<std::filesystem::path> source_inputs(const IndexHeader& header);
 /// The model-wide ids of the triangles a tet holds.
 using StoredIds = std::function<std::vector<std::uint64_t>(std::uint32_t tet)>;
 
-/// Streams the model (`inputs`, the files the index was built from, in the same order, one
-/// piece at a time) and checks that each tet in `tets` holds exactly the triangles that meet
+/// Streams the model (the pieces of the files the index was built from, in the same order,
+/// one at a time: input_pieces in Manifest.h) and checks that each tet in `tets` holds exactly the triangles that meet
 /// its closed region, by model-wide id (the input order), and that the model has
 /// `input_triangles` triangles.
 /// @throw as load_input_piece for an unreadable input.
 void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, const StoredIds& stored,
-                   std::uint64_t input_triangles, const std::vector<std::filesystem::path>& inputs,
+                   std::uint64_t input_triangles, std::span<const InputPiece> model,
                    AuditFindings& findings, Progress& progress = Progress::silent());
 
 /// The same for an index's tets and shards.
-void audit_binning(const IndexReader& index, const std::vector<std::filesystem::path>& inputs,
+void audit_binning(const IndexReader& index, std::span<const InputPiece> model,
                    std::span<const std::uint32_t> tets, AuditFindings& findings,
                    Progress& progress = Progress::silent());
 

@@ -7,6 +7,9 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <numeric>
+#include <utility>
+#include <vector>
 
 namespace tetrapage {
 
@@ -55,5 +58,18 @@ class Random {
   }
   std::uint64_t state_[4];
 };
+
+/// `count` distinct indices among [0, total), in draw order (partial Fisher-Yates: one uniform
+/// draw per pick, no rejection). Precondition: count <= total.
+inline std::vector<std::uint32_t> random_subset(std::size_t total, std::size_t count, Random& random) {
+  std::vector<std::uint32_t> indices(total);
+  std::iota(indices.begin(), indices.end(), 0u);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::size_t j = i + random.below(total - i);
+    std::swap(indices[i], indices[j]);
+  }
+  indices.resize(count);
+  return indices;
+}
 
 }  // namespace tetrapage
