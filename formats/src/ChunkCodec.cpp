@@ -57,10 +57,50 @@ std::uint32_t fletcher32(std::span<const std::byte> data) {
   return (sum2 << 16) | sum1;
 }
 
+namespace {
+
+// 8 elements of 8 bytes at once: an 8 x 8 byte transpose in registers (row j = element j;
+// column k = its byte k, little endian), so that each plane gets one 8-byte store.
+void transpose8x8(const std::byte* in, std::size_t in_stride, std::byte* out, std::size_t out_stride) {
+  std::uint64_t row[8];
+  for (int j = 0; j < 8; ++j) std::memcpy(&row[j], in + std::size_t(j) * in_stride, 8);
+  for (int k = 0; k < 8; ++k) {
+    std::uint64_t column = 0;
+    for (int j = 0; j < 8; ++j) column |= ((row[j] >> (8 * k)) & 0xffu) << (8 * j);
+    std::memcpy(out + std::size_t(k) * out_stride, &column, 8);
+  }
+}
+
+}  // namespace
+
+void shuffle_bytes(std::span<const std::byte> in, std::span<std::byte> out) {
+  const std::size_t n = in.size() / kShuffleElementBytes;
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) transpose8x8(in.data() + 8 * i, 8, out.data() + i, n);
+  for (; i < n; ++i)
+    for (std::size_t k = 0; k < 8; ++k) out[k * n + i] = in[8 * i + k];
+}
+
+void unshuffle_bytes(std::span<const std::byte> in, std::span<std::byte> out) {
+  const std::size_t n = in.size() / kShuffleElementBytes;
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) transpose8x8(in.data() + i, n, out.data() + 8 * i, 8);
+  for (; i < n; ++i)
+    for (std::size_t k = 0; k < 8; ++k) out[8 * i + k] = in[k * n + i];
+}
+
 void encode_chunk(std::span<const std::byte> chunk, int level, EncodedChunk& out) {
   if (level < 0 || level > 9)
     throw InputError("cannot deflate a chunk at level " + std::to_string(level) +
                      " (levels are 0 to 9)");
+  if (chunk.size() % kShuffleElementBytes != 0)
+    throw InputError("cannot shuffle a chunk of " + std::to_string(chunk.size()) +
+                     " bytes: not whole 8-byte elements");
+  // Byte planes: the high bytes of coordinates and indices repeat and the noisy low ones stay
+  // together, so that level 1 compresses about as well as level 4 on the bytes as they are.
+  thread_local std::vector<std::byte> shuffled;
+  shuffled.resize(chunk.size());
+  shuffle_bytes(chunk, shuffled);
   // libdeflate writes the same zlib format as zlib's compress2, about twice as fast and a
   // little smaller at a given level; one compressor per thread and level, as shards are
   // compressed in parallel.
@@ -75,14 +115,14 @@ void encode_chunk(std::span<const std::byte> chunk, int level, EncodedChunk& out
   out.bytes.resize(std::max(bound, chunk.size()) + kChecksumBytes);
   // 0: the stream would not fit in `bound`, which libdeflate promises never happens.
   const std::size_t compressed_bytes = libdeflate_zlib_compress(
-      compressor.get(), chunk.data(), chunk.size(), out.bytes.data(), bound);
+      compressor.get(), shuffled.data(), shuffled.size(), out.bytes.data(), bound);
   std::size_t filtered_bytes = compressed_bytes;
   out.filter_mask = 0;
   if (compressed_bytes == 0 || compressed_bytes >= chunk.size()) {
-    // Deflate is optional in the pipeline: HDF5 readers honour the mask bit.
+    // Both filters are optional in the pipeline: HDF5 readers honour the mask bits.
     std::memcpy(out.bytes.data(), chunk.data(), chunk.size());
     filtered_bytes = chunk.size();
-    out.filter_mask = kDeflateSkipped;
+    out.filter_mask = kShuffleSkipped | kDeflateSkipped;
   }
   const std::uint32_t checksum = fletcher32({out.bytes.data(), filtered_bytes});
   store_le32(out.bytes.data() + filtered_bytes, checksum);
@@ -106,11 +146,21 @@ std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter
                   expected, actual);
     return text;
   }
+  if (out.size() % kShuffleElementBytes != 0)
+    return "chunk of " + std::to_string(out.size()) + " bytes is not whole 8-byte elements";
+  const bool shuffled = (filter_mask & kShuffleSkipped) == 0;
+  thread_local std::vector<std::byte> planes;
+  std::span<std::byte> target = out;  // where the filtered bytes go before unshuffling
+  if (shuffled) {
+    planes.resize(out.size());
+    target = planes;
+  }
   if ((filter_mask & kDeflateSkipped) != 0) {
     if (filtered.size() != out.size())
       return "uncompressed chunk holds " + std::to_string(filtered.size()) + " bytes, expected " +
              std::to_string(out.size());
-    std::memcpy(out.data(), filtered.data(), out.size());
+    std::memcpy(target.data(), filtered.data(), out.size());
+    if (shuffled) unshuffle_bytes(target, out);
     return {};
   }
   // The Fletcher-32 above already covers the whole stream, so inflate it raw, past the 2-byte
@@ -133,13 +183,14 @@ std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter
   std::size_t inflated_bytes = 0;
   const libdeflate_result status = libdeflate_deflate_decompress(
       decompressor.get(), filtered.data() + kZlibHeader, filtered.size() - kZlibHeader - kAdlerTrailer,
-      out.data(), out.size(), &inflated_bytes);
+      target.data(), target.size(), &inflated_bytes);
   if (status == LIBDEFLATE_INSUFFICIENT_SPACE)
     return "chunk inflates to more than " + std::to_string(out.size()) + " bytes";
   if (status != LIBDEFLATE_SUCCESS) return "cannot inflate the chunk (corrupt or incomplete deflate data)";
   if (inflated_bytes != out.size())
     return "chunk inflates to " + std::to_string(inflated_bytes) + " bytes, expected " +
            std::to_string(out.size());
+  if (shuffled) unshuffle_bytes(target, out);
   return {};
 }
 

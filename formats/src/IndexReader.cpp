@@ -36,6 +36,8 @@ constexpr std::uint64_t kUnallocated = ~std::uint64_t{0};
 /// One pread() may span small holes between a shard's chunks (HDF5 metadata blocks can land
 /// between them) rather than splitting into one read per chunk.
 constexpr std::uint64_t kMaxHoleBytes = 64 * 1024;
+// /shards/data is stored as 8-byte little-endian words (the shuffle filter's element).
+constexpr std::uint64_t kWordBytes = 8;
 
 enum class Element { uint8, uint32, uint64, float64 };
 
@@ -301,17 +303,18 @@ struct IndexReader::Impl {
 
   void check_shard_data_layout() {
     const std::string name = "/shards/data";
-    data_extent = check_dataset(shard_data.get(), name, Element::uint8, 0);
+    // 8-byte words (the shuffle filter's element); extents and chunks are counted in bytes.
+    data_extent = check_dataset(shard_data.get(), name, Element::uint64, 0) * kWordBytes;
     PropertyListHandle creation(H5Dget_create_plist(shard_data.get()));
     if (!creation) hdf5_format_error("cannot inspect '" + name + "'");
     if (H5Pget_layout(creation.get()) != H5D_CHUNKED) format_error("'" + name + "' is not chunked");
     hsize_t chunk = 0;
-    if (H5Pget_chunk(creation.get(), 1, &chunk) != 1 || chunk == 0 || chunk > 0xffffffffu)
+    if (H5Pget_chunk(creation.get(), 1, &chunk) != 1 || chunk == 0 || chunk > 0xffffffffu / kWordBytes)
       format_error("'" + name + "' has an unusable chunk shape");
-    chunk_bytes = static_cast<std::uint32_t>(chunk);
+    chunk_bytes = static_cast<std::uint32_t>(chunk * kWordBytes);
     const int filters = H5Pget_nfilters(creation.get());
-    std::array<H5Z_filter_t, 2> expected{H5Z_FILTER_DEFLATE, H5Z_FILTER_FLETCHER32};
-    bool pipeline_ok = filters == 2;
+    std::array<H5Z_filter_t, 3> expected{H5Z_FILTER_SHUFFLE, H5Z_FILTER_DEFLATE, H5Z_FILTER_FLETCHER32};
+    bool pipeline_ok = filters == 3;
     std::string found;
     for (int f = 0; f < filters; ++f) {
       unsigned flags = 0;
@@ -319,12 +322,12 @@ struct IndexReader::Impl {
       const H5Z_filter_t filter = H5Pget_filter2(creation.get(), static_cast<unsigned>(f), &flags,
                                                  &values, nullptr, 0, nullptr, nullptr);
       found += (f == 0 ? "" : ", ") + std::to_string(filter);
-      if (f < 2 && filter != expected[static_cast<std::size_t>(f)]) pipeline_ok = false;
+      if (f < 3 && filter != expected[static_cast<std::size_t>(f)]) pipeline_ok = false;
     }
     if (!pipeline_ok)
       format_error("'" + name + "' has filters [" + found + "], expected [" +
-                   std::to_string(H5Z_FILTER_DEFLATE) + ", " +
-                   std::to_string(H5Z_FILTER_FLETCHER32) + "] (deflate, fletcher32)");
+                   std::to_string(H5Z_FILTER_SHUFFLE) + ", " + std::to_string(H5Z_FILTER_DEFLATE) + ", " +
+                   std::to_string(H5Z_FILTER_FLETCHER32) + "] (shuffle, deflate, fletcher32)");
   }
 
   std::vector<std::string> extent_problems() const {
@@ -362,7 +365,7 @@ struct IndexReader::Impl {
     // By coordinate, not H5Dget_chunk_info(index): the latter walks the index from the start
     // on every call (quadratic), a B-tree lookup is logarithmic.
     for (std::uint64_t c = 0; c < count; ++c) {
-      hsize_t coordinate = c * chunk_bytes;
+      hsize_t coordinate = c * chunk_bytes / kWordBytes;
       unsigned mask = 0;
       haddr_t address = HADDR_UNDEF;
       hsize_t stored = 0;
@@ -400,7 +403,7 @@ struct IndexReader::Impl {
   /// The stored bytes of one chunk and its filter mask, through HDF5's direct chunk read.
   std::vector<std::byte> read_stored_chunk(std::uint32_t shard, std::uint64_t k,
                                            std::uint32_t& mask) const {
-    hsize_t coordinate = (first_chunk(shard) + k) * chunk_bytes;
+    hsize_t coordinate = (first_chunk(shard) + k) * chunk_bytes / kWordBytes;
     hsize_t stored_bytes = 0;
     if (H5Dget_chunk_storage_size(shard_data.get(), &coordinate, &stored_bytes) < 0)
       hdf5_format_error("cannot locate " + chunk_name(shard, k));
@@ -663,7 +666,7 @@ std::uint64_t IndexReader::stored_shard_size(std::uint32_t shard) const {
   }
   // One chunk-index lookup per chunk, rather than locating every chunk of the file.
   for (std::uint64_t k = 0; k < r.chunk_count(shard); ++k) {
-    hsize_t coordinate = (r.first_chunk(shard) + k) * r.chunk_bytes;
+    hsize_t coordinate = (r.first_chunk(shard) + k) * r.chunk_bytes / kWordBytes;
     hsize_t stored = 0;
     if (H5Dget_chunk_storage_size(r.shard_data.get(), &coordinate, &stored) < 0)
       r.hdf5_format_error("cannot locate " + r.chunk_name(shard, k));
@@ -698,15 +701,19 @@ std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard)
   if (payload.empty()) return payload;
   const std::string what = "cannot read shard " + std::to_string(shard) + " through HDF5";
   DataspaceHandle file_space(H5Dget_space(r.shard_data.get()));
-  const hsize_t start = r.offsets[shard];
-  const hsize_t count = payload.size();
+  // The words that hold the payload (it starts on a chunk boundary, a whole word), read as
+  // little-endian words: the bytes as stored, on any machine.
+  const hsize_t start = r.offsets[shard] / kWordBytes;
+  const hsize_t count = (payload.size() + kWordBytes - 1) / kWordBytes;
   if (!file_space ||
       H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &start, nullptr, &count, nullptr) < 0)
     r.hdf5_format_error(what);
   DataspaceHandle memory_space(H5Screate_simple(1, &count, nullptr));
-  if (!memory_space || H5Dread(r.shard_data.get(), H5T_NATIVE_UINT8, memory_space.get(),
-                               file_space.get(), H5P_DEFAULT, payload.data()) < 0)
+  std::vector<std::byte> words(count * kWordBytes);
+  if (!memory_space || H5Dread(r.shard_data.get(), H5T_STD_U64LE, memory_space.get(),
+                               file_space.get(), H5P_DEFAULT, words.data()) < 0)
     r.hdf5_format_error(what);
+  std::memcpy(payload.data(), words.data(), payload.size());
   return payload;
 }
 

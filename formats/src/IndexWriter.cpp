@@ -31,6 +31,8 @@ namespace {
 
 constexpr std::uint32_t kMinChunkBytes = 1024;
 constexpr std::uint32_t kMaxChunkBytes = 64u << 20;
+// /shards/data is stored as 8-byte little-endian words (the shuffle filter's element).
+constexpr std::uint64_t kWordBytes = 8;
 /// Chunks of the mesh and table datasets hold about this many bytes.
 constexpr std::uint64_t kTableChunkBytes = 256 * 1024;
 
@@ -126,7 +128,7 @@ struct IndexWriter::Impl {
   /// A chunked, checksummed dataset whose first dimension may grow, deflated when `deflate`.
   DatasetHandle create_dataset(hid_t parent, const std::string& name, const std::string& what,
                                hid_t type, std::span<const hsize_t> dims,
-                               std::span<const hsize_t> chunk, bool deflate) {
+                               std::span<const hsize_t> chunk, bool deflate, bool shuffle = false) {
     std::array<hsize_t, 2> max_dims{H5S_UNLIMITED, 0};
     for (std::size_t d = 1; d < dims.size(); ++d) max_dims[d] = dims[d];
     DataspaceHandle space(check_id(
@@ -135,7 +137,8 @@ struct IndexWriter::Impl {
     PropertyListHandle creation(check_id(H5Pcreate(H5P_DATASET_CREATE), "properties of " + what));
     check(H5Pset_chunk(creation.get(), static_cast<int>(chunk.size()), chunk.data()),
           "the chunking of " + what);
-    // Order matters: deflate first, then the checksum over the compressed bytes.
+    // Order matters: shuffle, deflate, then the checksum over the compressed bytes.
+    if (shuffle) check(H5Pset_shuffle(creation.get()), "the shuffle filter of " + what);
     if (deflate)
       check(H5Pset_deflate(creation.get(), static_cast<unsigned>(options.deflate_level)),
             "the deflate filter of " + what);
@@ -219,10 +222,12 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   w.temporary = w.path;
   w.temporary += ".tmp-" + std::to_string(::getpid());
   w.options = options;
-  if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes)
+  if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes ||
+      options.chunk_bytes % kWordBytes != 0)
     throw InputError("index '" + w.path.string() + "': chunk size " +
                      std::to_string(options.chunk_bytes) + " bytes is outside [" +
-                     std::to_string(kMinChunkBytes) + ", " + std::to_string(kMaxChunkBytes) + "]");
+                     std::to_string(kMinChunkBytes) + ", " + std::to_string(kMaxChunkBytes) +
+                     "] or not a multiple of 8");
   if (options.deflate_level < 0 || options.deflate_level > 9)
     throw InputError("index '" + w.path.string() + "': deflate level " +
                      std::to_string(options.deflate_level) + " is outside [0, 9]");
@@ -243,9 +248,10 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   w.shards_group = GroupHandle(w.check_id(
       H5Gcreate2(file, "shards", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "group /shards"));
   const std::array<hsize_t, 1> empty{0};
-  const std::array<hsize_t, 1> chunk{options.chunk_bytes};
+  // 8-byte words, so that HDF5's shuffle filter puts byte k of every word together.
+  const std::array<hsize_t, 1> chunk{options.chunk_bytes / kWordBytes};
   w.shard_data = w.create_dataset(w.shards_group.get(), "data", "dataset /shards/data",
-                                  H5T_STD_U8LE, empty, chunk, true);
+                                  H5T_STD_U64LE, empty, chunk, true, true);
 }
 
 IndexWriter::~IndexWriter() = default;
@@ -309,8 +315,8 @@ void IndexWriter::write_table(std::string_view name, std::span<const double> val
 }
 
 EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterOptions& options) {
-  if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes || options.deflate_level < 0 ||
-      options.deflate_level > 9)
+  if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes ||
+      options.chunk_bytes % kWordBytes != 0 || options.deflate_level < 0 || options.deflate_level > 9)
     throw InputError("encode_shard: chunk size " + std::to_string(options.chunk_bytes) + " or deflate level " +
                      std::to_string(options.deflate_level) + " out of range");
   EncodedShard shard;
@@ -356,13 +362,14 @@ std::uint32_t IndexWriter::append_encoded_shard(const EncodedShard& encoded) {
   const std::uint64_t offset = w.data_extent;
   if (chunks > 0) {
     const std::string what = "shard " + std::to_string(shard);
-    hsize_t extent = w.data_extent + chunks * chunk_bytes;
-    w.check(H5Dset_extent(w.shard_data.get(), &extent), "the extent of /shards/data for " + what);
+    const std::uint64_t extent = w.data_extent + chunks * chunk_bytes;
+    hsize_t extent_words = extent / kWordBytes;
+    w.check(H5Dset_extent(w.shard_data.get(), &extent_words), "the extent of /shards/data for " + what);
     for (std::uint64_t k = 0; k < chunks; ++k) {
-      const hsize_t chunk_offset = offset + k * chunk_bytes;
+      const hsize_t chunk_offset = (offset + k * chunk_bytes) / kWordBytes;
       w.check(H5Dwrite_chunk(w.shard_data.get(), H5P_DEFAULT, encoded.filter_masks[k], &chunk_offset,
                              encoded.chunks[k].size(), encoded.chunks[k].data()),
-              "chunk " + std::to_string(chunk_offset / chunk_bytes) + " of /shards/data (" + what + ")");
+              "chunk " + std::to_string((offset + k * chunk_bytes) / chunk_bytes) + " of /shards/data (" + what + ")");
       w.stored_bytes += encoded.chunks[k].size();
     }
     w.data_extent = extent;
