@@ -67,7 +67,8 @@ enum class GridTrials : std::uint8_t { always, when_they_can_win };
 
 /// Estimates, for `region` queried by cubes of side query_extent centred on sampled triangles,
 /// each kind's cost: it builds the candidate layouts (grids of 1/4, 1 and 4 cells per
-/// triangle; R-tree leaves of 16, 8 and 4, the smaller only while they are cheaper), runs the
+/// triangle; R-tree leaves of 16, 8 and 4, the smaller only while they are cheaper and only in
+/// regions of at most 1,024 triangles), runs the
 /// sampled queries and counts.
 /// @throw InputError as build_shard, or if query_extent is negative or not finite.
 ShardCostReport estimate_shard_costs(const ShardTriangles& region, double query_extent,
