@@ -103,8 +103,38 @@ std::filesystem::path spill_path(const std::filesystem::path& folder, const std:
 }
 
 // The binned copies of one bucket: records in a spill file or, while the ingested soups are
-// held in memory, only (id, tet) pairs, 12 bytes instead of 88, made records again from the
-// soups when read.
+// held in memory, only (id, tet) pairs, 12 bytes instead of 88.
+#pragma pack(push, 4)
+struct CopyPair {
+  std::uint64_t id;
+  std::uint32_t tet;
+};
+#pragma pack(pop)
+
+// One bucket's copies as the shard stage reads them: records read back from a spill file, or
+// (id, tet) pairs whose records the soups give when a shard gathers its triangles (a bucket's
+// records, 88 bytes a copy, are then never all held: at 10M they were 1.1 GB).
+class BucketCopies {
+ public:
+  explicit BucketCopies(std::vector<TriangleRecord> records) : records_(std::move(records)) {}
+  BucketCopies(std::vector<CopyPair> pairs, const SoupSpill<TriangleRecord>& soups)
+      : soups_(&soups), pairs_(std::move(pairs)) {}
+  std::size_t size() const { return soups_ ? pairs_.size() : records_.size(); }
+  std::uint32_t tet(std::size_t i) const { return soups_ ? pairs_[i].tet : records_[i].tet; }
+  std::uint64_t id(std::size_t i) const { return soups_ ? pairs_[i].id : records_[i].id; }
+  TriangleRecord record(std::size_t i) const {
+    if (!soups_) return records_[i];
+    TriangleRecord record = soups_->record(pairs_[i].id);
+    record.tet = pairs_[i].tet;
+    return record;
+  }
+
+ private:
+  const SoupSpill<TriangleRecord>* soups_ = nullptr;
+  std::vector<TriangleRecord> records_;
+  std::vector<CopyPair> pairs_;
+};
+
 class CopyBucket {
  public:
   CopyBucket(std::filesystem::path file, const SoupSpill<TriangleRecord>& soups)
@@ -115,33 +145,21 @@ class CopyBucket {
     if (records_) return records_->append(copies);
     for (const TriangleRecord& copy : copies) pairs_.push_back({copy.id, copy.tet});
   }
-  std::vector<TriangleRecord> read_all() {
-    if (records_) return records_->read_all();
-    std::vector<TriangleRecord> records(pairs_.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs_.size(), 4096),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                          records[i] = soups_->record(pairs_[i].id);
-                          records[i].tet = pairs_[i].tet;
-                        }
-                      });
-    return records;
+  /// The copies, taken out of the bucket (which is then empty).
+  BucketCopies take() {
+    BucketCopies copies = records_ ? BucketCopies(records_->read_all()) : BucketCopies(std::move(pairs_), *soups_);
+    clear();
+    return copies;
   }
   void clear() {
     records_.reset();  // removes the file
-    std::vector<Pair>().swap(pairs_);
+    std::vector<CopyPair>().swap(pairs_);
   }
 
  private:
-#pragma pack(push, 4)
-  struct Pair {
-    std::uint64_t id;
-    std::uint32_t tet;
-  };
-#pragma pack(pop)
   const SoupSpill<TriangleRecord>* soups_;
   std::optional<RecordSpill<TriangleRecord>> records_;  ///< when the soups are spilled
-  std::vector<Pair> pairs_;
+  std::vector<CopyPair> pairs_;
 };
 
 // Ingest: every part file read once, instances placed, soups kept compactly (SoupSpill); a
@@ -606,33 +624,32 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     const ShardCostModel cost_model;
     Progress progress("building shards", tet_count, options.progress);
     for (auto& bucket : buckets) {
-      const std::vector<TriangleRecord> records = bucket.read_all();
-      bucket.clear();
-      // The records in (tet rank, id) order, as indices: a counting sort by rank (the records,
-      // 88 bytes each, stay where they are), then each tet's own by id, in parallel.
-      if (records.size() >= std::numeric_limits<std::uint32_t>::max())
-        throw InputError("a bucket of " + std::to_string(records.size()) +
+      const BucketCopies copies = bucket.take();
+      // The copies in (tet rank, id) order, as indices: a counting sort by rank, then each
+      // tet's own by id, in parallel.
+      if (copies.size() >= std::numeric_limits<std::uint32_t>::max())
+        throw InputError("a bucket of " + std::to_string(copies.size()) +
                          " triangle copies is beyond 2^32: give a smaller --memory, for more buckets");
-      std::vector<std::uint32_t> sorted(records.size());
+      std::vector<std::uint32_t> sorted(copies.size());
       std::vector<std::size_t> group_start;
-      if (!records.empty()) {
+      if (copies.size() > 0) {
         std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
-        for (const TriangleRecord& r : records) {
-          lowest = std::min(lowest, rank[r.tet]);
-          highest = std::max(highest, rank[r.tet]);
+        for (std::size_t i = 0; i < copies.size(); ++i) {
+          lowest = std::min(lowest, rank[copies.tet(i)]);
+          highest = std::max(highest, rank[copies.tet(i)]);
         }
         std::vector<std::size_t> next(std::size_t(highest - lowest) + 2, 0);
-        for (const TriangleRecord& r : records) ++next[rank[r.tet] - lowest + 1];
+        for (std::size_t i = 0; i < copies.size(); ++i) ++next[rank[copies.tet(i)] - lowest + 1];
         std::partial_sum(next.begin(), next.end(), next.begin());
         for (std::size_t k = 0; k + 1 < next.size(); ++k)
           if (next[k + 1] > next[k]) group_start.push_back(next[k]);
-        for (std::size_t i = 0; i < records.size(); ++i) sorted[next[rank[records[i].tet] - lowest]++] = std::uint32_t(i);
+        for (std::size_t i = 0; i < copies.size(); ++i) sorted[next[rank[copies.tet(i)] - lowest]++] = std::uint32_t(i);
       }
       const std::size_t groups = group_start.size();
-      group_start.push_back(records.size());
+      group_start.push_back(copies.size());
       tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
         std::sort(sorted.begin() + std::ptrdiff_t(group_start[g]), sorted.begin() + std::ptrdiff_t(group_start[g + 1]),
-                  [&](std::uint32_t a, std::uint32_t b) { return records[a].id < records[b].id; });
+                  [&](std::uint32_t a, std::uint32_t b) { return copies.id(a) < copies.id(b); });
       });
       // Built and compressed on all threads, appended in order on one while the others build
       // on: a pipeline with a few shards in flight (the bucket's shards are never all held).
@@ -663,13 +680,13 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                     ids.reserve(last - first);
                     parts.reserve(last - first);
                     for (std::size_t i = first; i < last; ++i) {
-                      const TriangleRecord& record = records[sorted[i]];
+                      const TriangleRecord record = copies.record(sorted[i]);
                       triangles.push_back(record.triangle);
                       ids.push_back(record.id);
                       parts.push_back(record.part);
                       for (const auto& p : record.triangle) ready->bounds.extend(p);
                     }
-                    ready->tet = records[sorted[first]].tet;
+                    ready->tet = copies.tet(sorted[first]);
                     const ShardTriangles region{triangles, ids, parts};
                     if (options.shard == ShardChoice::automatic) {
                       ShardCostReport costs =
