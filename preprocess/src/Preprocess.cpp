@@ -580,11 +580,23 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     const std::size_t block_records =
         std::max<std::size_t>(1024, options.memory_bytes / 12 / sizeof(TriangleRecord));
     Progress progress("binning triangles", triangle_count, options.progress);
+    // A block's triangles are binned in the Morton order of their centroids: consecutive ones
+    // then mostly share a tet, where each point location starts (in input order half of them
+    // needed a walk, of 5.6 tets on average, at 10M).
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> binning_order;
     in.soups.for_each_block(block_records, [&](std::span<const TriangleRecord> block) {
+      binning_order.resize(block.size());
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 4096),
+                        [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t i = range.begin(); i < range.end(); ++i)
+                            binning_order[i] = {morton_code(centroid(block[i].triangle), in.bounds), std::uint32_t(i)};
+                        });
+      tbb::parallel_sort(binning_order.begin(), binning_order.end());
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 256),
                         [&](const tbb::blocked_range<std::size_t>& range) {
                           ThreadState& s = states.local();
-                          for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                          for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                            const std::size_t i = binning_order[k].second;
                             s.tets.clear();
                             bin_triangle(mesh, block[i].triangle, s.scratch, s.tets);
                             for (const std::uint32_t t : s.tets) {
