@@ -11,6 +11,7 @@
 /// One FlyingObject is used from one thread at a time; many may share a CollisionIndex.
 
 #include <array>
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -154,7 +155,9 @@ class FlyingObject {
   void release_region();
   const Vec3& world_vertex(std::uint32_t v);
   // Containment checks of a step whose surfaces do not touch.
-  void check_containment(const geometry::Box& box, QueryResult& result);
+  // `start`: now, for its clock.
+  void check_containment(const geometry::Box& box, QueryResult& result,
+                         std::chrono::steady_clock::time_point start);
   // Does the placed object hold p? By the parity of crossings (the interior grid could not
   // tell): p must not lie on the object's surface.
   bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box);
