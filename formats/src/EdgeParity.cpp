@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <utility>
 
 namespace tetrapage {
 namespace {
@@ -16,33 +17,34 @@ std::uint64_t mix(std::uint64_t x) {
   return x;
 }
 
-std::array<std::uint64_t, 3> bits_of(const Vec3& p) {
-  std::array<std::uint64_t, 3> bits{};
-  for (int a = 0; a < 3; ++a) bits[a] = std::bit_cast<std::uint64_t>(p[a] == 0.0 ? 0.0 : p[a]);
-  return bits;
-}
-
-// A 128-bit hash of an unordered pair of positions: the pair is ordered first, then its six
-// words are chained through two differently seeded lanes.
-std::array<std::uint64_t, 2> edge_hash(const Vec3& p, const Vec3& q) {
-  auto a = bits_of(p), b = bits_of(q);
-  if (b < a) std::swap(a, b);
-  std::array<std::uint64_t, 2> lane{0x243f6a8885a308d3ULL, 0x13198a2e03707344ULL};
-  for (const auto* words : {&a, &b})
-    for (const std::uint64_t w : *words) {
-      lane[0] = mix(lane[0] ^ w);
-      lane[1] = mix(lane[1] + (w ^ 0xa4093822299f31d0ULL));
-    }
-  return lane;
+// A 128-bit hash of an unordered pair of positions from their hashes: the pair is ordered
+// first, then each lane chains the two vertices' words of that lane.
+std::array<std::uint64_t, 2> edge_hash(const EdgeParity::VertexHash& p, const EdgeParity::VertexHash& q) {
+  const auto& [a, b] = q < p ? std::pair(q, p) : std::pair(p, q);
+  return {mix(mix(a[0] ^ 0x243f6a8885a308d3ULL) ^ b[0]), mix(mix(a[1] + 0x13198a2e03707344ULL) + b[1])};
 }
 
 }  // namespace
 
-void EdgeParity::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+EdgeParity::VertexHash EdgeParity::hash_vertex(const Vec3& p) {
+  VertexHash lane{0xa4093822299f31d0ULL, 0x082efa98ec4e6c89ULL};
+  for (int a = 0; a < 3; ++a) {
+    const std::uint64_t w = std::bit_cast<std::uint64_t>(p[a] == 0.0 ? 0.0 : p[a]);  // -0 is 0
+    lane[0] = mix(lane[0] ^ w);
+    lane[1] = mix(lane[1] + (w ^ 0x452821e638d01377ULL));
+  }
+  return lane;
+}
+
+void EdgeParity::add_hashed_triangle(const VertexHash& a, const VertexHash& b, const VertexHash& c) {
   for (const auto& h : {edge_hash(a, b), edge_hash(b, c), edge_hash(c, a)}) {
     state_[0] ^= h[0];
     state_[1] ^= h[1];
   }
+}
+
+void EdgeParity::add_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+  add_hashed_triangle(hash_vertex(a), hash_vertex(b), hash_vertex(c));
 }
 
 }  // namespace tetrapage

@@ -200,10 +200,14 @@ LoadedSoup load_soup(const InputPiece& piece) {
   loaded.parity.resize(parts);
   loaded.bounds.resize(parts);
   loaded.centroids.resize(soup.triangle_count());
+  // Each vertex hashed once, not once per edge end (six times for a vertex of six triangles).
+  std::vector<EdgeParity::VertexHash> vertex_hashes(soup.vertices.size());
+  for (std::size_t v = 0; v < soup.vertices.size(); ++v) vertex_hashes[v] = EdgeParity::hash_vertex(soup.vertices[v]);
   for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
     const auto part = std::uint32_t(soup.part_of.empty() ? 0 : soup.part_of[t]);
     const auto corners = soup.corners(t);
-    loaded.parity[part].add_triangle(corners);
+    const auto& c = soup.triangles[t];
+    loaded.parity[part].add_hashed_triangle(vertex_hashes[c[0]], vertex_hashes[c[1]], vertex_hashes[c[2]]);
     for (const auto& p : corners) loaded.bounds[part].extend(p);
     loaded.centroids[t] = centroid(corners);
   }

@@ -19,6 +19,13 @@ class EdgeParity {
   /// after -0.0 is read as 0.0).
   void add_triangle(const Vec3& a, const Vec3& b, const Vec3& c);
   void add_triangle(const std::array<Vec3, 3>& t) { add_triangle(t[0], t[1], t[2]); }
+
+  /// A vertex position's 128-bit hash: a soup whose vertices are shared by several triangles
+  /// hashes each once and folds its triangles in with add_hashed_triangle.
+  using VertexHash = std::array<std::uint64_t, 2>;
+  static VertexHash hash_vertex(const Vec3& p);
+  /// The same as add_triangle for the positions whose hashes these are.
+  void add_hashed_triangle(const VertexHash& a, const VertexHash& b, const VertexHash& c);
   /// Combines another accumulator's triangles (for parallel folds).
   void merge(const EdgeParity& other) {
     state_[0] ^= other.state_[0];
