@@ -12,17 +12,46 @@
 
 namespace tetrapage {
 
+namespace {
+
+enum class Side : std::uint8_t { outside, boundary, inside };
+
+// Where p lies against the tet whose planes the scratch holds (exact: the planes' side tests
+// are orient3d's).
+Side side_of(const BinningScratch& scratch, const geometry::Point& p) {
+  Side side = Side::inside;
+  for (const auto& plane : *scratch.planes) {
+    const geometry::Sign s = plane.side(p) * scratch.orientation;
+    if (s == geometry::Sign::negative) return Side::outside;
+    if (s == geometry::Sign::zero) side = Side::boundary;
+  }
+  return side;
+}
+
+void prepare_planes(const TetMesh& mesh, std::uint32_t tet, BinningScratch& scratch) {
+  if (scratch.planes_tet == tet) return;
+  const auto t = mesh.corners(tet);
+  const auto plane = [&](int k) {
+    const auto& f = geometry::kTetrahedronFaces[k];
+    return geometry::OrientedPlane(t[f[0]], t[f[1]], t[f[2]]);
+  };
+  scratch.planes.emplace(std::array{plane(0), plane(1), plane(2), plane(3)});
+  scratch.orientation = geometry::orient3d(t[0], t[1], t[2], t[3]);
+  scratch.planes_tet = tet;
+}
+
+}  // namespace
+
 void bin_triangle(const TetMesh& mesh, const geometry::Triangle& triangle,
                   BinningScratch& scratch, std::vector<std::uint32_t>& tets) {
   if (scratch.hint >= mesh.tet_count()) scratch.hint = 0;
-  // A tet holding the first corner: the last triangle's, as a rule (input order is coherent
-  // and a region holds thousands of triangles), else the walk's. Testing that tet is a fifth
-  // of a walk's predicates.
+  // A tet holding the first corner: the last triangle's, as a rule (triangles come in Morton
+  // order), else the walk's. The last tet's face planes are kept: a corner's test against them
+  // is four dot products in the common case, a walk dozens of predicates.
   std::uint32_t start = scratch.hint;
-  geometry::TetrahedronPosition position =
-      geometry::locate_in_tetrahedron(triangle[0], mesh.corners(start)).position;
-  if (position == geometry::TetrahedronPosition::outside ||
-      position == geometry::TetrahedronPosition::degenerate_tetrahedron) {
+  prepare_planes(mesh, start, scratch);
+  Side corner0 = scratch.orientation == geometry::Sign::zero ? Side::outside : side_of(scratch, triangle[0]);
+  if (corner0 == Side::outside) {
     const WalkResult located = locate_point(mesh, scratch.hint, triangle[0]);
     if (located.tet == TetMesh::no_neighbour) {
       char text[160];
@@ -31,21 +60,17 @@ void bin_triangle(const TetMesh& mesh, const geometry::Triangle& triangle,
       throw InputError(text);
     }
     start = located.tet;
-    position = located.location.position;
     scratch.hint = start;
+    prepare_planes(mesh, start, scratch);
+    corner0 = located.location.position == geometry::TetrahedronPosition::inside ? Side::inside : Side::boundary;
   }
   // Most triangles lie strictly inside one tet: all three corners in its open interior put the
   // whole triangle there (the tet is convex), and the closed neighbours meet it only on their
   // common faces.
-  if (position == geometry::TetrahedronPosition::inside) {
-    const auto corners = mesh.corners(start);
-    if (geometry::locate_in_tetrahedron(triangle[1], corners).position ==
-            geometry::TetrahedronPosition::inside &&
-        geometry::locate_in_tetrahedron(triangle[2], corners).position ==
-            geometry::TetrahedronPosition::inside) {
-      tets.push_back(start);
-      return;
-    }
+  if (corner0 == Side::inside && side_of(scratch, triangle[1]) == Side::inside &&
+      side_of(scratch, triangle[2]) == Side::inside) {
+    tets.push_back(start);
+    return;
   }
   const geometry::Box box = geometry::box_of(triangle);
   const std::size_t first = tets.size();

@@ -2,10 +2,13 @@
 /// @file TriangleBinning.h
 /// Exact binning: the tets of the coarse mesh that a triangle really meets.
 
+#include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "tetrapage/formats/TetMesh.h"
+#include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
 
 namespace tetrapage {
@@ -15,6 +18,11 @@ struct BinningScratch {
   std::uint32_t hint = 0;  ///< where the next point location starts (the last tet found)
   std::vector<std::uint32_t> queue;
   std::uint64_t tet_tests = 0;  ///< exact triangle/tet tests run
+  /// The face planes of tet `planes_tet` (most triangles test their corners against the same
+  /// tet as the last one) and the sign of its orientation.
+  std::uint32_t planes_tet = TetMesh::no_neighbour;
+  std::optional<std::array<geometry::OrientedPlane, 4>> planes;
+  geometry::Sign orientation = geometry::Sign::zero;
 };
 
 /// Appends to `tets` every tet whose closed region meets the closed triangle (exact
