@@ -717,29 +717,43 @@ std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard)
   return payload;
 }
 
-std::vector<std::string> IndexReader::validate() const {
+std::vector<std::string> IndexReader::validate(
+    const std::function<void(std::uint32_t, std::span<const std::byte>)>& each_shard) const {
   detail::enter_hdf5();
   const Impl& r = *impl_;
   std::vector<std::string> problems = r.extent_problems();
   if (problems.empty()) {
     r.ensure_located();
-    std::vector<std::byte> chunk(r.chunk_bytes);
-    for (std::uint32_t s = 0; s < r.offsets.size(); ++s)
+    std::vector<std::byte> chunk(r.chunk_bytes), payload;
+    for (std::uint32_t s = 0; s < r.offsets.size(); ++s) {
+      payload.resize(r.sizes[s]);
+      bool intact = true;
       for (std::uint64_t k = 0; k < r.chunk_count(s); ++k) {
         const ChunkLocation& location = r.chunks[r.first_chunk(s) + k];
         if (location.address == kUnallocated) {
           problems.push_back(r.chunk_name(s, k) + " is not stored");
+          intact = false;
           continue;
         }
         try {
           std::uint32_t mask = 0;
           const auto stored = r.read_stored_chunk(s, k, mask);
           const std::string problem = detail::decode_chunk(stored, mask, chunk);
-          if (!problem.empty()) problems.push_back(r.chunk_name(s, k) + ": " + problem);
+          if (!problem.empty()) {
+            problems.push_back(r.chunk_name(s, k) + ": " + problem);
+            intact = false;
+            continue;
+          }
+          const std::uint64_t begin = k * r.chunk_bytes;
+          std::memcpy(payload.data() + begin, chunk.data(),
+                      std::min<std::uint64_t>(r.chunk_bytes, payload.size() - begin));
         } catch (const FormatError& error) {
           problems.push_back(error.what());
+          intact = false;
         }
       }
+      if (intact && each_shard) each_shard(s, payload);
+    }
   }
   try {
     read_mesh();

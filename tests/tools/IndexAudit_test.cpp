@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
@@ -168,6 +169,54 @@ TEST(ValidateCommand, ChecksAgainstBruteForceSampledAndInFull) {
   }
   EXPECT_NE(test::run_cli("validate " + m.index.string() + " " + other.string() + " --sample 20", out), 0);
   EXPECT_NE(out.find("not its model"), std::string::npos) << out;
+}
+
+// A copy of the good index, written again with shard 0's payload replaced by bytes that pass
+// the chunk checksums but are no shard, and shard 1's triangle count in /tables/shard_triangles
+// off by one: validate decodes every shard as it checks the chunks and must name both.
+TEST(ValidateCommand, AShardThatDoesNotDecodeAndATableThatDisagreesAreNamed) {
+  const Indexed& m = indexed();
+  const IndexReader good(m.index);
+  ASSERT_GE(good.shard_count(), 2u);
+  const fs::path broken = m.folder / "broken-shards.tpi";
+  {
+    IndexWriter writer(broken);
+    writer.write_mesh(good.read_mesh());
+    for (const std::string& name : good.table_names()) {
+      // Each table by the one reader that accepts its type.
+      try {
+        auto values = good.read_table_uint32(name);
+        if (name == "shard_triangles") values[1] += 1;
+        writer.write_table(name, std::span<const std::uint32_t>(values));
+        continue;
+      } catch (const FormatError&) {
+      }
+      try {
+        const auto values = good.read_table_double(name);
+        writer.write_table(name, std::span<const double>(values));
+        continue;
+      } catch (const FormatError&) {
+      }
+      try {
+        const auto values = good.read_table_uint64(name);
+        writer.write_table(name, std::span<const std::uint64_t>(values));
+        continue;
+      } catch (const FormatError&) {
+      }
+      const auto values = good.read_table_uint8(name);
+      writer.write_table(name, std::span<const std::uint8_t>(values));
+    }
+    const std::vector<std::byte> not_a_shard(256, std::byte{0x5a});
+    writer.append_shard(not_a_shard);
+    for (std::uint32_t s = 1; s < good.shard_count(); ++s) writer.append_shard(good.read_shard(s));
+    writer.commit(good.header());
+  }
+  std::string out;
+  EXPECT_NE(test::run_cli("validate " + broken.string() + " --sample 4 --boxes 1", out), 0) << out;
+  EXPECT_NE(out.find("problem: shard 0: "), std::string::npos) << out;
+  EXPECT_NE(out.find("magic"), std::string::npos) << out;
+  EXPECT_NE(out.find("problem: shard 1 holds "), std::string::npos) << out;
+  EXPECT_EQ(out.find("problem: shard 2"), std::string::npos) << out;
 }
 
 TEST(ValidateCommand, WithoutTheModelTheBinningCheckIsSkippedAndSaid) {

@@ -177,7 +177,23 @@ void run_inspect(const InspectArguments& args) {
 
 // Everything an index promises, checked; returns the problems found.
 std::vector<std::string> validate_index(const IndexReader& reader) {
-  std::vector<std::string> problems = reader.validate();
+  // Every shard decoded as the reader checks its chunks (one read and inflation of the data);
+  // what the tables must agree with is kept.
+  struct Decoded {
+    std::uint32_t triangles = 0;
+    BoundingBox bounds;
+    std::string problem;  ///< the decoder's, if it failed
+  };
+  std::vector<Decoded> decoded(reader.shard_count());
+  std::vector<std::string> problems = reader.validate([&](std::uint32_t s, std::span<const std::byte> payload) {
+    try {
+      const Shard shard = Shard::decode(payload);
+      decoded[s].triangles = shard.triangle_count();
+      decoded[s].bounds = shard.bounds();
+    } catch (const Error& error) {
+      decoded[s].problem = error.what();
+    }
+  });
   if (!problems.empty()) return problems;
   const TetMesh mesh = reader.read_mesh();  // checks every vertex and neighbour index
   auto problem = [&](std::string text) {
@@ -207,20 +223,20 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
   for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
     if (shard_tet[s] >= tet_shard.size() || tet_shard[shard_tet[s]] != s)
       problem("shard " + std::to_string(s) + " and tet " + std::to_string(shard_tet[s]) + " do not name each other");
-    try {
-      const Shard shard = Shard::decode(reader.read_shard(s));
-      if (shard.triangle_count() != shard_triangles[s])
-        problem("shard " + std::to_string(s) + " holds " + std::to_string(shard.triangle_count()) +
-                " triangles, the table says " + std::to_string(shard_triangles[s]));
-      // The runtime skips a shard by these bounds without reading it: they must hold it.
-      for (int a = 0; a < 3; ++a)
-        if (shard.triangle_count() > 0 &&
-            (shard.bounds().lo[a] < shard_bounds[6 * s + a] || shard.bounds().hi[a] > shard_bounds[6 * s + 3 + a]))
-          problem("shard " + std::to_string(s) + " reaches beyond its /tables/shard_bounds on axis " +
-                  std::to_string(a));
-    } catch (const Error& error) {
-      problem("shard " + std::to_string(s) + ": " + error.what());
+    const Decoded& shard = decoded[s];
+    if (!shard.problem.empty()) {
+      problem("shard " + std::to_string(s) + ": " + shard.problem);
+      continue;
     }
+    if (shard.triangles != shard_triangles[s])
+      problem("shard " + std::to_string(s) + " holds " + std::to_string(shard.triangles) +
+              " triangles, the table says " + std::to_string(shard_triangles[s]));
+    // The runtime skips a shard by these bounds without reading it: they must hold it.
+    for (int a = 0; a < 3; ++a)
+      if (shard.triangles > 0 &&
+          (shard.bounds.lo[a] < shard_bounds[6 * s + a] || shard.bounds.hi[a] > shard_bounds[6 * s + 3 + a]))
+        problem("shard " + std::to_string(s) + " reaches beyond its /tables/shard_bounds on axis " +
+                std::to_string(a));
   }
   // Interiors: the runtime's checks at open (all four tables, consistent), and every reference
   // point strictly inside its tet (the crossings are counted within the tet).

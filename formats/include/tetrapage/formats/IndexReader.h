@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -89,9 +90,12 @@ class IndexReader {
 
   /// Reads everything: every chunk's checksum and inflation, every extent, the mesh (and its
   /// index ranges) and every table. Returns one human-readable line per problem, empty when
-  /// the index is valid. Does not throw for problems it finds in the file.
-  /// @throw IoError if the operating system fails a read.
-  std::vector<std::string> validate() const;
+  /// the index is valid. Does not throw for problems it finds in the file. `each_shard`, when
+  /// given, receives every shard's payload whose chunks all check out, in shard order, so that
+  /// a caller checking the payloads too reads and inflates the data once.
+  /// @throw IoError if the operating system fails a read; what each_shard throws.
+  std::vector<std::string> validate(
+      const std::function<void(std::uint32_t shard, std::span<const std::byte> payload)>& each_shard = {}) const;
 
  private:
   struct Impl;
