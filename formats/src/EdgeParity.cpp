@@ -1,6 +1,5 @@
 #include "tetrapage/formats/EdgeParity.h"
 
-#include <algorithm>
 #include <bit>
 #include <utility>
 

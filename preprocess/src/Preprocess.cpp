@@ -145,15 +145,12 @@ class CopyBucket {
     if (records_) return records_->append(copies);
     for (const TriangleRecord& copy : copies) pairs_.push_back({copy.id, copy.tet});
   }
-  /// The copies, taken out of the bucket (which is then empty).
+  /// The copies, taken out of the bucket (which is then empty, its spill file removed).
   BucketCopies take() {
     BucketCopies copies = records_ ? BucketCopies(records_->read_all()) : BucketCopies(std::move(pairs_), *soups_);
-    clear();
-    return copies;
-  }
-  void clear() {
-    records_.reset();  // removes the file
+    records_.reset();
     std::vector<CopyPair>().swap(pairs_);
+    return copies;
   }
 
  private:

@@ -21,8 +21,9 @@ struct IndexWriterOptions {
   /// Chunk size of /shards/data in bytes, a multiple of 8 in 1 KiB .. 64 MiB. Every shard
   /// starts on a chunk boundary, and its last chunk is padded: deflating 64 KiB chunks of the
   /// 10M scene's shards (15 KB on average) spent half its time on the padding. 16 KiB chunks,
-  /// shuffled, at level 1: deflate 2.2x and inflate 1.6x faster per payload byte than 64 KiB
-  /// at level 4, and 1 % smaller (docs/BENCHMARKS.md, "Preprocess, fifth pass").
+  /// shuffled, at level 1: deflate about 2x and inflate 1.6-1.8x faster per payload byte than
+  /// 64 KiB at level 4, and 1 % smaller (tetrapage_bench_chunks; docs/BENCHMARKS.md, "Preprocess,
+  /// fifth pass").
   std::uint32_t chunk_bytes = 16384;
   /// zlib level of every compressed dataset, 0 (store) .. 9. On shuffled chunks level 1 is
   /// within 0.5 % of level 4's size and 1.2x faster.
