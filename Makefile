@@ -12,7 +12,7 @@ DEMO_DIR  ?= out/demo
 DEB_PACKAGES := cmake make g++ pkg-config \
   libeigen3-dev libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev libdeflate-dev time python3
+  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev libdeflate-dev liblz4-dev hdf5-filter-plugin time python3
 
 .PHONY: deps configure build test sanitize demo bench bench-study bench-peers bench-accuracy bench-scale clean format
 

@@ -1,13 +1,14 @@
 // The index file layout, measured (docs/FORMAT.md "Measured" quotes these figures):
 //  1. write + read-all time and file size of our layout (one chunked /shards/data with
 //     per-shard extents) against one group per shard with its own small dataset;
-//  2. read_shard (one pread, Fletcher-32 and inflate outside HDF5) against
+//  2. read_shard (one pread, Fletcher-32 and LZ4 outside HDF5) against
 //     read_shard_through_hdf5 (H5Dread, serialised behind HDF5's global lock), 1 and 2 threads.
 //
 //   tetrapage_bench_index [--shards=N] [benchmark flags]
 //
 // Payloads are 2-200 KiB of float32 coordinates with noisy low bits and increasing ids
-// (deflate shrinks them to roughly 60-70%), written into a temporary folder removed at exit.
+// (compressible, as real shards are), written into a temporary folder removed at exit. Both
+// layouts use the index's pipeline (shuffle, LZ4, Fletcher-32) and chunk size.
 // Files are read from the page cache: the figures are decode and library cost, not disk.
 
 #include <benchmark/benchmark.h>
@@ -81,17 +82,23 @@ std::uint64_t write_group_per_shard(const std::filesystem::path& path) {
   for (std::size_t s = 0; s < g_shard_count; ++s) {
     const hid_t group = H5Gcreate2(shards, std::to_string(s).c_str(), H5P_DEFAULT, H5P_DEFAULT,
                                    H5P_DEFAULT);
-    const hsize_t size = g_sizes[s];
-    const hsize_t chunk = std::min<hsize_t>(size, 65536);
-    const hid_t space = H5Screate_simple(1, &size, nullptr);
+    // The index's pipeline and chunk size on 8-byte words; HDF5 compresses with the LZ4
+    // plugin (Debian's hdf5-filter-plugin).
+    const hsize_t words = (g_sizes[s] + 7) / 8;
+    const hsize_t chunk = std::min<hsize_t>(words, tetrapage::IndexWriterOptions{}.chunk_bytes / 8);
+    std::vector<std::byte> padded(words * 8);
+    std::memcpy(padded.data(), payload(s).data(), g_sizes[s]);
+    const hid_t space = H5Screate_simple(1, &words, nullptr);
     const hid_t creation = H5Pcreate(H5P_DATASET_CREATE);
     H5Pset_chunk(creation, 1, &chunk);
-    H5Pset_deflate(creation, 4);
+    H5Pset_shuffle(creation);
+    const unsigned block = static_cast<unsigned>(chunk * 8);
+    H5Pset_filter(creation, 32004, H5Z_FLAG_MANDATORY, 1, &block);
     H5Pset_fletcher32(creation);
     const hid_t dataset =
-        H5Dcreate2(group, "data", H5T_STD_U8LE, space, H5P_DEFAULT, creation, H5P_DEFAULT);
-    if (H5Dwrite(dataset, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, payload(s).data()) < 0)
-      throw std::runtime_error("H5Dwrite failed");
+        H5Dcreate2(group, "data", H5T_STD_U64LE, space, H5P_DEFAULT, creation, H5P_DEFAULT);
+    if (dataset < 0 || H5Dwrite(dataset, H5T_STD_U64LE, H5S_ALL, H5S_ALL, H5P_DEFAULT, padded.data()) < 0)
+      throw std::runtime_error("H5Dwrite failed (is the LZ4 plugin, hdf5-filter-plugin, installed?)");
     H5Dclose(dataset);
     H5Pclose(creation);
     H5Sclose(space);
@@ -112,10 +119,10 @@ std::uint64_t read_all_group_per_shard(const std::filesystem::path& path) {
     const hid_t space = H5Dget_space(dataset);
     hsize_t size = 0;
     H5Sget_simple_extent_dims(space, &size, nullptr);
-    buffer.resize(size);
-    if (H5Dread(dataset, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()) < 0)
+    buffer.resize(size * 8);
+    if (H5Dread(dataset, H5T_STD_U64LE, H5S_ALL, H5S_ALL, H5P_DEFAULT, buffer.data()) < 0)
       throw std::runtime_error("H5Dread failed");
-    bytes += size;
+    bytes += g_sizes[s];
     H5Sclose(space);
     H5Dclose(dataset);
   }

@@ -1,13 +1,16 @@
 #pragma once
 // Internal: the byte-level encoding of one stored chunk of /shards/data, exactly as HDF5's
-// pipeline "shuffle (8-byte elements), deflate, fletcher32" produces and expects it, so that
-// the index reader can check and inflate chunks it read itself (outside HDF5's global lock)
-// and the writer can hand HDF5 chunks it compressed itself (H5Dwrite_chunk).
+// pipeline "shuffle (8-byte elements), LZ4 (registered filter 32004), fletcher32" produces and
+// expects it, so that the index reader can check and decompress chunks it read itself (outside
+// HDF5's global lock) and the writer can hand HDF5 chunks it compressed itself (H5Dwrite_chunk).
 //
 // A stored chunk is:   filtered bytes | Fletcher-32 of the filtered bytes (4 bytes, little endian)
-// where "filtered bytes" are a zlib stream (RFC 1950) of the shuffled chunk (byte k of every
+// where "filtered bytes" are the LZ4 filter's frame of the shuffled chunk (byte k of every
 // 8-byte element, for k = 0..7 in turn), or the chunk itself when the filter mask says shuffle
-// and deflate were skipped (incompressible data).
+// and LZ4 were skipped (incompressible data). The frame, as the filter plugin that HDF5
+// distributes (Debian: hdf5-filter-plugin) writes and reads it, all numbers big endian:
+//   uint64 decoded size | uint32 block size | per block: uint32 stored size, then the block's
+//   LZ4 block-format bytes, or the block itself when its stored size equals its decoded size.
 
 #include <cstddef>
 #include <cstdint>
@@ -19,11 +22,13 @@ namespace tetrapage::detail {
 
 /// Bits of an HDF5 chunk filter mask: bit i set = filter i of the pipeline was skipped.
 inline constexpr std::uint32_t kShuffleSkipped = 1u << 0;
-inline constexpr std::uint32_t kDeflateSkipped = 1u << 1;
+inline constexpr std::uint32_t kCompressionSkipped = 1u << 1;
 inline constexpr std::uint32_t kChecksumSkipped = 1u << 2;
 /// The shuffle's element size: the dataset's type, 8-byte little-endian words.
 inline constexpr std::size_t kShuffleElementBytes = 8;
 inline constexpr std::size_t kChecksumBytes = 4;
+/// HDF5's registered id of the LZ4 filter (the HDF Group's list of registered filters).
+inline constexpr int kLz4FilterId = 32004;
 
 /// HDF5's Fletcher-32: 16-bit big-endian words (an odd last byte is the high byte of a final
 /// word), both sums folded modulo 65535 every 360 words, result (sum2 << 16) | sum1.
@@ -35,11 +40,11 @@ struct EncodedChunk {
   std::uint32_t filter_mask = 0;
 };
 
-/// Shuffles and deflates `chunk` at `level` (0-9) and appends the checksum; keeps the chunk as
-/// it is (filter_mask = kShuffleSkipped | kDeflateSkipped) when deflate would not make it
+/// Shuffles and compresses `chunk` (one LZ4 block) and appends the checksum; keeps the chunk as
+/// it is (filter_mask = kShuffleSkipped | kCompressionSkipped) when LZ4 would not make it
 /// smaller. `out` is reused to avoid an allocation per chunk.
-/// @throw InputError for an invalid level or a chunk that is not whole 8-byte elements.
-void encode_chunk(std::span<const std::byte> chunk, int level, EncodedChunk& out);
+/// @throw InputError for an empty chunk, one over 1 GiB or one that is not whole 8-byte elements.
+void encode_chunk(std::span<const std::byte> chunk, EncodedChunk& out);
 
 /// Checks the checksum of `stored` and decodes it into `out`, which must receive exactly
 /// out.size() bytes (the chunk size). Returns "" on success, else what is wrong (the caller

@@ -313,7 +313,7 @@ struct IndexReader::Impl {
       format_error("'" + name + "' has an unusable chunk shape");
     chunk_bytes = static_cast<std::uint32_t>(chunk * kWordBytes);
     const int filters = H5Pget_nfilters(creation.get());
-    std::array<H5Z_filter_t, 3> expected{H5Z_FILTER_SHUFFLE, H5Z_FILTER_DEFLATE, H5Z_FILTER_FLETCHER32};
+    std::array<H5Z_filter_t, 3> expected{H5Z_FILTER_SHUFFLE, detail::kLz4FilterId, H5Z_FILTER_FLETCHER32};
     bool pipeline_ok = filters == 3;
     std::string found;
     for (int f = 0; f < filters; ++f) {
@@ -326,8 +326,8 @@ struct IndexReader::Impl {
     }
     if (!pipeline_ok)
       format_error("'" + name + "' has filters [" + found + "], expected [" +
-                   std::to_string(H5Z_FILTER_SHUFFLE) + ", " + std::to_string(H5Z_FILTER_DEFLATE) + ", " +
-                   std::to_string(H5Z_FILTER_FLETCHER32) + "] (shuffle, deflate, fletcher32)");
+                   std::to_string(H5Z_FILTER_SHUFFLE) + ", " + std::to_string(detail::kLz4FilterId) + ", " +
+                   std::to_string(H5Z_FILTER_FLETCHER32) + "] (shuffle, LZ4, fletcher32)");
   }
 
   std::vector<std::string> extent_problems() const {
@@ -417,7 +417,7 @@ struct IndexReader::Impl {
     return stored;
   }
 
-  /// Checks and inflates stored chunk k of a shard into its place in `payload`.
+  /// Checks and decompresses stored chunk k of a shard into its place in `payload`.
   void decode_into(std::uint32_t shard, std::uint64_t k, std::span<const std::byte> stored,
                    std::uint32_t filter_mask, std::vector<std::byte>& payload,
                    std::vector<std::byte>& scratch) const {
@@ -468,12 +468,23 @@ struct IndexReader::Impl {
       }
       return payload;
     }
-    for (std::uint64_t k = 0; k < count; ++k) {
-      std::uint32_t mask = 0;
-      const std::vector<std::byte> stored = read_stored_chunk(shard, k, mask);
-      decode_into(shard, k, stored, mask, payload, scratch);
+    // Every chunk of the shard read in one turn, then decoded: HDF5 takes its global lock in
+    // each call, and with two threads paging in, the lock's hand-overs between calls (a
+    // futex wake and a context switch each) cost more than LZ4 (tetrapage_bench_index).
+    std::vector<std::vector<std::byte>> stored(count);
+    std::vector<std::uint32_t> masks(count);
+    {
+      const std::lock_guard lock(chunk_read_mutex());
+      for (std::uint64_t k = 0; k < count; ++k) stored[k] = read_stored_chunk(shard, k, masks[k]);
     }
+    for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload, scratch);
     return payload;
+  }
+
+  /// Held over a page-in's direct chunk reads; one for the process, as HDF5's lock is.
+  static std::mutex& chunk_read_mutex() {
+    static std::mutex mutex;
+    return mutex;
   }
 };
 
@@ -684,7 +695,7 @@ std::vector<StoredChunk> IndexReader::shard_chunks(std::uint32_t shard) const {
     const std::uint64_t c = r.first_chunk(shard) + k;
     const ChunkLocation& location = r.chunks[c];
     result.push_back(StoredChunk{c, location.address, location.stored_bytes,
-                                 (location.filter_mask & detail::kDeflateSkipped) == 0});
+                                 (location.filter_mask & detail::kCompressionSkipped) == 0});
   }
   return result;
 }
@@ -700,6 +711,11 @@ std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard)
   std::vector<std::byte> payload(r.sizes[shard]);
   if (payload.empty()) return payload;
   const std::string what = "cannot read shard " + std::to_string(shard) + " through HDF5";
+  // HDF5 decompresses with the LZ4 filter plugin, which it loads on demand.
+  if (H5Zfilter_avail(detail::kLz4FilterId) <= 0)
+    throw InputError(r.where() + ": " + what + ": HDF5 finds no LZ4 filter (id " +
+                     std::to_string(detail::kLz4FilterId) +
+                     "); install its plugin (Debian: hdf5-filter-plugin) or set HDF5_PLUGIN_PATH");
   DataspaceHandle file_space(H5Dget_space(r.shard_data.get()));
   // The words that hold the payload (it starts on a chunk boundary, a whole word), read as
   // little-endian words: the bytes as stored, on any machine.

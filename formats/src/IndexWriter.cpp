@@ -125,10 +125,11 @@ struct IndexWriter::Impl {
                        path.string() + "' failed");
   }
 
-  /// A chunked, checksummed dataset whose first dimension may grow, deflated when `deflate`.
+  /// A chunked, checksummed dataset whose first dimension may grow; shuffled and compressed
+  /// with LZ4 when `compress` (the shard data).
   DatasetHandle create_dataset(hid_t parent, const std::string& name, const std::string& what,
                                hid_t type, std::span<const hsize_t> dims,
-                               std::span<const hsize_t> chunk, bool deflate, bool shuffle = false) {
+                               std::span<const hsize_t> chunk, bool compress) {
     std::array<hsize_t, 2> max_dims{H5S_UNLIMITED, 0};
     for (std::size_t d = 1; d < dims.size(); ++d) max_dims[d] = dims[d];
     DataspaceHandle space(check_id(
@@ -137,11 +138,16 @@ struct IndexWriter::Impl {
     PropertyListHandle creation(check_id(H5Pcreate(H5P_DATASET_CREATE), "properties of " + what));
     check(H5Pset_chunk(creation.get(), static_cast<int>(chunk.size()), chunk.data()),
           "the chunking of " + what);
-    // Order matters: shuffle, deflate, then the checksum over the compressed bytes.
-    if (shuffle) check(H5Pset_shuffle(creation.get()), "the shuffle filter of " + what);
-    if (deflate)
-      check(H5Pset_deflate(creation.get(), static_cast<unsigned>(options.deflate_level)),
-            "the deflate filter of " + what);
+    // Order matters: shuffle, LZ4, then the checksum over the compressed bytes. LZ4 need not
+    // be registered here: chunks arrive compressed (H5Dwrite_chunk), and an optional filter
+    // that HDF5 cannot find is kept in the pipeline for readers. Its one parameter is the
+    // block size, the chunk's size: one block a chunk, as encode_chunk writes.
+    if (compress) {
+      check(H5Pset_shuffle(creation.get()), "the shuffle filter of " + what);
+      const unsigned block_bytes = static_cast<unsigned>(options.chunk_bytes);
+      check(H5Pset_filter(creation.get(), detail::kLz4FilterId, H5Z_FLAG_OPTIONAL, 1, &block_bytes),
+            "the LZ4 filter of " + what);
+    }
     check(H5Pset_fletcher32(creation.get()), "the Fletcher-32 filter of " + what);
     return DatasetHandle(check_id(H5Dcreate2(parent, name.c_str(), type, space.get(),
                                              H5P_DEFAULT, creation.get(), H5P_DEFAULT),
@@ -228,9 +234,6 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
                      std::to_string(options.chunk_bytes) + " bytes is outside [" +
                      std::to_string(kMinChunkBytes) + ", " + std::to_string(kMaxChunkBytes) +
                      "] or not a multiple of 8");
-  if (options.deflate_level < 0 || options.deflate_level > 9)
-    throw InputError("index '" + w.path.string() + "': deflate level " +
-                     std::to_string(options.deflate_level) + " is outside [0, 9]");
   PropertyListHandle access(w.check_id(H5Pcreate(H5P_FILE_ACCESS), "file access properties"));
   // SEMI: closing the file fails if a handle is still open, so commit() cannot leave data
   // unwritten behind a forgotten handle.
@@ -251,7 +254,7 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   // 8-byte words, so that HDF5's shuffle filter puts byte k of every word together.
   const std::array<hsize_t, 1> chunk{options.chunk_bytes / kWordBytes};
   w.shard_data = w.create_dataset(w.shards_group.get(), "data", "dataset /shards/data",
-                                  H5T_STD_U64LE, empty, chunk, true, true);
+                                  H5T_STD_U64LE, empty, chunk, true);
 }
 
 IndexWriter::~IndexWriter() = default;
@@ -316,9 +319,8 @@ void IndexWriter::write_table(std::string_view name, std::span<const double> val
 
 EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterOptions& options) {
   if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes ||
-      options.chunk_bytes % kWordBytes != 0 || options.deflate_level < 0 || options.deflate_level > 9)
-    throw InputError("encode_shard: chunk size " + std::to_string(options.chunk_bytes) + " or deflate level " +
-                     std::to_string(options.deflate_level) + " out of range");
+      options.chunk_bytes % kWordBytes != 0)
+    throw InputError("encode_shard: chunk size " + std::to_string(options.chunk_bytes) + " out of range");
   EncodedShard shard;
   shard.payload_bytes = payload.size();
   shard.chunk_bytes = options.chunk_bytes;
@@ -334,7 +336,7 @@ EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterO
       std::copy(piece.begin(), piece.end(), padded.begin());
       piece = padded;
     }
-    detail::encode_chunk(piece, options.deflate_level, encoded);
+    detail::encode_chunk(piece, encoded);
     shard.chunks.push_back(encoded.bytes);
     shard.filter_masks.push_back(encoded.filter_mask);
   }

@@ -2,7 +2,7 @@
 /// @file IndexReader.h
 /// Opens a tetrapage index (docs/FORMAT.md), checks its layout, and reads the coarse mesh,
 /// the tables and the shards. A shard is read with one pread() of its consecutive chunks,
-/// then checked (Fletcher-32) and inflated outside HDF5, so several threads page shards in
+/// then checked (Fletcher-32) and decompressed outside HDF5, so several threads page shards in
 /// at once instead of queueing behind HDF5's global lock.
 
 #include <cstddef>
@@ -24,7 +24,7 @@ struct StoredChunk {
   std::uint64_t chunk = 0;         ///< chunk number in /shards/data
   std::uint64_t file_offset = 0;   ///< byte offset of the stored chunk in the file
   std::uint64_t stored_bytes = 0;  ///< filtered bytes plus the 4-byte checksum
-  bool compressed = true;          ///< false when deflate was skipped for this chunk
+  bool compressed = true;          ///< false when LZ4 was skipped for this chunk
 };
 
 class IndexReader {
@@ -75,24 +75,25 @@ class IndexReader {
   std::vector<StoredChunk> shard_chunks(std::uint32_t shard) const;
 
   /// The shard's payload. Thread-safe; reads the file directly (one pread() when the chunks
-  /// are contiguous on disk) and checks and inflates outside HDF5.
+  /// are contiguous on disk) and checks and decompresses outside HDF5.
   /// @throw InputError if shard >= shard_count().
   /// @throw FormatError naming the file, shard and chunk on a checksum mismatch, a chunk
-  ///        that does not inflate to the chunk size, or a chunk past the end of the file.
+  ///        that does not decompress to the chunk size, or a chunk past the end of the file.
   /// @throw IoError if the operating system fails the read.
   std::vector<std::byte> read_shard(std::uint32_t shard) const;
 
-  /// The same payload through H5Dread of the shard's byte range (HDF5 checks and inflates,
-  /// under its global lock). For comparison and as an independent check. Thread-safe.
-  /// @throw InputError if shard >= shard_count().
+  /// The same payload through H5Dread of the shard's byte range (HDF5 checks and decompresses,
+  /// under its global lock, with the LZ4 filter plugin that the HDF Group distributes). For
+  /// comparison and as an independent check. Thread-safe.
+  /// @throw InputError if shard >= shard_count(), or if HDF5 cannot load the LZ4 plugin.
   /// @throw FormatError if HDF5 fails to read (checksum mismatch, truncation).
   std::vector<std::byte> read_shard_through_hdf5(std::uint32_t shard) const;
 
-  /// Reads everything: every chunk's checksum and inflation, every extent, the mesh (and its
+  /// Reads everything: every chunk's checksum and decompression, every extent, the mesh (and its
   /// index ranges) and every table. Returns one human-readable line per problem, empty when
   /// the index is valid. Does not throw for problems it finds in the file. `each_shard`, when
   /// given, receives every shard's payload whose chunks all check out, in shard order, so that
-  /// a caller checking the payloads too reads and inflates the data once.
+  /// a caller checking the payloads too reads and decompresses the data once.
   /// @throw IoError if the operating system fails a read; what each_shard throws.
   std::vector<std::string> validate(
       const std::function<void(std::uint32_t shard, std::span<const std::byte> payload)>& each_shard = {}) const;

@@ -19,15 +19,10 @@ namespace tetrapage {
 
 struct IndexWriterOptions {
   /// Chunk size of /shards/data in bytes, a multiple of 8 in 1 KiB .. 64 MiB. Every shard
-  /// starts on a chunk boundary, and its last chunk is padded: deflating 64 KiB chunks of the
-  /// 10M scene's shards (15 KB on average) spent half its time on the padding. 16 KiB chunks,
-  /// shuffled, at level 1: deflate about 2x and inflate 1.6-1.8x faster per payload byte than
-  /// 64 KiB at level 4, and 1 % smaller (tetrapage_bench_chunks; docs/BENCHMARKS.md, "Preprocess,
-  /// fifth pass").
+  /// starts on a chunk boundary, and its last chunk is padded. On the 10M scene's shards (15 KB
+  /// on average), shuffled 16 KiB chunks decompress with LZ4 2.4x as fast per payload byte as
+  /// 64 KiB ones and are 1 % smaller (tetrapage_bench_chunks; docs/FORMAT.md).
   std::uint32_t chunk_bytes = 16384;
-  /// zlib level of every compressed dataset, 0 (store) .. 9. On shuffled chunks level 1 is
-  /// within 0.5 % of level 4's size and 1.2x faster.
-  int deflate_level = 1;
 };
 
 /// A shard's payload cut into chunks, each compressed and checksummed as the index stores it.
@@ -35,7 +30,7 @@ struct EncodedShard {
   std::uint64_t payload_bytes = 0;
   std::uint32_t chunk_bytes = 0;
   std::vector<std::vector<std::byte>> chunks;
-  std::vector<std::uint32_t> filter_masks;  ///< HDF5's per-chunk filter mask (shuffle and deflate skipped)
+  std::vector<std::uint32_t> filter_masks;  ///< HDF5's per-chunk filter mask (shuffle and LZ4 skipped)
 };
 
 /// Compresses a payload as IndexWriter::append_shard does, without a file: thread-safe, so
