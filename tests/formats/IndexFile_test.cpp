@@ -395,6 +395,50 @@ TEST(IndexFile, ChunkCodecAgreesWithHdf5Filters) {
   EXPECT_GE(multi_block_frames, 2u);
 }
 
+/// HDF5's Fletcher-32 word by word, as its H5_checksum_fletcher32 states it: the reference
+/// for our blockwise one.
+std::uint32_t fletcher32_word_by_word(std::span<const std::byte> data) {
+  std::uint32_t sum1 = 0, sum2 = 0;
+  std::size_t i = 0;
+  auto fold = [](std::uint32_t x) { return (x & 0xffff) + (x >> 16); };
+  for (std::size_t left = data.size() / 2; left > 0;) {
+    const std::size_t block = std::min<std::size_t>(left, 360);
+    left -= block;
+    for (std::size_t k = 0; k < block; ++k, i += 2) {
+      sum1 += (std::uint32_t(data[i]) << 8) | std::uint32_t(data[i + 1]);
+      sum2 += sum1;
+    }
+    sum1 = fold(sum1);
+    sum2 = fold(sum2);
+  }
+  if (data.size() % 2 != 0) {
+    sum1 += std::uint32_t(data[i]) << 8;
+    sum2 += sum1;
+    sum1 = fold(sum1);
+    sum2 = fold(sum2);
+  }
+  sum1 = fold(sum1);
+  sum2 = fold(sum2);
+  return (sum2 << 16) | sum1;
+}
+
+TEST(IndexFile, Fletcher32EqualsTheWordByWordSums) {
+  // Every length around the 8-word and 360-word steps, random and extreme bytes (all 0xff
+  // makes the sums wrap; all zero and one odd byte test the tails).
+  Random random(77);
+  for (std::size_t size = 0; size < 2200; size += size < 64 ? 1 : 7) {
+    for (const int fill : {-1, 0x00, 0xff}) {
+      std::vector<std::byte> data(size);
+      for (auto& b : data) b = std::byte(fill < 0 ? random.below(256) : std::uint64_t(fill));
+      ASSERT_EQ(detail::fletcher32(data), fletcher32_word_by_word(data)) << "size " << size << " fill " << fill;
+    }
+  }
+  std::vector<std::byte> large(1 << 20, std::byte{0xff});
+  EXPECT_EQ(detail::fletcher32(large), fletcher32_word_by_word(large));
+  for (auto& b : large) b = std::byte(random.below(256));
+  EXPECT_EQ(detail::fletcher32(std::span(large).subspan(3)), fletcher32_word_by_word(std::span(large).subspan(3)));
+}
+
 TEST(IndexFile, ChunkCodecRejectsMalformedFramesWithValidChecksums) {
   // Frames whose checksum is right but whose LZ4 framing lies: a clear problem, never a read
   // past either buffer (ASan builds check that).
