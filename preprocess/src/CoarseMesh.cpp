@@ -5,6 +5,8 @@
 #include <CGAL/Triangulation_cell_base_with_info_3.h>
 #include <CGAL/Triangulation_vertex_base_with_info_3.h>
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -44,8 +46,19 @@ void split(std::vector<Vec3>& points, std::size_t begin, std::size_t end, std::s
   std::nth_element(points.begin() + long(begin), points.begin() + long(middle),
                    points.begin() + long(end),
                    [axis](const Vec3& a, const Vec3& b) { return a[axis] < b[axis]; });
-  split(points, begin, middle, leaf, sites);
-  split(points, middle, end, leaf, sites);
+  // The halves are disjoint ranges: large ones split on two threads (the sample holds up to
+  // 4M centroids, and this was a serial 0.4 s of the 10M preprocess), their sites appended
+  // left then right as the serial recursion does.
+  constexpr std::size_t kParallelPoints = std::size_t(1) << 16;
+  if (end - begin < kParallelPoints) {
+    split(points, begin, middle, leaf, sites);
+    split(points, middle, end, leaf, sites);
+    return;
+  }
+  std::vector<Vec3> right_sites;
+  tbb::parallel_invoke([&] { split(points, begin, middle, leaf, sites); },
+                       [&] { split(points, middle, end, leaf, right_sites); });
+  sites.insert(sites.end(), right_sites.begin(), right_sites.end());
 }
 
 }  // namespace

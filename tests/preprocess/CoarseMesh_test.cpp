@@ -6,6 +6,7 @@
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 #include "tetrapage/formats/Error.h"
@@ -49,6 +50,48 @@ TEST(SampleSites, OneSitePerLeafPlusTheBoxCorners) {
       EXPECT_LE(s[a], box.hi[a]);
     }
   EXPECT_THROW(sample_sites({}, bounds, options), InputError);
+}
+
+/// The sampler's median split, serial and depth first: the reference for the parallel one.
+void split_serially(std::vector<Vec3>& points, std::size_t begin, std::size_t end, std::size_t leaf,
+                    std::vector<Vec3>& sites) {
+  if (end - begin <= leaf) {
+    Vec3 mean{0, 0, 0};
+    for (std::size_t i = begin; i < end; ++i)
+      for (int a = 0; a < 3; ++a) mean[a] += points[i][a];
+    for (auto& m : mean) m /= double(end - begin);
+    sites.push_back(mean);
+    return;
+  }
+  BoundingBox box;
+  for (std::size_t i = begin; i < end; ++i) box.extend(points[i]);
+  const Vec3 size = box.size();
+  const int axis = size[0] >= size[1] && size[0] >= size[2] ? 0 : (size[1] >= size[2] ? 1 : 2);
+  if (size[axis] == 0.0) {
+    sites.push_back(points[begin]);
+    return;
+  }
+  const std::size_t middle = begin + (end - begin) / 2;
+  std::nth_element(points.begin() + long(begin), points.begin() + long(middle), points.begin() + long(end),
+                   [axis](const Vec3& a, const Vec3& b) { return a[axis] < b[axis]; });
+  split_serially(points, begin, middle, leaf, sites);
+  split_serially(points, middle, end, leaf, sites);
+}
+
+TEST(SampleSites, TheSameSitesInTheSameOrderAsTheSerialSplit) {
+  // Enough centroids that the halves are split on several threads (from 65,536 points), with
+  // repeated coordinates (ties in the medians).
+  auto centroids = clustered_centroids(5, 300000);
+  for (std::size_t i = 0; i < centroids.size(); i += 3) centroids[i][0] = std::round(centroids[i][0] * 64) / 64;
+  BoundingBox bounds;
+  for (const auto& c : centroids) bounds.extend(c);
+  SamplingOptions options;
+  options.leaf_triangles = 700;
+  std::vector<Vec3> points = centroids, expected;
+  split_serially(points, 0, points.size(), options.leaf_triangles, expected);
+  const auto sites = sample_sites(centroids, bounds, options);
+  ASSERT_EQ(sites.size(), expected.size() + 8);
+  EXPECT_TRUE(std::equal(expected.begin(), expected.end(), sites.begin()));
 }
 
 TEST(CoarseMesh, IsAValidDelaunayTilingOfTheEnlargedBox) {
