@@ -403,6 +403,12 @@ struct IndexReader::Impl {
   /// The stored bytes of one chunk and its filter mask, through HDF5's direct chunk read.
   std::vector<std::byte> read_stored_chunk(std::uint32_t shard, std::uint64_t k,
                                            std::uint32_t& mask) const {
+    std::vector<std::byte> stored;
+    read_stored_chunk(shard, k, mask, stored);
+    return stored;
+  }
+  void read_stored_chunk(std::uint32_t shard, std::uint64_t k, std::uint32_t& mask,
+                         std::vector<std::byte>& stored) const {
     hsize_t coordinate = (first_chunk(shard) + k) * chunk_bytes / kWordBytes;
     hsize_t stored_bytes = 0;
     if (H5Dget_chunk_storage_size(shard_data.get(), &coordinate, &stored_bytes) < 0)
@@ -411,10 +417,9 @@ struct IndexReader::Impl {
     if (stored_bytes > 2 * std::uint64_t(chunk_bytes) + 64)
       format_error(chunk_name(shard, k) + " claims " + std::to_string(stored_bytes) +
                    " stored bytes for a " + std::to_string(chunk_bytes) + "-byte chunk");
-    std::vector<std::byte> stored(stored_bytes);
+    stored.resize(stored_bytes);
     if (H5Dread_chunk(shard_data.get(), H5P_DEFAULT, &coordinate, &mask, stored.data()) < 0)
       hdf5_format_error("cannot read " + chunk_name(shard, k));
-    return stored;
   }
 
   /// Checks and decompresses stored chunk k of a shard into its place in `payload`.
@@ -433,13 +438,18 @@ struct IndexReader::Impl {
     if (bytes < chunk_bytes) std::memcpy(payload.data() + begin, scratch.data(), bytes);
   }
 
-  std::vector<std::byte> read_shard(std::uint32_t shard) const {
+  void read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const {
     check_shard(shard);
-    std::vector<std::byte> payload(sizes[shard]);
-    if (payload.empty()) return payload;
+    payload.resize(sizes[shard]);
+    if (payload.empty()) return;
     const std::uint64_t first = first_chunk(shard);
     const std::uint64_t count = chunk_count(shard);
-    std::vector<std::byte> scratch;
+    // Buffers kept by the thread: fresh ones made every page-in fault new pages in (a tenth
+    // of a paged flight's main thread in perf).
+    constexpr std::size_t kKeptBufferBytes = std::size_t(1) << 20;
+    thread_local std::vector<std::byte> scratch;
+    thread_local std::vector<std::vector<std::byte>> stored;
+    thread_local std::vector<std::uint32_t> masks;
 
     // One read when the chunks are located and follow each other in the file (small holes
     // allowed); otherwise each chunk through HDF5's direct chunk read (a B-tree lookup), with
@@ -457,28 +467,29 @@ struct IndexReader::Impl {
       stored_total += location.stored_bytes;
     }
     if (one_read && high - low <= stored_total + kMaxHoleBytes) {
-      std::vector<std::byte> stored(high - low);
-      pread_all(stored.data(), stored.size(), low, "shard " + std::to_string(shard));
+      stored.resize(1);
+      stored[0].resize(high - low);
+      pread_all(stored[0].data(), stored[0].size(), low, "shard " + std::to_string(shard));
       for (std::uint64_t k = 0; k < count; ++k) {
         const ChunkLocation& location = chunks[first + k];
         decode_into(shard, k,
-                    std::span<const std::byte>(stored).subspan(location.address - low,
-                                                               location.stored_bytes),
+                    std::span<const std::byte>(stored[0]).subspan(location.address - low,
+                                                                  location.stored_bytes),
                     location.filter_mask, payload, scratch);
       }
-      return payload;
+      if (stored[0].capacity() > kKeptBufferBytes) std::vector<std::byte>().swap(stored[0]);  // a rare large shard
+      return;
     }
     // Every chunk of the shard read in one turn, then decoded: HDF5 takes its global lock in
     // each call, and with two threads paging in, the lock's hand-overs between calls (a
     // futex wake and a context switch each) cost more than LZ4 (tetrapage_bench_index).
-    std::vector<std::vector<std::byte>> stored(count);
-    std::vector<std::uint32_t> masks(count);
+    if (stored.size() < count) stored.resize(count);
+    masks.resize(count);
     {
       const std::lock_guard lock(chunk_read_mutex());
-      for (std::uint64_t k = 0; k < count; ++k) stored[k] = read_stored_chunk(shard, k, masks[k]);
+      for (std::uint64_t k = 0; k < count; ++k) read_stored_chunk(shard, k, masks[k], stored[k]);
     }
     for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload, scratch);
-    return payload;
   }
 
   /// Held over a page-in's direct chunk reads; one for the process, as HDF5's lock is.
@@ -701,7 +712,13 @@ std::vector<StoredChunk> IndexReader::shard_chunks(std::uint32_t shard) const {
 }
 
 std::vector<std::byte> IndexReader::read_shard(std::uint32_t shard) const {
-  return impl_->read_shard(shard);
+  std::vector<std::byte> payload;
+  impl_->read_shard(shard, payload);
+  return payload;
+}
+
+void IndexReader::read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const {
+  impl_->read_shard(shard, payload);
 }
 
 std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard) const {

@@ -47,7 +47,12 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   cache_ = std::make_unique<ShardCache<Shard>>(
       options_.memory_budget_bytes,
       [reader](std::uint32_t shard) {
-        return std::make_shared<const Shard>(Shard::decode(reader->read_shard(shard), "shard " + std::to_string(shard)));
+        // One payload buffer per loading thread: the decoded shard keeps copies of its arrays.
+        thread_local std::vector<std::byte> payload;
+        reader->read_shard(shard, payload);
+        auto decoded = std::make_shared<const Shard>(Shard::decode(payload, "shard " + std::to_string(shard)));
+        if (payload.capacity() > (std::size_t(1) << 20)) std::vector<std::byte>().swap(payload);  // a rare large shard
+        return decoded;
       },
       shards, [this](std::uint32_t shard) { return shard_bytes_[shard]; }, cache_options);
 }

@@ -81,6 +81,9 @@ class IndexReader {
   ///        that does not decompress to the chunk size, or a chunk past the end of the file.
   /// @throw IoError if the operating system fails the read.
   std::vector<std::byte> read_shard(std::uint32_t shard) const;
+  /// The same into `payload` (resized to the shard's payload), reusing its capacity: a page-in
+  /// loop that keeps one buffer per thread touches no fresh memory. Same errors.
+  void read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const;
 
   /// The same payload through H5Dread of the shard's byte range (HDF5 checks and decompresses,
   /// under its global lock, with the LZ4 filter plugin that the HDF Group distributes). For
