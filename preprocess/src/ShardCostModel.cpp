@@ -11,24 +11,26 @@
 
 namespace tetrapage {
 
-// Measured by bench/runtime/ShardBench.cpp on the build machine (2 x 2.6 GHz shared cores,
-// load ~6), CPU time, three runs each:
+// Measured by bench/runtime/ShardBench.cpp on the build machine (2 cores, idle), CPU time,
+// three runs each, on 2026-11-22 with index format 3 (the runtime's shard queries and page-ins
+// as they are then):
 //  BM_CostFit (non-negative least squares over 45 workloads per kind: 3 regions x 5 query
 //  extents x 3 layouts, median of 5 x 512 queries each):
-//    grid:  407, 371, 407 ns per query; 20.8, 21.2, 20.6 ns per reference; per cell and per
+//    grid:  401, 407, 436 ns per query; 17.1, 17.5, 17.8 ns per reference; per cell and per
 //           candidate indistinguishable from 0 (fitted 0; a cell visit is an empty-list read)
-//    rtree: 0 ns per query; 31.4, 32.0, 31.7 ns per node; 14.9, 14.4, 14.4 ns per reference
-//  BM_PageIn (zlib inflate of the level-4 deflated payload + Shard::decode, per decoded
-//  byte): 4.1 to 6.7 ns (median 5.7).
+//    rtree: 0 ns per query; 25.1, 28.0, 28.1 ns per node; 12.7, 13.0, 13.8 ns per reference
+//  BM_PageIn (IndexReader::read_shard of a one-shard index in the page cache, LZ4, and
+//  Shard::decode, per decoded byte): 0.42 to 0.93 ns, median of the six workloads 0.61 in
+//  both runs. Format 2's deflate, and zlib level 4 before it, made this 5.7 ns.
 // The cell cost is set to 1 ns (not the fitted 0) so that finer grids are never free.
 ShardCostModel::ShardCostModel()
-    : seconds_per_grid_query(400e-9),
+    : seconds_per_grid_query(407e-9),
       seconds_per_cell(1e-9),
-      seconds_per_grid_reference(21e-9),
+      seconds_per_grid_reference(17.5e-9),
       seconds_per_rtree_query(0),
-      seconds_per_node(32e-9),
-      seconds_per_rtree_reference(14.5e-9),
-      seconds_per_byte(5.7e-9) {}
+      seconds_per_node(28e-9),
+      seconds_per_rtree_reference(13e-9),
+      seconds_per_byte(0.6e-9) {}
 
 namespace {
 
