@@ -141,9 +141,15 @@ class CopyBucket {
       : soups_(soups.spilled() ? nullptr : &soups) {
     if (soups_ == nullptr) records_.emplace(std::move(file));
   }
+  /// Whether the bucket keeps (id, tet) pairs (the soups are in memory), else records.
+  bool holds_pairs() const { return !records_; }
   void append(std::span<const TriangleRecord> copies) {
     if (records_) return records_->append(copies);
     for (const TriangleRecord& copy : copies) pairs_.push_back({copy.id, copy.tet});
+  }
+  void append(std::span<const CopyPair> copies) {
+    if (records_) throw Error("a bucket that spills records was given (id, tet) pairs");
+    pairs_.insert(pairs_.end(), copies.begin(), copies.end());
   }
   /// The copies, taken out of the bucket (which is then empty, its spill file removed).
   BucketCopies take() {
@@ -568,14 +574,22 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   summary.spilled = in.soups.spilled();
   {
     StageClock clock(summary, "binning");
+    // The copies as the buckets keep them: (id, tet) pairs while the soups are in memory (a
+    // record of 88 bytes made and then read back for each copy was a serial tenth of binning),
+    // else records for the spill files.
+    const bool pairs = buckets.front().holds_pairs();
     struct ThreadState {
       BinningScratch scratch;
       std::vector<std::uint32_t> tets;
       std::vector<std::vector<TriangleRecord>> out;
+      std::vector<std::vector<CopyPair>> out_pairs;
     };
     tbb::enumerable_thread_specific<ThreadState> states([&] {
       ThreadState s;
-      s.out.resize(bucket_count);
+      if (pairs)
+        s.out_pairs.resize(bucket_count);
+      else
+        s.out.resize(bucket_count);
       return s;
     });
     const std::size_t block_records =
@@ -601,6 +615,10 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                             s.tets.clear();
                             bin_triangle(mesh, block[i].triangle, s.scratch, s.tets);
                             for (const std::uint32_t t : s.tets) {
+                              if (pairs) {
+                                s.out_pairs[bucket_of[t]].push_back({block[i].id, t});
+                                continue;
+                              }
                               TriangleRecord copy = block[i];
                               copy.tet = t;
                               s.out[bucket_of[t]].push_back(copy);
@@ -609,8 +627,13 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                         });
       for (auto& s : states) {
         for (std::size_t b = 0; b < bucket_count; ++b) {
-          buckets[b].append(s.out[b]);
-          s.out[b].clear();
+          if (pairs) {
+            buckets[b].append(std::span<const CopyPair>(s.out_pairs[b]));
+            s.out_pairs[b].clear();
+          } else {
+            buckets[b].append(std::span<const TriangleRecord>(s.out[b]));
+            s.out[b].clear();
+          }
         }
       }
       progress.advance(block.size());
