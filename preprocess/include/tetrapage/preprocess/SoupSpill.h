@@ -52,6 +52,22 @@ class SoupSpill {
     pieces_.push_back(std::move(piece));
   }
 
+  /// The soups held in memory (none once spilled()), one piece per append, in input order:
+  /// piece p holds the records of ids piece_first_id(p) .. + piece_size(p) - 1.
+  std::size_t piece_count() const { return pieces_.size(); }
+  std::size_t piece_size(std::size_t p) const { return pieces_[p].triangles.size(); }
+  std::uint64_t piece_first_id(std::size_t p) const { return pieces_[p].first_id; }
+  /// Record t of piece p (t < piece_size(p)), its `tet` zero: only while not spilled().
+  Record piece_record(std::size_t p, std::size_t t) const {
+    const Piece& piece = pieces_[p];
+    const auto& corners = piece.triangles[t];
+    Record record{};
+    record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]], piece.vertices[corners[2]]};
+    record.id = piece.first_id + t;
+    record.part = piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
+    return record;
+  }
+
   /// The record of triangle `id` (< size()), read in memory: only while not spilled().
   Record record(std::uint64_t id) const {
     // The last piece that starts at or before id.
