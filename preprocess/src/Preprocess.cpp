@@ -290,6 +290,21 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   if (in.seen == 0) throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
 }
 
+// The in-memory soups cut into tasks of at most kTaskTriangles consecutive triangles of one
+// piece, for the passes that visit every triangle on all threads.
+struct InMemoryTask {
+  std::size_t piece, first, count;
+};
+constexpr std::size_t kTaskTriangles = std::size_t(1) << 15;
+
+std::vector<InMemoryTask> in_memory_tasks(const SoupSpill<TriangleRecord>& soups) {
+  std::vector<InMemoryTask> tasks;
+  for (std::size_t p = 0; p < soups.piece_count(); ++p)
+    for (std::size_t first = 0; first < soups.piece_size(p); first += kTaskTriangles)
+      tasks.push_back({p, first, std::min(kTaskTriangles, soups.piece_size(p) - first)});
+  return tasks;
+}
+
 // The interiors: each tet's reference point classified against the closed parts, as CSR
 // tables by tet (see docs/FORMAT.md), exactly, by vertical ray parity (RayParity.h) over one
 // stream of the records per pass.
@@ -373,15 +388,36 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       for (const std::uint32_t p : pass) asked[p] = std::move(of_part[p]);
       RayParity parity(points, asked);
       asked.clear();
-      in.soups.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 2048),
+      if (!in.soups.spilled()) {
+        // In memory: the soups cut into tasks, the triangles of parts not asked about skipped
+        // before their records are made (blocks of every record, made on one thread, were a
+        // third of this stage).
+        std::vector<InMemoryTask> tasks = in_memory_tasks(in.soups);
+        std::mutex progress_mutex;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 1),
                           [&](const tbb::blocked_range<std::size_t>& range) {
-                            for (std::size_t i = range.begin(); i < range.end(); ++i)
-                              if (parity.wanted(block[i].part))
-                                parity.add_triangle(block[i].part, block[i].triangle);
+                            for (std::size_t k = range.begin(); k < range.end(); ++k) {
+                              const InMemoryTask& task = tasks[k];
+                              for (std::size_t t = task.first; t < task.first + task.count; ++t) {
+                                const std::uint32_t part = in.soups.piece_part(task.piece, t);
+                                if (parity.wanted(part))
+                                  parity.add_triangle(part, in.soups.piece_record(task.piece, t).triangle);
+                              }
+                              const std::lock_guard lock(progress_mutex);
+                              progress.advance(task.count);
+                            }
                           });
-        progress.advance(block.size());
-      });
+      } else {
+        in.soups.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 2048),
+                            [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t i = range.begin(); i < range.end(); ++i)
+                                if (parity.wanted(block[i].part))
+                                  parity.add_triangle(block[i].part, block[i].triangle);
+                            });
+          progress.advance(block.size());
+        });
+      }
       parity.for_each_answer([&](std::uint32_t t, std::uint32_t p, bool odd, bool on_surface) {
         if (on_surface)
           undecided[t] = 1;
@@ -625,19 +661,12 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
       // binned by one thread in its own Morton order, its pairs appended as it ends. Binning
       // block by block (a block per soup, 745 at 10M) made both threads wait at every block's
       // end while one built the next block and appended the last one's copies.
-      constexpr std::size_t kTaskTriangles = std::size_t(1) << 15;
-      struct Task {
-        std::size_t piece, first, count;
-      };
-      std::vector<Task> tasks;
-      for (std::size_t p = 0; p < in.soups.piece_count(); ++p)
-        for (std::size_t first = 0; first < in.soups.piece_size(p); first += kTaskTriangles)
-          tasks.push_back({p, first, std::min(kTaskTriangles, in.soups.piece_size(p) - first)});
+      const std::vector<InMemoryTask> tasks = in_memory_tasks(in.soups);
       std::mutex append_mutex;
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tasks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
         ThreadState& s = states.local();
         for (std::size_t k = range.begin(); k < range.end(); ++k) {
-          const Task& task = tasks[k];
+          const InMemoryTask& task = tasks[k];
           s.records.resize(task.count);
           s.order.resize(task.count);
           for (std::size_t i = 0; i < task.count; ++i) {

@@ -57,6 +57,11 @@ class SoupSpill {
   std::size_t piece_count() const { return pieces_.size(); }
   std::size_t piece_size(std::size_t p) const { return pieces_[p].triangles.size(); }
   std::uint64_t piece_first_id(std::size_t p) const { return pieces_[p].first_id; }
+  /// The part of record t of piece p (its `part`), without the rest of the record.
+  std::uint32_t piece_part(std::size_t p, std::size_t t) const {
+    const Piece& piece = pieces_[p];
+    return piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
+  }
   /// Record t of piece p (t < piece_size(p)), its `tet` zero: only while not spilled().
   Record piece_record(std::size_t p, std::size_t t) const {
     const Piece& piece = pieces_[p];
