@@ -490,6 +490,11 @@ struct IndexReader::Impl {
       for (std::uint64_t k = 0; k < count; ++k) read_stored_chunk(shard, k, masks[k], stored[k]);
     }
     for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload, scratch);
+    constexpr std::size_t kKeptChunks = kKeptBufferBytes / 16384;
+    if (stored.size() > kKeptChunks) {  // a rare large shard: keep a megabyte's worth
+      stored.resize(kKeptChunks);
+      stored.shrink_to_fit();
+    }
   }
 
   /// Held over a page-in's direct chunk reads; one for the process, as HDF5's lock is.

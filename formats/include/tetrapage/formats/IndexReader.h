@@ -82,7 +82,8 @@ class IndexReader {
   /// @throw IoError if the operating system fails the read.
   std::vector<std::byte> read_shard(std::uint32_t shard) const;
   /// The same into `payload` (resized to the shard's payload), reusing its capacity: a page-in
-  /// loop that keeps one buffer per thread touches no fresh memory. Same errors.
+  /// loop that keeps one buffer per thread touches no fresh memory. Same errors; after one,
+  /// `payload`'s bytes are unspecified.
   void read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const;
 
   /// The same payload through H5Dread of the shard's byte range (HDF5 checks and decompresses,
