@@ -31,8 +31,8 @@ namespace {
 
 constexpr std::uint32_t kMinChunkBytes = 1024;
 constexpr std::uint32_t kMaxChunkBytes = 64u << 20;
-// /shards/data is stored as 8-byte little-endian words (the shuffle filter's element).
-constexpr std::uint64_t kWordBytes = 8;
+// /shards/data is stored as 8-byte little-endian words: the shuffle's element (ChunkCodec.h).
+constexpr std::uint64_t kWordBytes = detail::kShuffleElementBytes;
 /// Chunks of the mesh and table datasets hold about this many bytes.
 constexpr std::uint64_t kTableChunkBytes = 256 * 1024;
 

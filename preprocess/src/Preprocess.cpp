@@ -155,11 +155,10 @@ class CopyBucket {
       : soups_(soups.spilled() ? nullptr : &soups) {
     if (soups_ == nullptr) records_.emplace(std::move(file));
   }
-  /// Whether the bucket keeps (id, tet) pairs (the soups are in memory), else records.
-  bool holds_pairs() const { return !records_; }
+  /// Records while the soups are spilled; (id, tet) pairs while they are in memory.
   void append(std::span<const TriangleRecord> copies) {
-    if (records_) return records_->append(copies);
-    for (const TriangleRecord& copy : copies) pairs_.push_back({copy.id, copy.tet});
+    if (!records_) throw Error("a bucket of (id, tet) pairs was given records");
+    records_->append(copies);
   }
   void append(std::span<const CopyPair> copies) {
     if (records_) throw Error("a bucket that spills records was given (id, tet) pairs");
@@ -234,8 +233,9 @@ LoadedSoup load_soup(const InputPiece& piece) {
 // How many soups the ingest's pipeline may hold at once. One more than the threads left both
 // threads idle whenever the in-order append waited for a slow file; four times the threads
 // took the 10M ingest from 0.91 to 0.72 s. Bounded so that the soups in flight, taken at 4
-// times their files' bytes (a loaded soup with its centroids and edge parity is about that),
-// stay within an eighth of the budget.
+// times their files' bytes, stay within an eighth of the budget. (A loaded soup holds double
+// vertices, indices and a double centroid a triangle: by arithmetic about 2.6 times a binary
+// PLY of float vertices, less for double ones; not measured for every reader.)
 std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memory_bytes, std::size_t threads) {
   std::uint64_t largest = 0;
   for (const InputPiece& job : jobs) {
@@ -650,7 +650,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     // The copies as the buckets keep them: (id, tet) pairs while the soups are in memory (a
     // record of 88 bytes made and then read back for each copy was a serial tenth of binning),
     // else records for the spill files.
-    const bool pairs = buckets.front().holds_pairs();
+    const bool pairs = !in.soups.spilled();  // what the buckets keep (CopyBucket)
     struct ThreadState {
       BinningScratch scratch;
       std::vector<std::uint32_t> tets;

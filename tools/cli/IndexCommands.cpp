@@ -177,7 +177,7 @@ void run_inspect(const InspectArguments& args) {
 
 // Everything an index promises, checked; returns the problems found.
 std::vector<std::string> validate_index(const IndexReader& reader) {
-  // Every shard decoded as the reader checks its chunks (one read and inflation of the data);
+  // Every shard decoded as the reader checks its chunks (one read and decompression of the data);
   // what the tables must agree with is kept.
   struct Decoded {
     std::uint32_t triangles = 0;

@@ -24,7 +24,7 @@ struct ShardCostModel {
   double seconds_per_rtree_query;      ///< fixed cost of an R-tree query
   double seconds_per_node;             ///< per R-tree node whose box is tested
   double seconds_per_rtree_reference;  ///< per triangle in a visited leaf
-  double seconds_per_byte;             ///< per payload byte paged in (inflate and decode)
+  double seconds_per_byte;             ///< per payload byte paged in (read, decompress, decode)
   /// Queries a shard answers, on average, each time it is paged in: a property of the scene
   /// and the memory budget, not of the machine.
   double queries_per_page_in = 256;

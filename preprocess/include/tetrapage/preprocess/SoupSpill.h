@@ -58,20 +58,9 @@ class SoupSpill {
   std::size_t piece_size(std::size_t p) const { return pieces_[p].triangles.size(); }
   std::uint64_t piece_first_id(std::size_t p) const { return pieces_[p].first_id; }
   /// The part of record t of piece p (its `part`), without the rest of the record.
-  std::uint32_t piece_part(std::size_t p, std::size_t t) const {
-    const Piece& piece = pieces_[p];
-    return piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
-  }
+  std::uint32_t piece_part(std::size_t p, std::size_t t) const { return part_of(pieces_[p], t); }
   /// Record t of piece p (t < piece_size(p)), its `tet` zero: only while not spilled().
-  Record piece_record(std::size_t p, std::size_t t) const {
-    const Piece& piece = pieces_[p];
-    const auto& corners = piece.triangles[t];
-    Record record{};
-    record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]], piece.vertices[corners[2]]};
-    record.id = piece.first_id + t;
-    record.part = piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
-    return record;
-  }
+  Record piece_record(std::size_t p, std::size_t t) const { return record_of(pieces_[p], t); }
 
   /// The record of triangle `id` (< size()), read in memory: only while not spilled().
   Record record(std::uint64_t id) const {
@@ -79,14 +68,7 @@ class SoupSpill {
     const auto piece_it = std::upper_bound(pieces_.begin(), pieces_.end(), id,
                                            [](std::uint64_t i, const Piece& p) { return i < p.first_id; }) -
                           1;
-    const Piece& piece = *piece_it;
-    const std::size_t t = std::size_t(id - piece.first_id);
-    const auto& corners = piece.triangles[t];
-    Record record{};
-    record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]], piece.vertices[corners[2]]};
-    record.id = id;
-    record.part = piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
-    return record;
+    return record_of(*piece_it, std::size_t(id - piece_it->first_id));
   }
 
   /// Moves what is held in memory to `file` and spills from now on.
@@ -110,16 +92,8 @@ class SoupSpill {
       const std::size_t n = piece.triangles.size();
       for (std::size_t first = 0; first < n; first += block_records) {
         const std::size_t count = std::min(block_records, n - first);
-        block.assign(count, Record{});
-        for (std::size_t i = 0; i < count; ++i) {
-          const std::size_t t = first + i;
-          const auto& corners = piece.triangles[t];
-          Record& record = block[i];
-          record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]],
-                             piece.vertices[corners[2]]};
-          record.id = piece.first_id + t;
-          record.part = piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
-        }
+        block.resize(count);
+        for (std::size_t i = 0; i < count; ++i) block[i] = record_of(piece, first + i);
         visit(std::span<const Record>(block));
       }
     };
@@ -156,6 +130,18 @@ class SoupSpill {
              part_of.size() * sizeof(std::uint32_t);
     }
   };
+  static std::uint32_t part_of(const Piece& piece, std::size_t t) {
+    return piece.part_offset + (piece.part_of.empty() ? 0 : piece.part_of[t]);
+  }
+  // Record t of a piece, its `tet` (and anything else) zero.
+  static Record record_of(const Piece& piece, std::size_t t) {
+    const auto& corners = piece.triangles[t];
+    Record record{};
+    record.triangle = {piece.vertices[corners[0]], piece.vertices[corners[1]], piece.vertices[corners[2]]};
+    record.id = piece.first_id + t;
+    record.part = part_of(piece, t);
+    return record;
+  }
   struct Header {
     std::uint64_t first_id, vertices, triangles, parts;
     std::uint32_t part_offset, unused;

@@ -19,7 +19,8 @@ struct BinningScratch {
   std::vector<std::uint32_t> queue;
   std::uint64_t tet_tests = 0;  ///< exact triangle/tet tests run
   /// The face planes of tet `planes_tet` (most triangles test their corners against the same
-  /// tet as the last one) and the sign of its orientation.
+  /// tet as the last one) and the sign of its orientation. Keyed by their own tet, not taken to
+  /// be `hint`'s, so that a caller moving the hint cannot make them stale.
   std::uint32_t planes_tet = TetMesh::no_neighbour;
   std::optional<std::array<geometry::OrientedPlane, 4>> planes;
   geometry::Sign orientation = geometry::Sign::zero;
