@@ -262,6 +262,40 @@ GridIndex build_grid(const std::vector<Triangle>& triangles, const Box& bounds,
 // of their centres into groups of full subtrees, so every leaf but the last of a parent is
 // full and triangles end up in tree order.
 
+/// Rearranges distinct keys so that keys[k] is the k-th smallest, with the smaller ones before
+/// it and the larger ones after: std::nth_element's contract. A quickselect whose partition
+/// has no branch on the data (Lomuto's, with the comparison's result as the step): the cuts
+/// are on nearly random keys, where std::nth_element's branches mispredicted half the time.
+void select_nth(std::span<std::uint64_t> keys, std::size_t k) {
+  std::size_t lo = 0, hi = keys.size();
+  while (hi - lo > 16) {
+    // Median of three as the pivot, moved to lo.
+    const std::size_t mid = lo + (hi - lo) / 2;
+    std::uint64_t a = keys[lo], b = keys[mid], c = keys[hi - 1];
+    if (a > b) std::swap(a, b);
+    if (b > c) std::swap(b, c);
+    if (a > b) std::swap(a, b);
+    const std::size_t p = b == keys[lo] ? lo : (b == keys[mid] ? mid : hi - 1);
+    std::swap(keys[lo], keys[p]);
+    const std::uint64_t pivot = keys[lo];
+    std::size_t smaller = lo + 1;  // [lo + 1, smaller) < pivot <= [smaller, j)
+    for (std::size_t j = lo + 1; j < hi; ++j) {
+      const std::uint64_t x = keys[j];
+      keys[j] = keys[smaller];
+      keys[smaller] = x;
+      smaller += x < pivot;
+    }
+    std::swap(keys[lo], keys[smaller - 1]);  // the pivot at its rank
+    const std::size_t rank = smaller - 1;
+    if (rank == k) return;
+    if (k < rank)
+      hi = rank;
+    else
+      lo = rank + 1;
+  }
+  std::sort(keys.begin() + std::ptrdiff_t(lo), keys.begin() + std::ptrdiff_t(hi));
+}
+
 struct RtreeNode {
   Box box;  ///< relative coordinates (stored values)
   std::uint32_t first = 0;
@@ -273,24 +307,24 @@ class RtreeBuilder {
   RtreeBuilder(const std::vector<Box>& relative_boxes, std::uint32_t leaf_size,
                std::uint32_t fanout)
       : boxes_(relative_boxes), leaf_size_(leaf_size), fanout_(fanout) {
-    items_.reserve(boxes_.size());
-    for (std::uint32_t t = 0; t < boxes_.size(); ++t) items_.push_back({boxes_[t].center(), t});
+    centres_.reserve(boxes_.size());
+    order_.resize(boxes_.size());
+    for (std::uint32_t t = 0; t < boxes_.size(); ++t) {
+      centres_.push_back(boxes_[t].center());
+      order_[t] = t;
+    }
   }
 
   void build() {
-    const std::uint64_t n = items_.size();
+    const std::uint64_t n = order_.size();
     std::uint32_t height = 0;
     for (std::uint64_t capacity = leaf_size_; capacity < n; capacity *= fanout_) ++height;
     nodes_.resize(1);
     build_node(0, 0, std::uint32_t(n), height);
   }
 
-  std::vector<std::uint32_t> order() const {
-    std::vector<std::uint32_t> order;
-    order.reserve(items_.size());
-    for (const Item& item : items_) order.push_back(item.triangle);
-    return order;
-  }
+  /// The triangles in tree order (each leaf's in increasing number).
+  const std::vector<std::uint32_t>& order() const { return order_; }
   std::vector<RtreeNode>& nodes() { return nodes_; }
 
  private:
@@ -298,7 +332,8 @@ class RtreeBuilder {
                   std::uint32_t height) {
     Box box;
     if (height == 0) {
-      for (std::uint32_t i = begin; i < end; ++i) box.extend(boxes_[items_[i].triangle]);
+      std::sort(order_.begin() + begin, order_.begin() + end);
+      for (std::uint32_t i = begin; i < end; ++i) box.extend(boxes_[order_[i]]);
       nodes_[index] = {box, begin, (end - begin) | shard_format::kLeafFlag};
       return;
     }
@@ -316,6 +351,12 @@ class RtreeBuilder {
     nodes_[index] = {box, first, std::uint32_t(groups.size())};
   }
 
+  // A float's bits as an unsigned integer of the same order (negative values reversed).
+  static std::uint32_t ordered_bits(float value) {
+    const auto bits = std::bit_cast<std::uint32_t>(value);
+    return bits & 0x8000'0000u ? ~bits : bits | 0x8000'0000u;
+  }
+
   void split(std::uint32_t begin, std::uint32_t end, std::uint32_t groups, std::uint64_t capacity,
              std::vector<std::pair<std::uint32_t, std::uint32_t>>& out) {
     if (groups == 1) {
@@ -325,26 +366,28 @@ class RtreeBuilder {
     const std::uint32_t left = groups / 2;
     const auto middle = std::uint32_t(begin + left * capacity);
     Box spread;
-    for (std::uint32_t i = begin; i < end; ++i) spread.extend(items_[i].centre);
+    for (std::uint32_t i = begin; i < end; ++i) spread.extend(centres_[order_[i]]);
     const Point size = spread.size();
     const int axis = size[0] >= size[1] ? (size[0] >= size[2] ? 0 : 2) : (size[1] >= size[2] ? 1 : 2);
-    // The centres travel with the triangle numbers: the comparisons read memory in order.
-    std::nth_element(items_.begin() + begin, items_.begin() + middle, items_.begin() + end,
-                     [&](const Item& a, const Item& b) {
-                       const double ca = a.centre[axis], cb = b.centre[axis];
-                       return ca < cb || (ca == cb && a.triangle < b.triangle);
-                     });
+    // The cut needs no more than the centres' order along the axis: the centre in float and
+    // the triangle number in one integer, whose selection is a third of the time of
+    // (double centre, triangle) records with a comparison function.
+    keys_.resize(end - begin);
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const std::uint32_t t = order_[i];
+      keys_[i - begin] = std::uint64_t(ordered_bits(float(centres_[t][axis]))) << 32 | t;
+    }
+    select_nth(std::span<std::uint64_t>(keys_), middle - begin);
+    for (std::uint32_t i = begin; i < end; ++i) order_[i] = std::uint32_t(keys_[i - begin]);
     split(begin, middle, left, capacity, out);
     split(middle, end, groups - left, capacity, out);
   }
 
-  struct Item {
-    Point centre;
-    std::uint32_t triangle;
-  };
   const std::vector<Box>& boxes_;
   std::uint32_t leaf_size_, fanout_;
-  std::vector<Item> items_;  ///< in tree order once built
+  std::vector<Point> centres_;         ///< per triangle
+  std::vector<std::uint32_t> order_;   ///< the triangles, in tree order once built
+  std::vector<std::uint64_t> keys_;    ///< a cut's scratch
   std::vector<RtreeNode> nodes_;
 };
 

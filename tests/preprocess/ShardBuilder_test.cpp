@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstring>
 #include <map>
+#include <numeric>
 #include <string>
 #include <thread>
 #include <tuple>
@@ -417,6 +418,39 @@ TEST(ShardBuilder, UsesCompactWidthsWhereTheyFit) {
   const Shard shard = Shard::decode(built.payload);
   for (std::uint32_t t = 0; t < shard.triangle_count(); ++t) EXPECT_EQ(shard.part_id(t), 5u);
   EXPECT_LE(built.vertex_count, 3 * built.triangle_count);
+}
+
+TEST(ShardBuilder, RtreeLeavesAreMedianCutsAlongTheLongestSide) {
+  // Tiny triangles with centres at distinct x (in shuffled input order) along a long thin box:
+  // every cut is along x, so, in tree order, leaf k holds exactly the triangles of x ranks
+  // 16k .. 16k + 15 (every leaf but the last full), each leaf's in input order. A selection
+  // that cut anywhere else still answers queries right, which the brute-force tests cannot see.
+  for (const std::size_t n : {std::size_t(17), std::size_t(389), std::size_t(2048), std::size_t(3001)}) {
+    Random r(n);
+    std::vector<std::size_t> rank_of(n);
+    std::iota(rank_of.begin(), rank_of.end(), 0);
+    for (std::size_t i = n; i > 1; --i) std::swap(rank_of[i - 1], rank_of[r.below(std::uint32_t(i))]);
+    Region region;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = double(rank_of[i]) - 0.25 * double(n);  // negative and positive centres
+      const double y = r.uniform(-0.1, 0.1), z = r.uniform(-0.1, 0.1);
+      region.triangles.push_back({Point{x, y, z}, Point{x + 0.01, y, z}, Point{x, y + 0.01, z}});
+      region.ids.push_back(i);
+      region.parts.push_back(0);
+    }
+    ShardLayout layout;
+    layout.rtree_leaf_size = 16;
+    const BuiltShard built = build_shard(region.view(), ShardKind::rtree, StoredPrecision::float64, layout);
+    const Shard shard = Shard::decode(built.payload);
+    ASSERT_EQ(shard.triangle_count(), n);
+    for (std::uint32_t t = 0; t < n; ++t) {
+      const std::size_t input = shard.triangle_id(t);
+      EXPECT_EQ(rank_of[input] / 16, t / 16) << "n " << n << " stored triangle " << t;
+      if (t % 16 != 0) {
+        EXPECT_GT(input, shard.triangle_id(t - 1)) << "n " << n << " stored triangle " << t;
+      }
+    }
+  }
 }
 
 TEST(ShardCostModel, BothKindsFindTheSameCandidatesAndTheChoiceIsTheCheaper) {
