@@ -125,6 +125,41 @@ struct CopyPair {
 };
 #pragma pack(pop)
 
+// A counting sort of copies by their tet's rank: where each copy goes (target), and where each
+// tet's copies start (with their count last).
+template <class Copy>
+std::vector<std::size_t> place_copies_by_tet(const std::vector<Copy>& copies, std::span<const std::uint32_t> rank,
+                                             std::vector<std::uint32_t>& target) {
+  if (copies.size() >= std::numeric_limits<std::uint32_t>::max())
+    throw InputError("a bucket of " + std::to_string(copies.size()) +
+                     " triangle copies is beyond 2^32: give a smaller --memory, for more buckets");
+  target.resize(copies.size());
+  std::vector<std::size_t> group_start;
+  if (!copies.empty()) {
+    std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
+    for (const Copy& c : copies) {
+      lowest = std::min(lowest, rank[c.tet]);
+      highest = std::max(highest, rank[c.tet]);
+    }
+    std::vector<std::size_t> next(std::size_t(highest - lowest) + 2, 0);
+    for (const Copy& c : copies) ++next[rank[c.tet] - lowest + 1];
+    std::partial_sum(next.begin(), next.end(), next.begin());
+    for (std::size_t k = 0; k + 1 < next.size(); ++k)
+      if (next[k + 1] > next[k]) group_start.push_back(next[k]);
+    for (std::size_t i = 0; i < copies.size(); ++i) target[i] = std::uint32_t(next[rank[copies[i].tet] - lowest]++);
+  }
+  group_start.push_back(copies.size());
+  return group_start;
+}
+
+// Sorts each group [start[g], start[g + 1]) of `values` by `less`, on all threads.
+template <class Value, class Less>
+void sort_groups(std::vector<Value>& values, const std::vector<std::size_t>& start, Less less) {
+  tbb::parallel_for(std::size_t(0), start.size() - 1, [&](std::size_t g) {
+    std::sort(values.begin() + std::ptrdiff_t(start[g]), values.begin() + std::ptrdiff_t(start[g + 1]), less);
+  });
+}
+
 // One bucket's copies as the shard stage reads them: records read back from a spill file, or
 // (id, tet) pairs whose records the soups give when a shard gathers its triangles (a bucket's
 // records, 88 bytes a copy, are then never all held: at 10M they were 1.1 GB).
@@ -133,20 +168,50 @@ class BucketCopies {
   explicit BucketCopies(std::vector<TriangleRecord> records) : records_(std::move(records)) {}
   BucketCopies(std::vector<CopyPair> pairs, const SoupSpill<TriangleRecord>& soups)
       : soups_(&soups), pairs_(std::move(pairs)) {}
-  std::size_t size() const { return soups_ ? pairs_.size() : records_.size(); }
-  std::uint32_t tet(std::size_t i) const { return soups_ ? pairs_[i].tet : records_[i].tet; }
-  std::uint64_t id(std::size_t i) const { return soups_ ? pairs_[i].id : records_[i].id; }
-  TriangleRecord record(std::size_t i) const {
-    if (!soups_) return records_[i];
-    TriangleRecord record = soups_->record(pairs_[i].id);
-    record.tet = pairs_[i].tet;
-    return record;
+  /// Orders the copies by their tet's rank, each tet's by id; returns where each tet's copies
+  /// start in that order, and their count last. The pairs are moved into that order (a second
+  /// array, 12 bytes a copy: the sorts and gathers then read them in order, where reading them
+  /// through positions was a cache miss each); the records, 88 bytes, are read through positions.
+  std::vector<std::size_t> order_by_tet(std::span<const std::uint32_t> rank) {
+    std::vector<std::uint32_t> target;
+    if (!soups_) {
+      const std::vector<std::size_t> start = place_copies_by_tet(records_, rank, target);
+      order_.resize(records_.size());
+      for (std::size_t i = 0; i < records_.size(); ++i) order_[target[i]] = std::uint32_t(i);
+      sort_groups(order_, start, [&](std::uint32_t a, std::uint32_t b) { return records_[a].id < records_[b].id; });
+      return start;
+    }
+    const std::vector<std::size_t> start = place_copies_by_tet(pairs_, rank, target);
+    std::vector<CopyPair> placed(pairs_.size());
+    for (std::size_t i = 0; i < pairs_.size(); ++i) placed[target[i]] = pairs_[i];
+    pairs_.swap(placed);
+    sort_groups(pairs_, start, [](const CopyPair& a, const CopyPair& b) { return a.id < b.id; });
+    return start;
+  }
+  /// The tet of the i-th copy in order_by_tet's order.
+  std::uint32_t tet(std::size_t i) const { return soups_ ? pairs_[i].tet : records_[order_[i]].tet; }
+  /// Appends the triangles, ids and parts of copies [first, last) of order_by_tet's order.
+  void gather(std::size_t first, std::size_t last, std::vector<geometry::Triangle>& triangles,
+              std::vector<std::uint64_t>& ids, std::vector<std::uint32_t>& parts) const {
+    if (soups_) {
+      const std::size_t had = ids.size();
+      for (std::size_t i = first; i < last; ++i) ids.push_back(pairs_[i].id);
+      soups_->gather(std::span<const std::uint64_t>(ids).subspan(had), triangles, parts);
+      return;
+    }
+    for (std::size_t i = first; i < last; ++i) {
+      const TriangleRecord& record = records_[order_[i]];
+      triangles.push_back(record.triangle);
+      ids.push_back(record.id);
+      parts.push_back(record.part);
+    }
   }
 
  private:
   const SoupSpill<TriangleRecord>* soups_ = nullptr;
   std::vector<TriangleRecord> records_;
   std::vector<CopyPair> pairs_;
+  std::vector<std::uint32_t> order_;  ///< of the records
 };
 
 class CopyBucket {
@@ -767,33 +832,10 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     const ShardCostModel cost_model;
     Progress progress("building shards", tet_count, options.progress);
     for (auto& bucket : buckets) {
-      const BucketCopies copies = bucket.take();
-      // The copies in (tet rank, id) order, as indices: a counting sort by rank, then each
-      // tet's own by id, in parallel.
-      if (copies.size() >= std::numeric_limits<std::uint32_t>::max())
-        throw InputError("a bucket of " + std::to_string(copies.size()) +
-                         " triangle copies is beyond 2^32: give a smaller --memory, for more buckets");
-      std::vector<std::uint32_t> sorted(copies.size());
-      std::vector<std::size_t> group_start;
-      if (copies.size() > 0) {
-        std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
-        for (std::size_t i = 0; i < copies.size(); ++i) {
-          lowest = std::min(lowest, rank[copies.tet(i)]);
-          highest = std::max(highest, rank[copies.tet(i)]);
-        }
-        std::vector<std::size_t> next(std::size_t(highest - lowest) + 2, 0);
-        for (std::size_t i = 0; i < copies.size(); ++i) ++next[rank[copies.tet(i)] - lowest + 1];
-        std::partial_sum(next.begin(), next.end(), next.begin());
-        for (std::size_t k = 0; k + 1 < next.size(); ++k)
-          if (next[k + 1] > next[k]) group_start.push_back(next[k]);
-        for (std::size_t i = 0; i < copies.size(); ++i) sorted[next[rank[copies.tet(i)] - lowest]++] = std::uint32_t(i);
-      }
-      const std::size_t groups = group_start.size();
-      group_start.push_back(copies.size());
-      tbb::parallel_for(std::size_t(0), groups, [&](std::size_t g) {
-        std::sort(sorted.begin() + std::ptrdiff_t(group_start[g]), sorted.begin() + std::ptrdiff_t(group_start[g + 1]),
-                  [&](std::uint32_t a, std::uint32_t b) { return copies.id(a) < copies.id(b); });
-      });
+      BucketCopies copies = bucket.take();
+      // The copies in (tet rank, id) order: each tet's then lie side by side.
+      const std::vector<std::size_t> group_start = copies.order_by_tet(rank);
+      const std::size_t groups = group_start.size() - 1;
       // Built and compressed on all threads, appended in order on one while the others build
       // on: a pipeline with a few shards in flight (the bucket's shards are never all held).
       struct Ready {
@@ -822,14 +864,10 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                     triangles.reserve(last - first);
                     ids.reserve(last - first);
                     parts.reserve(last - first);
-                    for (std::size_t i = first; i < last; ++i) {
-                      const TriangleRecord record = copies.record(sorted[i]);
-                      triangles.push_back(record.triangle);
-                      ids.push_back(record.id);
-                      parts.push_back(record.part);
-                      for (const auto& p : record.triangle) ready->bounds.extend(p);
-                    }
-                    ready->tet = copies.tet(sorted[first]);
+                    copies.gather(first, last, triangles, ids, parts);
+                    for (const geometry::Triangle& t : triangles)
+                      for (const auto& p : t) ready->bounds.extend(p);
+                    ready->tet = copies.tet(first);
                     const ShardTriangles region{triangles, ids, parts};
                     if (options.shard == ShardChoice::automatic) {
                       ShardCostReport costs =

@@ -1,6 +1,6 @@
 // SoupSpill: the ingested soups read back as records, the same in memory and spilled (also when
-// the spill starts midway), ids and parts offset as asked, blocks of any size; a damaged or
-// truncated spill file is a clear error; nothing is left on disk.
+// the spill starts midway), ids and parts offset as asked, blocks of any size, gathers of any
+// ids in memory; a damaged or truncated spill file is a clear error; nothing is left on disk.
 
 #include "tetrapage/preprocess/SoupSpill.h"
 
@@ -69,6 +69,23 @@ TEST(SoupSpill, RecordsAreTheSameInMemoryAndSpilledMidway) {
         EXPECT_EQ(got[i].id, expected[i].id) << i;
         EXPECT_EQ(got[i].part, expected[i].part) << i;
         EXPECT_EQ(got[i].tet, 0u) << i;
+      }
+    }
+    if (!spill.spilled()) {
+      // Gathers of ascending ids, within a soup and across soups, every id and none.
+      std::vector<std::vector<std::uint64_t>> id_sets{{}, {0}, {3, 4, 5}, {9, 10, 34, 35, 36, 75}};
+      id_sets.emplace_back();
+      for (std::uint64_t id = 0; id < expected.size(); ++id) id_sets.back().push_back(id);
+      for (const auto& ids : id_sets) {
+        std::vector<std::array<Vec3, 3>> triangles{expected[1].triangle};  // appended to
+        std::vector<std::uint32_t> parts{77};
+        spill.gather(std::span<const std::uint64_t>(ids), triangles, parts);
+        ASSERT_EQ(triangles.size(), ids.size() + 1);
+        ASSERT_EQ(parts.size(), ids.size() + 1);
+        for (std::size_t i = 0; i < ids.size(); ++i) {
+          EXPECT_EQ(triangles[i + 1], expected[ids[i]].triangle) << ids[i];
+          EXPECT_EQ(parts[i + 1], expected[ids[i]].part) << ids[i];
+        }
       }
     }
     // Appending after a read goes on at the end.
