@@ -24,7 +24,7 @@ using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 
 // Median split along the longest side of the centroids' own box; appends one site per leaf.
-void split(std::vector<Vec3>& points, std::size_t begin, std::size_t end, std::size_t leaf,
+void split(std::span<Vec3> points, std::size_t begin, std::size_t end, std::size_t leaf,
            std::vector<Vec3>& sites) {
   if (end - begin <= leaf) {
     Vec3 mean{0, 0, 0};
@@ -76,15 +76,14 @@ BoundingBox enlarged_bounds(const BoundingBox& bounds, double margin) {
   return out;
 }
 
-std::vector<Vec3> sample_sites(std::span<const Vec3> centroids, const BoundingBox& bounds,
+std::vector<Vec3> sample_sites(std::span<Vec3> centroids, const BoundingBox& bounds,
                                const SamplingOptions& options) {
   if (centroids.empty()) throw InputError("sampling: the model has no triangle");
   for (int a = 0; a < 3; ++a)
     if (!std::isfinite(bounds.lo[a]) || !std::isfinite(bounds.hi[a]))
       throw InputError("sampling: the model's bounds are not finite");
-  std::vector<Vec3> points(centroids.begin(), centroids.end());
   std::vector<Vec3> sites;
-  split(points, 0, points.size(), std::max<std::size_t>(1, options.leaf_triangles), sites);
+  split(centroids, 0, centroids.size(), std::max<std::size_t>(1, options.leaf_triangles), sites);
   const BoundingBox box = enlarged_bounds(bounds, options.margin);
   for (int i = 0; i < 8; ++i)
     sites.push_back({(i & 1) ? box.hi[0] : box.lo[0], (i & 2) ? box.hi[1] : box.lo[1],

@@ -126,29 +126,55 @@ struct CopyPair {
 #pragma pack(pop)
 
 // A counting sort of copies by their tet's rank: where each copy goes (target), and where each
-// tet's copies start (with their count last).
+// tet's copies start (with their count last). Stable, on all threads: fixed chunks of the
+// copies count their ranks, and each chunk's copies of a rank go after those of the chunks
+// before it (done on one thread, this was a serial 0.05 s at the start of the 10M shard stage).
 template <class Copy>
 std::vector<std::size_t> place_copies_by_tet(const std::vector<Copy>& copies, std::span<const std::uint32_t> rank,
                                              std::vector<std::uint32_t>& target) {
-  if (copies.size() >= std::numeric_limits<std::uint32_t>::max())
-    throw InputError("a bucket of " + std::to_string(copies.size()) +
+  const std::size_t n = copies.size();
+  if (n >= std::numeric_limits<std::uint32_t>::max())
+    throw InputError("a bucket of " + std::to_string(n) +
                      " triangle copies is beyond 2^32: give a smaller --memory, for more buckets");
-  target.resize(copies.size());
+  target.resize(n);
   std::vector<std::size_t> group_start;
-  if (!copies.empty()) {
-    std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
-    for (const Copy& c : copies) {
-      lowest = std::min(lowest, rank[c.tet]);
-      highest = std::max(highest, rank[c.tet]);
+  if (n > 0) {
+    const std::size_t chunks = std::min<std::size_t>(16, (n + 65535) / 65536);
+    const auto first_of = [&](std::size_t c) { return c * n / chunks; };
+    std::vector<std::uint32_t> chunk_lowest(chunks), chunk_highest(chunks);
+    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
+      std::uint32_t lowest = std::numeric_limits<std::uint32_t>::max(), highest = 0;
+      for (std::size_t i = first_of(c); i < first_of(c + 1); ++i) {
+        lowest = std::min(lowest, rank[copies[i].tet]);
+        highest = std::max(highest, rank[copies[i].tet]);
+      }
+      chunk_lowest[c] = lowest;
+      chunk_highest[c] = highest;
+    });
+    const std::uint32_t lowest = *std::min_element(chunk_lowest.begin(), chunk_lowest.end());
+    const std::size_t ranks = std::size_t(*std::max_element(chunk_highest.begin(), chunk_highest.end()) - lowest) + 1;
+    // next[c * ranks + r]: chunk c's count of rank lowest + r, then where its next one goes.
+    std::vector<std::uint32_t> next(chunks * ranks, 0);
+    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
+      std::uint32_t* count = next.data() + c * ranks;
+      for (std::size_t i = first_of(c); i < first_of(c + 1); ++i) ++count[rank[copies[i].tet] - lowest];
+    });
+    std::uint32_t placed = 0;
+    for (std::size_t r = 0; r < ranks; ++r) {
+      const std::uint32_t start = placed;
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const std::uint32_t count = next[c * ranks + r];
+        next[c * ranks + r] = placed;
+        placed += count;
+      }
+      if (placed > start) group_start.push_back(start);
     }
-    std::vector<std::size_t> next(std::size_t(highest - lowest) + 2, 0);
-    for (const Copy& c : copies) ++next[rank[c.tet] - lowest + 1];
-    std::partial_sum(next.begin(), next.end(), next.begin());
-    for (std::size_t k = 0; k + 1 < next.size(); ++k)
-      if (next[k + 1] > next[k]) group_start.push_back(next[k]);
-    for (std::size_t i = 0; i < copies.size(); ++i) target[i] = std::uint32_t(next[rank[copies[i].tet] - lowest]++);
+    tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
+      std::uint32_t* at = next.data() + c * ranks;
+      for (std::size_t i = first_of(c); i < first_of(c + 1); ++i) target[i] = at[rank[copies[i].tet] - lowest]++;
+    });
   }
-  group_start.push_back(copies.size());
+  group_start.push_back(n);
   return group_start;
 }
 
@@ -177,13 +203,17 @@ class BucketCopies {
     if (!soups_) {
       const std::vector<std::size_t> start = place_copies_by_tet(records_, rank, target);
       order_.resize(records_.size());
-      for (std::size_t i = 0; i < records_.size(); ++i) order_[target[i]] = std::uint32_t(i);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, records_.size(), 1 << 16), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i < range.end(); ++i) order_[target[i]] = std::uint32_t(i);
+      });
       sort_groups(order_, start, [&](std::uint32_t a, std::uint32_t b) { return records_[a].id < records_[b].id; });
       return start;
     }
     const std::vector<std::size_t> start = place_copies_by_tet(pairs_, rank, target);
     std::vector<CopyPair> placed(pairs_.size());
-    for (std::size_t i = 0; i < pairs_.size(); ++i) placed[target[i]] = pairs_[i];
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pairs_.size(), 1 << 16), [&](const auto& range) {
+      for (std::size_t i = range.begin(); i < range.end(); ++i) placed[target[i]] = pairs_[i];
+    });
     pairs_.swap(placed);
     sort_groups(pairs_, start, [](const CopyPair& a, const CopyPair& b) { return a.id < b.id; });
     return start;
@@ -622,6 +652,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     summary.region_triangles =
         options.region_triangles != 0 ? options.region_triangles : auto_region_triangles(triangle_count);
     sampling.leaf_triangles = std::max<std::size_t>(1, std::size_t(std::llround(double(summary.region_triangles) * share)));
+    // Reorders the sample (the buckets' estimate below takes any every-stride-th of it).
     const std::vector<Vec3> sites = sample_sites(in.sample, in.bounds, sampling);
     summary.sites = sites.size();
     mesh = build_coarse_mesh(sites);

@@ -34,7 +34,7 @@ std::vector<Vec3> clustered_centroids(std::uint64_t seed, std::size_t count) {
 }
 
 TEST(SampleSites, OneSitePerLeafPlusTheBoxCorners) {
-  const auto centroids = clustered_centroids(3, 20000);
+  auto centroids = clustered_centroids(3, 20000);
   BoundingBox bounds;
   for (const auto& c : centroids) bounds.extend(c);
   SamplingOptions options;
@@ -97,7 +97,7 @@ TEST(SampleSites, TheSameSitesInTheSameOrderAsTheSerialSplit) {
 TEST(CoarseMesh, IsAValidDelaunayTilingOfTheEnlargedBox) {
   const std::uint64_t seed = 11;
   SCOPED_TRACE("seed " + std::to_string(seed));
-  const auto centroids = clustered_centroids(seed, 5000);
+  auto centroids = clustered_centroids(seed, 5000);
   BoundingBox bounds;
   for (const auto& c : centroids) bounds.extend(c);
   SamplingOptions options;

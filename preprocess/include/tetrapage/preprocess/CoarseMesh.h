@@ -21,9 +21,10 @@ struct SamplingOptions {
 
 /// Sites for the coarse mesh: the mean centroid of each leaf of a median split of the
 /// centroids (split along the longest side until a leaf holds at most leaf_triangles), plus
-/// the eight corners of the enlarged bounding box.
+/// the eight corners of the enlarged bounding box. The split reorders `centroids` in place
+/// (they are the preprocess's sample, up to 96 MB: a copy was a serial twentieth of a second).
 /// @throw InputError if there is no centroid or the bounds are not finite.
-std::vector<Vec3> sample_sites(std::span<const Vec3> centroids, const BoundingBox& bounds,
+std::vector<Vec3> sample_sites(std::span<Vec3> centroids, const BoundingBox& bounds,
                                const SamplingOptions& options);
 
 /// The enlarged box whose corners bound the coarse mesh.
