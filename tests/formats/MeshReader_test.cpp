@@ -505,21 +505,24 @@ TEST(MeshReader, DegenerateTrianglesAreDroppedAndCounted) {
 }
 
 TEST(MeshReader, IsDegenerateTriangleAgreesWithExactRationalArithmetic) {
-  // Oracle: the cross product in exact rationals is zero iff the corners are collinear.
+  // Oracle: the cross product in exact rationals is zero iff the corners are collinear. At
+  // unit scale and at the extremes of double (products that underflow or overflow), where
+  // the inline filter must hand over to the exact test.
   using Q = CGAL::Exact_rational;
   Random random(20240611);
   int collinear = 0;
   for (int trial = 0; trial < 4000; ++trial) {
+    const double scale = trial % 3 == 0 ? 1.0 : (trial % 3 == 1 ? 0x1p-1000 : 0x1p+600);
     Vec3 a, b, c;
-    for (auto& x : a) x = random.uniform(-1, 1);
-    for (auto& x : b) x = random.uniform(-1, 1);
+    for (auto& x : a) x = scale * random.uniform(-1, 1);
+    for (auto& x : b) x = scale * random.uniform(-1, 1);
     if (trial % 2 == 0) {
       // On the line through a and b up to rounding: sometimes exactly, mostly not.
       const double t = trial % 4 == 0 ? 0.5 : random.uniform(-2, 2);
       for (int k = 0; k < 3; ++k) c[k] = a[k] + t * (b[k] - a[k]);
       if (trial % 8 == 0) c = a;  // coincident corners
     } else {
-      for (auto& x : c) x = random.uniform(-1, 1);
+      for (auto& x : c) x = scale * random.uniform(-1, 1);
     }
     const Q u[3] = {Q(b[0]) - Q(a[0]), Q(b[1]) - Q(a[1]), Q(b[2]) - Q(a[2])};
     const Q v[3] = {Q(c[0]) - Q(a[0]), Q(c[1]) - Q(a[1]), Q(c[2]) - Q(a[2])};
@@ -530,6 +533,19 @@ TEST(MeshReader, IsDegenerateTriangleAgreesWithExactRationalArithmetic) {
   }
   EXPECT_GT(collinear, 100);  // the test did exercise both answers
   EXPECT_LT(collinear, 3900);
+  // Exactly collinear corners whose differences round: a and b on the line x = 3y = 3z / 5
+  // through the origin c, at magnitudes 2^50 apart, so that (b - a) is inexact and the cross
+  // product in double is often not zero.
+  int rounded_nonzero = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    const double k1 = std::ldexp(double(random.below(std::uint64_t(1) << 50) + 1), 0);
+    const double k2 = std::ldexp(double(random.below(std::uint64_t(1) << 50) + 1), -50);
+    const Vec3 a{3 * k1, k1, 5 * k1}, b{3 * k2, k2, 5 * k2}, c{0, 0, 0};
+    const double ux = b[0] - a[0], uy = b[1] - a[1], vx = c[0] - a[0], vy = c[1] - a[1];
+    rounded_nonzero += ux * vy - uy * vx != 0;
+    ASSERT_TRUE(is_degenerate_triangle(a, b, c)) << "trial " << trial;
+  }
+  EXPECT_GT(rounded_nonzero, 0);  // the filter's error bound was needed
 }
 
 TEST(MeshReader, MissingFileAndUnknownExtension) {
