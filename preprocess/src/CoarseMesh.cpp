@@ -47,7 +47,7 @@ void split(std::span<Vec3> points, std::size_t begin, std::size_t end, std::size
                    points.begin() + long(end),
                    [axis](const Vec3& a, const Vec3& b) { return a[axis] < b[axis]; });
   // The halves are disjoint ranges: large ones split on two threads (the sample holds up to
-  // 4M centroids, and this was a serial 0.4 s of the 10M preprocess), their sites appended
+  // 2M centroids, 4M when this was a serial 0.4 s of the 10M preprocess), their sites appended
   // left then right as the serial recursion does.
   constexpr std::size_t kParallelPoints = std::size_t(1) << 16;
   if (end - begin < kParallelPoints) {

@@ -364,8 +364,13 @@ std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memo
 void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
             const std::filesystem::path& spill_folder, Ingest& in, PreprocessSummary& summary) {
   const std::uint64_t held_limit = options.memory_bytes / 4;
+  // At most 2M centroids, at least 2^16: a site stands for the mean of hundreds of sampled
+  // centroids at the default region size. A cap of 4M gave the 10M scene the same regions
+  // (26,081 against 26,071), duplication (1.2623 against 1.2630) and flights in memory (six
+  // objects, four runs each, within their noise) at twice the coarse mesh's time; 1M began to
+  // show in the flights (the tetrahedron's 7 % slower; docs/BENCHMARKS.md).
   const std::size_t sample_capacity = std::size_t(
-      std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 22));
+      std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 21));
   in.sample.reserve(std::min<std::size_t>(sample_capacity, 1 << 16));
   std::mt19937_64 random(0x7e7a9a9e);
 

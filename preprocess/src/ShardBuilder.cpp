@@ -114,6 +114,7 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
   g.relative.reserve(input.size());
   g.corners.resize(input.size());
   g.triangles.resize(input.size());
+  double max_squared = 0;
   for (std::size_t t = 0; t < input.size(); ++t)
     for (int c = 0; c < 3; ++c) {
       const Point& v = input[t][c];
@@ -130,7 +131,7 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
         stored[k] = o[k] + r[k];
         squared += (stored[k] - v[k]) * (stored[k] - v[k]);
       }
-      g.max_rounding_distance = std::max(g.max_rounding_distance, std::sqrt(squared));
+      max_squared = std::max(max_squared, squared);
       g.triangles[t][c] = stored;
       const VertexKey key{{std::bit_cast<std::uint64_t>(r[0]), std::bit_cast<std::uint64_t>(r[1]),
                            std::bit_cast<std::uint64_t>(r[2])}};
@@ -150,6 +151,7 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
       }
       g.corners[t][c] = table[slot];
     }
+  g.max_rounding_distance = std::sqrt(max_squared);  // the same as the largest root
   return g;
 }
 
