@@ -199,6 +199,11 @@ TEST(Shard, NamesTheFieldAtFault) {
   float shrunk = 0.5f;  // the root no longer encloses leaf 2
   std::memcpy(bad.data() + at + 12, &shrunk, 4);
   EXPECT_NE(message(bad).find("does not enclose"), std::string::npos) << message(bad);
+  bad = tiny_shard(ShardKind::rtree);
+  float lowered = 0.25f;  // leaf 2's top below its triangle 1's corner at z 0.5
+  std::memcpy(bad.data() + at + 2 * 32 + 20, &lowered, 4);
+  EXPECT_NE(message(bad).find("box of R-tree leaf 2"), std::string::npos) << message(bad);
+  EXPECT_NE(message(bad).find("does not enclose its triangle 1"), std::string::npos) << message(bad);
 }
 
 TEST(ShardKind, NamesRoundTrip) {
