@@ -407,13 +407,8 @@ struct IndexReader::Impl {
   /// are far below): a larger claim is damage, not a size to allocate.
   std::uint64_t max_stored_bytes() const { return 2 * std::uint64_t(chunk_bytes) + 64; }
 
-  /// The stored bytes of one chunk and its filter mask, through HDF5's direct chunk read.
-  std::vector<std::byte> read_stored_chunk(std::uint32_t shard, std::uint64_t k,
-                                           std::uint32_t& mask) const {
-    std::vector<std::byte> stored;
-    read_stored_chunk(shard, k, mask, stored);
-    return stored;
-  }
+  /// The stored bytes of one chunk (into `stored`, reusing its capacity) and its filter mask,
+  /// through HDF5's direct chunk read.
   void read_stored_chunk(std::uint32_t shard, std::uint64_t k, std::uint32_t& mask,
                          std::vector<std::byte>& stored) const {
     hsize_t coordinate = (first_chunk(shard) + k) * chunk_bytes / kWordBytes;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <type_traits>
 #include <array>
 #include <atomic>
 #include <mutex>
@@ -72,6 +73,28 @@ class StageClock {
   std::string name_;
   Clock::time_point start_;
 };
+
+// Runs produce(i) for i = 0 .. count - 1 on all threads, at most `in_flight` at once, and
+// consume(result) on one thread at a time in the order of i: the shape of the ingest, the
+// in-memory binning and the shard stage (work in parallel, results appended in order).
+// produce returns a std::shared_ptr (TBB passes items between filters by copy).
+template <class Produce, class Consume>
+void produce_in_parallel_consume_in_order(std::size_t count, std::size_t in_flight, Produce&& produce,
+                                          Consume&& consume) {
+  using Result = std::invoke_result_t<Produce&, std::size_t>;
+  std::size_t next = 0;
+  tbb::parallel_pipeline(
+      std::max<std::size_t>(in_flight, 1),
+      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
+                                          [&](tbb::flow_control& control) -> std::size_t {
+                                            if (next == count) control.stop();
+                                            return next++;
+                                          }) &
+          tbb::make_filter<std::size_t, Result>(tbb::filter_mode::parallel,
+                                                [&](std::size_t i) { return produce(i); }) &
+          tbb::make_filter<Result, void>(tbb::filter_mode::serial_in_order,
+                                         [&](const Result& result) { consume(result); }));
+}
 
 // Spreads a 21-bit integer's bits three apart (for Morton codes).
 std::uint64_t spread_bits(std::uint64_t x) {
@@ -404,24 +427,14 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   // Parsing, edge parity, bounds and centroids run on all threads, a few soups at once; the
   // soups are appended in input order on one.
   Progress progress("reading parts", jobs.size(), options.progress);
-  std::size_t next = 0;
   const std::size_t in_flight =
       ingest_depth(jobs, options.memory_bytes, std::size_t(tbb::this_task_arena::max_concurrency()));
-  tbb::parallel_pipeline(
-      in_flight,
-      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                          [&](tbb::flow_control& control) -> std::size_t {
-                                            if (next == jobs.size()) control.stop();
-                                            return next++;
-                                          }) &
-          tbb::make_filter<std::size_t, std::shared_ptr<LoadedSoup>>(
-              tbb::filter_mode::parallel,
-              [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); }) &
-          tbb::make_filter<std::shared_ptr<LoadedSoup>, void>(
-              tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<LoadedSoup>& loaded) {
-                add_soup(*loaded);
-                progress.advance();
-              }));
+  produce_in_parallel_consume_in_order(
+      jobs.size(), in_flight, [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); },
+      [&](const std::shared_ptr<LoadedSoup>& loaded) {
+        add_soup(*loaded);
+        progress.advance();
+      });
   progress.finish();
   summary.triangles_read = in.seen;
   summary.parts = in.part_names.size();
@@ -808,16 +821,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         std::vector<std::vector<CopyPair>> by_bucket;
         std::size_t triangles = 0;
       };
-      std::size_t next_task = 0;
-      tbb::parallel_pipeline(
-          4 * std::size_t(tbb::this_task_arena::max_concurrency()),
-          tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                              [&](tbb::flow_control& control) -> std::size_t {
-                                                if (next_task == tasks.size()) control.stop();
-                                                return next_task++;
-                                              }) &
-              tbb::make_filter<std::size_t, std::shared_ptr<TaskPairs>>(
-                  tbb::filter_mode::parallel,
+      produce_in_parallel_consume_in_order(
+          tasks.size(), 4 * std::size_t(tbb::this_task_arena::max_concurrency()),
                   [&](std::size_t k) {
                     ThreadState& s = states.local();
                     const InMemoryTask& task = tasks[k];
@@ -849,13 +854,12 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                         out->by_bucket[bucket_of[s.flat[j]]].push_back({s.records[i].id, s.flat[j]});
                     }
                     return out;
-                  }) &
-              tbb::make_filter<std::shared_ptr<TaskPairs>, void>(
-                  tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<TaskPairs>& out) {
+                  },
+                  [&](const std::shared_ptr<TaskPairs>& out) {
                     for (std::size_t b = 0; b < bucket_count; ++b)
                       buckets[b].append(std::span<const CopyPair>(out->by_bucket[b]));
                     progress.advance(out->triangles);
-                  }));
+                  });
     }
     // Soups spilled: blocks read back from the spill file, each binned by all threads, the
     // copies as records.
@@ -925,16 +929,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
         BoundingBox bounds;
         std::uint32_t tet = 0;
       };
-      std::size_t next_group = 0;
-      tbb::parallel_pipeline(
-          4 * std::size_t(tbb::this_task_arena::max_concurrency()),
-          tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                              [&](tbb::flow_control& control) -> std::size_t {
-                                                if (next_group == groups) control.stop();
-                                                return next_group++;
-                                              }) &
-              tbb::make_filter<std::size_t, std::shared_ptr<Ready>>(
-                  tbb::filter_mode::parallel,
+      produce_in_parallel_consume_in_order(
+          groups, 4 * std::size_t(tbb::this_task_arena::max_concurrency()),
                   [&](std::size_t g) {
                     auto ready = std::make_shared<Ready>();
                     const std::size_t first = group_start[g], last = group_start[g + 1];
@@ -962,9 +958,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                     ready->payload_bytes = ready->built.payload.size();
                     std::vector<std::byte>().swap(ready->built.payload);
                     return ready;
-                  }) &
-              tbb::make_filter<std::shared_ptr<Ready>, void>(
-                  tbb::filter_mode::serial_in_order, [&](const std::shared_ptr<Ready>& ready) {
+                  },
+                  [&](const std::shared_ptr<Ready>& ready) {
                     const BuiltShard& built = ready->built;
                     // Stored vertices lie within the shard's rounding distance of the input
                     // ones: grow the input box by it (and a few ulps) so the runtime can skip
@@ -988,7 +983,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                     summary.max_rounding_distance = std::max(summary.max_rounding_distance, built.max_rounding_distance);
                     (built.kind == ShardKind::grid ? summary.grid_shards : summary.rtree_shards) += 1;
                     progress.advance();
-                  }));
+                  });
     }
     progress.finish();
     in.soups.clear();

@@ -53,10 +53,9 @@ class SoupSpill {
   }
 
   /// The soups held in memory (none once spilled()), one piece per append, in input order:
-  /// piece p holds the records of ids piece_first_id(p) .. + piece_size(p) - 1.
+  /// piece p holds piece_size(p) records of consecutive ids.
   std::size_t piece_count() const { return pieces_.size(); }
   std::size_t piece_size(std::size_t p) const { return pieces_[p].triangles.size(); }
-  std::uint64_t piece_first_id(std::size_t p) const { return pieces_[p].first_id; }
   /// The part of record t of piece p (its `part`), without the rest of the record.
   std::uint32_t piece_part(std::size_t p, std::size_t t) const { return part_of(pieces_[p], t); }
   /// Record t of piece p (t < piece_size(p)), its `tet` zero: only while not spilled().
