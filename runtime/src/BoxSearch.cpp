@@ -1,6 +1,7 @@
 #include "tetrapage/runtime/BoxSearch.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -28,12 +29,75 @@ void extreme_corners(const Box& box, const Sign n[3], Point& highest, Point& low
 constexpr int kEdges[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2},
                               {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};  // edge, then the others
 
+enum class Filtered : std::uint8_t { disjoint, meet, unsure };
+
+// The separating-axis test in double: the tet's four face normals and its six edges times
+// the three axes (the box's own axes are the caller's). An axis decides only where the
+// intervals part, or overlap, by more than a bound far beyond the roundings, which are
+// relative to |axis| |x - origin| (differences round relative to themselves); overlap on
+// every axis means the closed sets meet only for a tet that is certainly not flat.
+Filtered separating_axes_in_double(const Tetrahedron& t, const Box& box) {
+  double scale = 0;
+  for (const Point& p : t)
+    for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(p[a] - t[0][a]));
+  for (int a = 0; a < 3; ++a)
+    scale = std::max({scale, std::fabs(box.lo[a] - t[0][a]), std::fabs(box.hi[a] - t[0][a])});
+  bool sure_overlap = true;
+  // `d` from tet vertex `origin`; `size` bounds |d|_1 including its own rounding's source.
+  auto separates = [&](const Point& d, const Point& origin, double size) {
+    double tet_lo = 0, tet_hi = 0;
+    for (const Point& p : t) {
+      const double x = d[0] * (p[0] - origin[0]) + d[1] * (p[1] - origin[1]) + d[2] * (p[2] - origin[2]);
+      tet_lo = std::min(tet_lo, x), tet_hi = std::max(tet_hi, x);
+    }
+    double box_lo = 0, box_hi = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double l = d[a] * (box.lo[a] - origin[a]), h = d[a] * (box.hi[a] - origin[a]);
+      box_lo += std::min(l, h), box_hi += std::max(l, h);
+    }
+    const double bound = size * scale * 0x1p-40;
+    if (box_lo > tet_hi + bound || tet_lo > box_hi + bound) return true;
+    if (!(box_lo < tet_hi - bound && tet_lo < box_hi - bound)) sure_overlap = false;
+    return false;
+  };
+  for (int k = 0; k < 4; ++k) {
+    const auto& f = kTetrahedronFaces[k];
+    const Point& a = t[f[0]];
+    const Point u{t[f[1]][0] - a[0], t[f[1]][1] - a[1], t[f[1]][2] - a[2]};
+    const Point v{t[f[2]][0] - a[0], t[f[2]][1] - a[1], t[f[2]][2] - a[2]};
+    const Point n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double size = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
+                        (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]));
+    if (separates(n, a, size)) return Filtered::disjoint;
+    // The opposite vertex far off the face's plane: the tet is not flat.
+    const Point& o = t[k];
+    const double height = n[0] * (o[0] - a[0]) + n[1] * (o[1] - a[1]) + n[2] * (o[2] - a[2]);
+    if (!(std::fabs(height) > size * scale * 0x1p-40)) sure_overlap = false;
+  }
+  for (const auto& e : kEdges) {
+    const Point& p = t[e[0]];
+    const Point edge{t[e[1]][0] - p[0], t[e[1]][1] - p[1], t[e[1]][2] - p[2]};
+    const double size = std::fabs(edge[0]) + std::fabs(edge[1]) + std::fabs(edge[2]);
+    // edge x (unit axis k)
+    if (separates({0, edge[2], -edge[1]}, p, size) || separates({-edge[2], 0, edge[0]}, p, size) ||
+        separates({edge[1], -edge[0], 0}, p, size))
+      return Filtered::disjoint;
+  }
+  return sure_overlap ? Filtered::meet : Filtered::unsure;
+}
+
 }  // namespace
 
 bool tetrahedron_intersects_box(const Tetrahedron& t, const Box& box) {
   if (inverted(box) || !boxes_overlap(box_of(t), box)) return false;  // the box's axes
   for (const Point& v : t)
     if (box_contains(box, v)) return true;
+  // Most tets are decided in double; near contact (touching, flat) the exact tests follow.
+  switch (separating_axes_in_double(t, box)) {
+    case Filtered::disjoint: return false;
+    case Filtered::meet: return true;
+    case Filtered::unsure: break;
+  }
 
   const Sign orientation = orient3d(t[0], t[1], t[2], t[3]);
   if (orientation != Sign::zero) {

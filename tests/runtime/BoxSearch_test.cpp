@@ -112,6 +112,57 @@ TEST(TetrahedronBox, AgreesWithCgalAndWithTheKernelsFaceTests) {
   EXPECT_LT(hits, cases - cases / 10);
 }
 
+// Boxes a hair's breadth from a tet: a box with one corner on a face (interior, edge or vertex)
+// and the rest on the face's outer side touches the tet; moved out by 2^-45 or 2^-20 it misses it;
+// moved in by 2^-45, it meets it. Double precision cannot tell the nearest apart, so the answer
+// must come from the exact tests; scaled and moved far from the origin by exact transforms.
+TEST(TetrahedronBox, BoxesAHairFromAFace) {
+  geometry::testing::Disagreements with_cgal("tetrahedron_intersects_box vs CGAL Epeck, near contact");
+  std::uint64_t cases = 0, touching = 0, apart = 0;
+  for (std::uint64_t seed = 0; seed < 3000; ++seed) {
+    Generator g(seed + 1'000'000);
+    Tetrahedron t;
+    for (auto& v : t) v = geometry::testing::lattice_point(g, 3);
+    const geometry::Sign orientation = geometry::orient3d(t[0], t[1], t[2], t[3]);
+    if (orientation == geometry::Sign::zero) continue;
+    const int k = int(g.integer(0, 3));
+    const auto& f = geometry::kTetrahedronFaces[k];
+    const geometry::Triangle face{t[f[0]], t[f[1]], t[f[2]]};
+    const Point p = geometry::testing::dyadic_point_on(g, face, int(g.integer(0, 2)), 8);
+    // The face's outward normal (exact: small integers), away from the opposite vertex.
+    Point n;
+    for (int a = 0; a < 3; ++a) {
+      const int i = (a + 1) % 3, j = (a + 2) % 3;
+      n[a] = (face[1][i] - face[0][i]) * (face[2][j] - face[0][j]) - (face[1][j] - face[0][j]) * (face[2][i] - face[0][i]);
+    }
+    if (n[0] == 0 || n[1] == 0 || n[2] == 0) continue;
+    const double towards_opposite = n[0] * (t[k][0] - p[0]) + n[1] * (t[k][1] - p[1]) + n[2] * (t[k][2] - p[2]);
+    for (auto& x : n) x = towards_opposite > 0 ? -x : x;
+    const auto transform = geometry::testing::random_exact_transform(g, 48);
+    for (const double shift : {0.0, 0x1p-45, -0x1p-45, 0x1p-20}) {
+      Point a, b;
+      for (int axis = 0; axis < 3; ++axis) {
+        const double s = n[axis] > 0 ? 1.0 : -1.0;
+        a[axis] = p[axis] + shift * s;
+        b[axis] = a[axis] + s;
+      }
+      const Tetrahedron placed{transform(t[0]), transform(t[1]), transform(t[2]), transform(t[3])};
+      const Box box = box_between(transform(a), transform(b));
+      const bool got = geometry::tetrahedron_intersects_box(placed, box);
+      ++cases;
+      if (got != cgal_oracle(placed, box))
+        with_cgal.add(seed, describe(placed, box) + (got ? ": said yes" : ": said no") + ", shift " + std::to_string(shift));
+      if (shift == 0 && !got) with_cgal.add(seed, "a box touching the face at a point must meet the tet");
+      if (shift > 0 && got) with_cgal.add(seed, "a box outside the face's plane must miss the tet");
+      touching += shift == 0;
+      apart += shift > 0;
+    }
+  }
+  with_cgal.expect_none(cases);
+  EXPECT_GT(touching, 1000u);
+  EXPECT_GT(apart, 1000u);
+}
+
 TetMesh random_mesh(std::size_t sites, std::uint64_t seed, int exponent, double offset) {
   Generator g(seed);
   auto place = [&](Point p) {
