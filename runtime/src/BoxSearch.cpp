@@ -245,6 +245,9 @@ BoxSearchResult search(const TetMesh& mesh, std::uint32_t start_tet, const geome
       if constexpr (kExact) {
         ++result.exact_tests;
         if (!geometry::tetrahedron_intersects_box(mesh.corners(next), box)) continue;
+      } else {
+        // Sliver tets' boxes reach far beyond them: a face plane keeps most of those out.
+        if (!no_face_separates(mesh.corners(next), box)) continue;
       }
       found.push_back(next);
     }

@@ -263,8 +263,6 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
       reach.hi[a] = std::min(tet_box.hi[a], stored.hi[a]);
     }
     if (!geometry::boxes_overlap(region, reach)) continue;
-    // The search's test is conservative; a shard costs every step a look: decide exactly.
-    if (!geometry::tetrahedron_intersects_box(mesh.corners(tet), region)) continue;
     shards_.push_back(shard);
     shard_reach_.push_back(reach);
   }

@@ -222,6 +222,22 @@ void check_search(const TetMesh& mesh, const Box& box, std::uint32_t walk_start,
   EXPECT_GE(result.exact_tests, result.tets.size());
   visited_per_found += double(result.tets_visited) / double(result.tets.size());
   if (!missed.empty() || !extra.empty()) ++failures;
+
+  // The cheap search (the flying object's region) keeps every tet that meets the box; what it
+  // keeps beyond them has a bounding box that meets it.
+  const BoxSearchResult near = tets_near_box(mesh, start, box, scratch);
+  std::vector<std::uint32_t> near_tets(near.tets.begin(), near.tets.end());
+  std::sort(near_tets.begin(), near_tets.end());
+  std::vector<std::uint32_t> near_missed;
+  std::set_difference(expected.begin(), expected.end(), near_tets.begin(), near_tets.end(),
+                      std::back_inserter(near_missed));
+  EXPECT_TRUE(near_missed.empty()) << what << ": box " << hex(box.lo) << " .. " << hex(box.hi)
+                                   << ": the near search missed " << near_missed.size() << " of "
+                                   << expected.size() << " tets meeting it";
+  for (const std::uint32_t tet : near_tets)
+    EXPECT_TRUE(geometry::boxes_overlap(mesh.bounds(tet), box)) << what << ": near tet " << tet;
+  EXPECT_EQ(near.exact_tests, 0u);
+  if (!near_missed.empty()) ++failures;
 }
 
 TEST(BoxSearch, FindsExactlyTheTetsMeetingTheBoxInRandomMeshes) {
