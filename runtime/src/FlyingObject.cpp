@@ -495,20 +495,27 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // One clock pair around the loop (a free step is a few microseconds; a clock read per shard
   // cost a tenth of it): the tests' time is the loop's less the acquisitions'.
   const auto loop_start = phase_start;
+  // Does this step need shard k? Only if its box meets the shard's reach and, before the shard
+  // is pinned (a page-in is dearer than the test), the object's own box meets it in its frame:
+  // a contact point, or a point of a triangle inside the object, lies in the object and in some
+  // tet of the region, within that tet's reach, and that tet's shard holds the triangle.
+  auto needs = [&](std::size_t k) {
+    return geometry::boxes_overlap(box, shard_reach_[k]) &&
+           ((keep_pins_ && pins_[k]) || meets_own_box(shard_reach_[k], 0));
+  };
   if (index.options().prefetch) {
     // Several shards to page in: the prefetch thread loads them from the last while this
     // thread loads from the first (on two cores, a step entering a new region waits about half).
     hints_.clear();
     for (std::size_t k = 0; k < shards_.size(); ++k)
-      if (geometry::boxes_overlap(box, shard_reach_[k]) && !(keep_pins_ && pins_[k]) &&
-          !index.cache().contains(shards_[k]))
+      if (!(keep_pins_ && pins_[k]) && needs(k) && !index.cache().contains(shards_[k]))
         hints_.push_back(shards_[k]);
     if (hints_.size() > 1) index.cache().prefetch_urgently(std::span(hints_).subspan(1));
   }
   for (std::size_t k = 0; k < shards_.size() && !stop; ++k) {
     const std::uint32_t shard_id = shards_[k];
-    // Shards whose stored triangles cannot meet the box are neither read nor pinned.
-    if (!geometry::boxes_overlap(box, shard_reach_[k])) continue;
+    // Shards whose stored triangles cannot meet the object are neither read nor pinned.
+    if (!needs(k)) continue;
     ++counters.shards_touched;
     ShardCache<Shard>::Pin local_pin;
     ShardCache<Shard>::Pin& pin = keep_pins_ ? pins_[k] : local_pin;
