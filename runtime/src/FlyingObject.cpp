@@ -286,7 +286,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
         hints_.push_back(shards_[k]);
     if (!hints_.empty()) index.cache().prefetch(hints_);
   }
-  if (index.options().prefetch && searched_valid_) {
+  if (index.options().prefetch && index.options().prefetch_ahead && searched_valid_) {
     // The next region, if the motion since the last search goes on.
     geometry::Box next = region;
     const Vec3 now = box.center();

@@ -167,8 +167,9 @@ TEST(FlyingObject, ATightBudgetGivesTheSameAnswersWithinItself) {
   CollisionIndexOptions tight;
   tight.memory_budget_bytes = probe->total_shard_bytes() / 20;  // 5 %
   std::uint64_t peak = 0;
-  for (const bool prefetch : {false, true}) {
-    tight.prefetch = prefetch;
+  for (const int prefetch : {0, 1, 2}) {  // none, the region's shards, and the next region's
+    tight.prefetch = prefetch > 0;
+    tight.prefetch_ahead = prefetch > 1;
     const std::vector<std::uint8_t> paged = fly(world, tight, &peak);
     EXPECT_EQ(paged, unlimited) << "prefetch " << prefetch;
     EXPECT_LE(peak, tight.memory_budget_bytes);

@@ -24,6 +24,7 @@ struct FlyArguments {
   std::string accuracy = "exact";
   bool all_contacts = false;
   bool no_prefetch = false;
+  bool prefetch_ahead = false;
   bool preload = false;
 };
 
@@ -35,6 +36,7 @@ void run_fly(const FlyArguments& args) {
   CollisionIndexOptions index_options;
   index_options.memory_budget_bytes = parse_byte_size(args.memory);
   index_options.prefetch = !args.no_prefetch;
+  index_options.prefetch_ahead = args.prefetch_ahead;
 
   const TriangleSoup object_mesh = read_mesh(args.object);
   const std::vector<Pose> poses = read_poses(args.path);
@@ -112,6 +114,7 @@ void run_fly(const FlyArguments& args) {
                                {"index", args.index.string()},
                                {"accuracy", args.accuracy},
                                {"prefetch", !args.no_prefetch},
+                               {"prefetch_ahead", !args.no_prefetch && args.prefetch_ahead},
                                {"preloaded", args.preload},
                                {"preload_seconds", preload_seconds},
                                {"steps", poses.size()},
@@ -163,6 +166,9 @@ void add_fly_command(CLI::App& app) {
       ->capture_default_str();
   command->add_flag("--all-contacts", args->all_contacts, "Collect every contact pair, not only the first hit");
   command->add_flag("--no-prefetch", args->no_prefetch, "Disable the background prefetcher");
+  command->add_flag("--prefetch-ahead", args->prefetch_ahead,
+                    "Also prefetch the next region along the motion at each region change (a walk and a box "
+                    "search on the flying thread; pays where page-ins wait for a disk)");
   command->add_flag("--preload", args->preload,
                     "Load every shard before the first step (needs --memory of at least the index's shards): "
                     "the all-resident reference; open-to-first-answer then excludes the preload");
