@@ -29,6 +29,23 @@ void extreme_corners(const Box& box, const Sign n[3], Point& highest, Point& low
 constexpr int kEdges[6][4] = {{0, 1, 2, 3}, {0, 2, 1, 3}, {0, 3, 1, 2},
                               {1, 2, 0, 3}, {1, 3, 0, 2}, {2, 3, 0, 1}};  // edge, then the others
 
+// Face k's normal u x v (unnormalised, u and v its edges from its first corner) and
+// |u|_1 |v|_1, which bounds the normal's size and its rounding (relative to |u| |v|, not to
+// |n|, which is tiny for a sliver face).
+struct FaceNormal {
+  Point normal;
+  double size;
+};
+
+FaceNormal face_normal(const Tetrahedron& t, int k) {
+  const auto& f = kTetrahedronFaces[k];
+  const Point& a = t[f[0]];
+  const Point u{t[f[1]][0] - a[0], t[f[1]][1] - a[1], t[f[1]][2] - a[2]};
+  const Point v{t[f[2]][0] - a[0], t[f[2]][1] - a[1], t[f[2]][2] - a[2]};
+  return {{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]},
+          (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) * (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]))};
+}
+
 enum class Filtered : std::uint8_t { disjoint, meet, unsure };
 
 // The separating-axis test in double: the tet's four face normals and its six edges times
@@ -61,13 +78,8 @@ Filtered separating_axes_in_double(const Tetrahedron& t, const Box& box) {
     return false;
   };
   for (int k = 0; k < 4; ++k) {
-    const auto& f = kTetrahedronFaces[k];
-    const Point& a = t[f[0]];
-    const Point u{t[f[1]][0] - a[0], t[f[1]][1] - a[1], t[f[1]][2] - a[2]};
-    const Point v{t[f[2]][0] - a[0], t[f[2]][1] - a[1], t[f[2]][2] - a[2]};
-    const Point n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
-    const double size = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
-                        (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]));
+    const Point& a = t[kTetrahedronFaces[k][0]];
+    const auto [n, size] = face_normal(t, k);
     if (separates(n, a, size)) return Filtered::disjoint;
     // The opposite vertex far off the face's plane: the tet is not flat.
     const Point& o = t[k];
@@ -181,20 +193,14 @@ bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box)
     for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(p[a]));
   for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(box.lo[a]), std::fabs(box.hi[a])});
   for (int k = 0; k < 4; ++k) {
-    const auto& f = geometry::kTetrahedronFaces[k];
-    const geometry::Point& a = t[f[0]];
-    const geometry::Point u{t[f[1]][0] - a[0], t[f[1]][1] - a[1], t[f[1]][2] - a[2]};
-    const geometry::Point v{t[f[2]][0] - a[0], t[f[2]][1] - a[1], t[f[2]][2] - a[2]};
-    geometry::Point n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const geometry::Point& a = t[geometry::kTetrahedronFaces[k][0]];
+    auto [n, size] = geometry::face_normal(t, k);
     const geometry::Point& opposite = t[k];
     const double inside = n[0] * (opposite[0] - a[0]) + n[1] * (opposite[1] - a[1]) + n[2] * (opposite[2] - a[2]);
     if (inside < 0) n = {-n[0], -n[1], -n[2]};
     // The box corner farthest into the tet's side of the plane.
     double reach = 0;
     for (int axis = 0; axis < 3; ++axis) reach += n[axis] * ((n[axis] > 0 ? box.hi[axis] : box.lo[axis]) - a[axis]);
-    // The normal's rounding is relative to |u| |v|, not to |n| (tiny for a sliver face).
-    const double size = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
-                        (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]));
     if (reach < -size * scale * 0x1p-40) return false;
   }
   return true;
