@@ -48,9 +48,11 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
       options_.memory_budget_bytes,
       [reader](std::uint32_t shard) {
         // One payload buffer per loading thread: the decoded shard keeps copies of its arrays.
+        // The checksums guard the payload's boxes on disk: a page-in checks its structure only.
         thread_local std::vector<std::byte> payload;
         reader->read_shard(shard, payload);
-        auto decoded = std::make_shared<const Shard>(Shard::decode(payload, "shard " + std::to_string(shard)));
+        auto decoded = std::make_shared<const Shard>(
+            Shard::decode(payload, "shard " + std::to_string(shard), DecodeChecks::structure));
         if (payload.capacity() > (std::size_t(1) << 20)) std::vector<std::byte>().swap(payload);  // a rare large shard
         return decoded;
       },

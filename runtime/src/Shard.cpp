@@ -169,7 +169,7 @@ bool shard_format::grid_cell_range(double lo, double cell_size, std::uint32_t ce
   return true;
 }
 
-Shard Shard::decode(std::span<const std::byte> payload, std::string_view context) {
+Shard Shard::decode(std::span<const std::byte> payload, std::string_view context, DecodeChecks checks) {
   namespace sf = shard_format;
   const Reader in(payload, context);
   if (payload.size() < sf::kHeaderBytes)
@@ -181,6 +181,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   if (version != sf::kVersion)
     in.fail("version", version, "this reader knows version " + std::to_string(sf::kVersion));
 
+  const bool check_boxes = checks == DecodeChecks::full;
   Shard shard;
   const auto kind = in.at<std::uint8_t>(6);
   if (kind > 1) in.fail("kind", unsigned(kind), "0 grid or 1 rtree");
@@ -248,14 +249,15 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
         in.array<double>(begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
   // The stored vertices, kept for the R-tree's leaf checks below (cheaper than each
   // triangle's box there: a vertex is shared by about six triangles).
-  std::vector<geometry::Point> stored(vertex_count);
+  std::vector<geometry::Point> stored;
+  if (check_boxes && shard.kind_ == ShardKind::rtree) stored.resize(vertex_count);
   for (std::uint32_t v = 0; v < vertex_count; ++v) {
     const geometry::Point p = shard.precision_ == StoredPrecision::float32
                                   ? shard.stored_vertex<float>(v)
                                   : shard.stored_vertex<double>(v);
     if (!finite(p)) in.fail("stored vertex", v, "its coordinates are not finite");
     shard.bounds_.extend(p);
-    stored[v] = p;
+    if (!stored.empty()) stored[v] = p;
   }
 
   // Triangles.
@@ -396,10 +398,11 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
         for (std::uint32_t t = node.first; t < node.first + count; ++t) {
           if (covered[t]) in.fail("triangle " + std::to_string(t), "", "in two R-tree leaves");
           covered[t] = 1;
-          for (int k = 0; k < 3; ++k)
-            if (!geometry::box_contains(node.box, stored[shard.corner(t, k)]))
-              in.fail("box of R-tree leaf " + std::to_string(i), "",
-                      "does not enclose its triangle " + std::to_string(t));
+          if (check_boxes)
+            for (int k = 0; k < 3; ++k)
+              if (!geometry::box_contains(node.box, stored[shard.corner(t, k)]))
+                in.fail("box of R-tree leaf " + std::to_string(i), "",
+                        "does not enclose its triangle " + std::to_string(t));
         }
         leaf_triangles += count;
       } else {
@@ -423,7 +426,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
       in.fail("triangles in R-tree leaves", leaf_triangles,
               "must equal triangle_count " + std::to_string(triangle_count));
     // Parents enclose children: checked after every box is read.
-    for (std::uint32_t i = 0; i < structure_count; ++i) {
+    for (std::uint32_t i = 0; i < structure_count && check_boxes; ++i) {
       const Node& node = shard.nodes_[i];
       if (node.count & sf::kLeafFlag) continue;
       for (std::uint32_t c = node.first; c < node.first + node.count; ++c)

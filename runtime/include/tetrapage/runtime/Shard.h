@@ -68,13 +68,26 @@ struct ShardQueryCounters {
   std::uint64_t candidates = 0;  ///< triangles passed to visit
 };
 
+/// What Shard::decode checks beyond the payload's structure.
+enum class DecodeChecks {
+  /// Also that each R-tree box encloses its triangles and its children, which the answers
+  /// rely on: for `tetrapage validate`, tests and payloads of unknown origin.
+  full,
+  /// What memory safety and termination rely on only (every count, offset, index, the
+  /// R-tree's shape, finite coordinates): for page-ins of an index whose writer guarantees
+  /// the boxes and whose checksums guard them on disk. The box checks were 40 % of a decode.
+  structure,
+};
+
 class Shard {
  public:
-  /// Decodes and validates a payload: every count, offset, index and box is checked, so a
-  /// corrupted payload throws instead of crashing or looping.
+  /// Decodes and validates a payload: every count, offset and index is checked, so a
+  /// corrupted payload throws instead of crashing or looping, and with DecodeChecks::full
+  /// every box too.
   /// @param context names the payload in error messages (e.g. "model.tpi shard 17").
   /// @throw FormatError naming the field at fault and its value.
-  static Shard decode(std::span<const std::byte> payload, std::string_view context = "shard");
+  static Shard decode(std::span<const std::byte> payload, std::string_view context = "shard",
+                      DecodeChecks checks = DecodeChecks::full);
 
   ShardKind kind() const { return kind_; }
   StoredPrecision precision() const { return precision_; }
