@@ -43,16 +43,21 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   read_interiors(where);
   ShardCacheOptions cache_options;
   cache_options.prefetch_threads = options_.prefetch ? std::max<std::size_t>(1, options_.prefetch_threads) : 0;
+  if (options_.shard_arena) {
+    const std::uint64_t most = std::min(options_.memory_budget_bytes, total_shard_bytes_);
+    arena_ = std::make_unique<ShardArena>(std::size_t(most + most / 8));
+  }
   const IndexReader* reader = &reader_;
+  std::pmr::memory_resource* memory = arena_.get();
   cache_ = std::make_unique<ShardCache<Shard>>(
       options_.memory_budget_bytes,
-      [reader](std::uint32_t shard) {
+      [reader, memory](std::uint32_t shard) {
         // One payload buffer per loading thread: the decoded shard keeps copies of its arrays.
         // The checksums guard the payload's boxes on disk: a page-in checks its structure only.
         thread_local std::vector<std::byte> payload;
         reader->read_shard(shard, payload);
         auto decoded = std::make_shared<const Shard>(
-            Shard::decode(payload, "shard " + std::to_string(shard), DecodeChecks::structure));
+            Shard::decode(payload, "shard " + std::to_string(shard), DecodeChecks::structure, memory));
         if (payload.capacity() > (std::size_t(1) << 20)) std::vector<std::byte>().swap(payload);  // a rare large shard
         return decoded;
       },

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/runtime/ShardArena.h"
 
 namespace tetrapage {
 
@@ -57,18 +58,18 @@ class Reader {
     return value;
   }
 
-  /// Copies `count` values of `T` from a section, which must hold them.
+  /// Copies `count` values of `T` from a section, which must hold them, into `values` (in
+  /// its own memory resource).
   template <class T>
-  std::vector<T> array(std::size_t offset, std::size_t end, std::uint64_t count,
-                       const char* section) const {
+  void array(std::pmr::vector<T>& values, std::size_t offset, std::size_t end, std::uint64_t count,
+             const char* section) const {
     const std::uint64_t available = end - offset;  // end >= offset is checked by the caller
     if (count > available / sizeof(T))
       fail(std::string("section ") + section + " holds " + std::to_string(available) +
            " bytes, fewer than " + std::to_string(count) + " values of " +
            std::to_string(sizeof(T)) + " bytes");
-    std::vector<T> values(count);
+    values.resize(count);
     if (count > 0) std::memcpy(values.data(), payload_.data() + offset, count * sizeof(T));
-    return values;
   }
 
   std::size_t size() const { return payload_.size(); }
@@ -136,8 +137,27 @@ std::uint32_t Shard::part_id(std::uint32_t local) const {
   }
 }
 
+Shard::Shard(std::pmr::memory_resource* memory)
+    : vertices32_(memory),
+      vertices64_(memory),
+      indices16_(memory),
+      indices32_(memory),
+      id_offsets32_(memory),
+      id_offsets64_(memory),
+      part_palette_(memory),
+      part_indices_(memory),
+      cell_offsets_(memory),
+      references16_(memory),
+      references32_(memory),
+      nodes_(memory) {}
+
 std::size_t Shard::memory_bytes() const {
-  auto bytes = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  auto bytes = [](const auto& v) {
+    const std::size_t requested = v.capacity() * sizeof(v[0]);
+    return dynamic_cast<const ShardArena*>(v.get_allocator().resource()) != nullptr
+               ? ShardArena::block_bytes(requested)
+               : requested;
+  };
   return sizeof(Shard) + bytes(vertices32_) + bytes(vertices64_) + bytes(indices16_) +
          bytes(indices32_) + bytes(id_offsets32_) + bytes(id_offsets64_) + bytes(part_palette_) +
          bytes(part_indices_) + bytes(cell_offsets_) + bytes(references16_) +
@@ -169,7 +189,8 @@ bool shard_format::grid_cell_range(double lo, double cell_size, std::uint32_t ce
   return true;
 }
 
-Shard Shard::decode(std::span<const std::byte> payload, std::string_view context, DecodeChecks checks) {
+Shard Shard::decode(std::span<const std::byte> payload, std::string_view context, DecodeChecks checks,
+                    std::pmr::memory_resource* memory) {
   namespace sf = shard_format;
   const Reader in(payload, context);
   if (payload.size() < sf::kHeaderBytes)
@@ -182,7 +203,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     in.fail("version", version, "this reader knows version " + std::to_string(sf::kVersion));
 
   const bool check_boxes = checks == DecodeChecks::full;
-  Shard shard;
+  Shard shard(memory != nullptr ? memory : std::pmr::get_default_resource());
   const auto kind = in.at<std::uint8_t>(6);
   if (kind > 1) in.fail("kind", unsigned(kind), "0 grid or 1 rtree");
   shard.kind_ = ShardKind(kind);
@@ -242,11 +263,9 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   // Vertices.
   const std::uint64_t coordinates = 3 * std::uint64_t(vertex_count);
   if (shard.precision_ == StoredPrecision::float32)
-    shard.vertices32_ =
-        in.array<float>(begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
+    in.array(shard.vertices32_, begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
   else
-    shard.vertices64_ =
-        in.array<double>(begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
+    in.array(shard.vertices64_, begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
   // The stored vertices, kept for the R-tree's leaf checks below (cheaper than each
   // triangle's box there: a vertex is shared by about six triangles).
   std::vector<geometry::Point> stored;
@@ -263,10 +282,10 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   // Triangles.
   const std::uint64_t corners = 3 * std::uint64_t(triangle_count);
   if (vertex_index_bytes == 2)
-    shard.indices16_ = in.array<std::uint16_t>(begin_of(sf::triangles), end_of(sf::triangles),
+    in.array(shard.indices16_, begin_of(sf::triangles), end_of(sf::triangles),
                                                corners, "triangles");
   else
-    shard.indices32_ = in.array<std::uint32_t>(begin_of(sf::triangles), end_of(sf::triangles),
+    in.array(shard.indices32_, begin_of(sf::triangles), end_of(sf::triangles),
                                                corners, "triangles");
   for (std::uint32_t t = 0; t < triangle_count; ++t)
     for (int k = 0; k < 3; ++k)
@@ -276,16 +295,13 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
 
   // Ids and parts.
   if (id_bytes == 4)
-    shard.id_offsets32_ =
-        in.array<std::uint32_t>(begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
+    in.array(shard.id_offsets32_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
   else
-    shard.id_offsets64_ =
-        in.array<std::uint64_t>(begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
-  shard.part_palette_ = in.array<std::uint32_t>(begin_of(sf::part_palette),
+    in.array(shard.id_offsets64_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
+  in.array(shard.part_palette_, begin_of(sf::part_palette),
                                                 end_of(sf::part_palette), part_count,
                                                 "part_palette");
-  shard.part_indices_ =
-      in.array<std::uint8_t>(begin_of(sf::part_indices), end_of(sf::part_indices),
+  in.array(shard.part_indices_, begin_of(sf::part_indices), end_of(sf::part_indices),
                              std::uint64_t(triangle_count) * part_index_bytes, "part_indices");
   // One loop per index width: a copy of a variable width per triangle was an eighth of decode.
   auto check_part_indices = [&]<class Index>() {
@@ -330,7 +346,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     if (reference_bytes != (triangle_count <= 65536 ? 2 : 4))
       in.fail("reference_bytes", unsigned(reference_bytes),
               "2 when triangle_count <= 65536, else 4");
-    shard.cell_offsets_ = in.array<std::uint32_t>(begin_of(sf::structure),
+    in.array(shard.cell_offsets_, begin_of(sf::structure),
                                                   end_of(sf::structure), cells + 1, "structure");
     if (shard.cell_offsets_[0] != 0) in.fail("offset of cell 0", shard.cell_offsets_[0], "0");
     for (std::uint64_t c = 0; c < cells; ++c)
@@ -342,10 +358,10 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
       in.fail("last cell offset", shard.cell_offsets_[cells],
               "must equal reference_count " + std::to_string(reference_count));
     if (reference_bytes == 2)
-      shard.references16_ = in.array<std::uint16_t>(
+      in.array(shard.references16_, 
           begin_of(sf::references), end_of(sf::references), reference_count, "references");
     else
-      shard.references32_ = in.array<std::uint32_t>(
+      in.array(shard.references32_, 
           begin_of(sf::references), end_of(sf::references), reference_count, "references");
     for (std::uint32_t r = 0; r < reference_count; ++r) {
       const std::uint32_t t =

@@ -167,11 +167,14 @@ TEST(FlyingObject, ATightBudgetGivesTheSameAnswersWithinItself) {
   CollisionIndexOptions tight;
   tight.memory_budget_bytes = probe->total_shard_bytes() / 20;  // 5 %
   std::uint64_t peak = 0;
-  for (const int prefetch : {0, 1, 2}) {  // none, the region's shards, and the next region's
-    tight.prefetch = prefetch > 0;
-    tight.prefetch_ahead = prefetch > 1;
+  // No prefetcher; the region's shards; and the next region's; shards in malloc's memory
+  // instead of the arena.
+  for (const int variant : {0, 1, 2, 3}) {
+    tight.prefetch = variant == 1 || variant == 2;
+    tight.prefetch_ahead = variant == 2;
+    tight.shard_arena = variant != 3;
     const std::vector<std::uint8_t> paged = fly(world, tight, &peak);
-    EXPECT_EQ(paged, unlimited) << "prefetch " << prefetch;
+    EXPECT_EQ(paged, unlimited) << "variant " << variant;
     EXPECT_LE(peak, tight.memory_budget_bytes);
     EXPECT_GT(peak, 0u);
   }

@@ -4,6 +4,7 @@
 // naming the field, or decodes to a shard whose queries stay in range.
 
 #include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/ShardArena.h"
 
 #include <gtest/gtest.h>
 
@@ -144,6 +145,23 @@ TEST_P(ShardTest, QueriesMatchBruteForce) {
       EXPECT_EQ(seen[t], int(geometry::triangle_intersects_box(shard.triangle(t), box)))
           << "seed 5 query " << q << " triangle " << t;
   }
+}
+
+TEST_P(ShardTest, DecodesIntoAnArenaAlike) {
+  const std::vector<std::byte> payload = tiny_shard(GetParam());
+  ShardArena arena(std::size_t(4) << 20, 0);
+  const Shard plain = Shard::decode(payload);
+  Shard in_arena = Shard::decode(payload, "shard", DecodeChecks::full, &arena);
+  ASSERT_EQ(in_arena.triangle_count(), plain.triangle_count());
+  for (std::uint32_t t = 0; t < plain.triangle_count(); ++t) {
+    EXPECT_EQ(in_arena.triangle(t), plain.triangle(t));
+    EXPECT_EQ(in_arena.triangle_id(t), plain.triangle_id(t));
+    EXPECT_EQ(in_arena.part_id(t), plain.part_id(t));
+  }
+  // Its arrays are counted as the arena's blocks, never less than what they hold.
+  EXPECT_GE(in_arena.memory_bytes(), plain.memory_bytes());
+  const Shard moved = std::move(in_arena);  // keeps the arena's arrays
+  EXPECT_EQ(moved.triangle(1), plain.triangle(1));
 }
 
 TEST_P(ShardTest, EveryTruncationThrows) {

@@ -14,6 +14,7 @@
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/TetMesh.h"
 #include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/ShardArena.h"
 #include "tetrapage/runtime/ShardCache.h"
 #include "tetrapage/runtime/geometry/Box.h"
 
@@ -31,6 +32,10 @@ struct CollisionIndexOptions {
   /// disk it may pay.
   bool prefetch_ahead = false;
   std::size_t prefetch_threads = 1;
+  /// Decode shards into a ShardArena of the budget's size (at most the index's shards, plus an
+  /// eighth for its size classes) whose pages a background thread faults in ahead of use, so
+  /// that page-ins do not take the page faults. Off: shards are allocated by malloc.
+  bool shard_arena = true;
 };
 
 class CollisionIndex {
@@ -104,6 +109,7 @@ class CollisionIndex {
   std::vector<geometry::Point> reference_points_;
   std::vector<std::uint64_t> interior_offsets_;
   std::vector<std::uint32_t> interior_parts_;
+  std::unique_ptr<ShardArena> arena_;  // before the cache: its shards go first
   std::unique_ptr<ShardCache<Shard>> cache_;
 };
 

@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory_resource>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -85,15 +86,18 @@ class Shard {
   /// corrupted payload throws instead of crashing or looping, and with DecodeChecks::full
   /// every box too.
   /// @param context names the payload in error messages (e.g. "model.tpi shard 17").
+  /// @param memory holds the decoded arrays (the runtime's ShardArena); it must outlive the
+  ///        shard. Null: the default resource.
   /// @throw FormatError naming the field at fault and its value.
   static Shard decode(std::span<const std::byte> payload, std::string_view context = "shard",
-                      DecodeChecks checks = DecodeChecks::full);
+                      DecodeChecks checks = DecodeChecks::full,
+                      std::pmr::memory_resource* memory = nullptr);
 
   ShardKind kind() const { return kind_; }
   StoredPrecision precision() const { return precision_; }
   std::uint32_t triangle_count() const { return triangle_count_; }
   std::uint32_t vertex_count() const { return vertex_count_; }
-  /// Bytes held by this object (its arrays and itself).
+  /// Bytes held by this object (its arrays, as their memory resource's blocks, and itself).
   std::size_t memory_bytes() const;
   const geometry::Point& origin() const { return origin_; }
 
@@ -169,6 +173,9 @@ class Shard {
   }
 
  private:
+  /// Empty, its arrays in `memory`.
+  explicit Shard(std::pmr::memory_resource* memory);
+
   /// An R-tree node with its box converted to stored (absolute) coordinates at decode.
   struct Node {
     geometry::Box box;
@@ -321,25 +328,25 @@ class Shard {
   geometry::Point origin_{};
   geometry::Box bounds_;
 
-  std::vector<float> vertices32_;  ///< relative xyz, when stored as float
-  std::vector<double> vertices64_;
-  std::vector<std::uint16_t> indices16_;  ///< three corners per triangle
-  std::vector<std::uint32_t> indices32_;
+  std::pmr::vector<float> vertices32_;  ///< relative xyz, when stored as float
+  std::pmr::vector<double> vertices64_;
+  std::pmr::vector<std::uint16_t> indices16_;  ///< three corners per triangle
+  std::pmr::vector<std::uint32_t> indices32_;
   std::uint64_t id_base_ = 0;
-  std::vector<std::uint32_t> id_offsets32_;
-  std::vector<std::uint64_t> id_offsets64_;
-  std::vector<std::uint32_t> part_palette_;
-  std::vector<std::uint8_t> part_indices_;  ///< part_index_bytes_ per triangle, little-endian
+  std::pmr::vector<std::uint32_t> id_offsets32_;
+  std::pmr::vector<std::uint64_t> id_offsets64_;
+  std::pmr::vector<std::uint32_t> part_palette_;
+  std::pmr::vector<std::uint8_t> part_indices_;  ///< part_index_bytes_ per triangle, little-endian
   std::uint8_t part_index_bytes_ = 0;
 
   std::array<std::uint32_t, 3> grid_cells_{};
   geometry::Point grid_lo_{};
   geometry::Point grid_cell_size_{};
-  std::vector<std::uint32_t> cell_offsets_;
-  std::vector<std::uint16_t> references16_;
-  std::vector<std::uint32_t> references32_;
+  std::pmr::vector<std::uint32_t> cell_offsets_;
+  std::pmr::vector<std::uint16_t> references16_;
+  std::pmr::vector<std::uint32_t> references32_;
 
-  std::vector<Node> nodes_;
+  std::pmr::vector<Node> nodes_;
 };
 
 }  // namespace tetrapage

@@ -1,0 +1,162 @@
+#include "tetrapage/runtime/ShardArena.h"
+
+#include <sys/mman.h>
+
+#include <algorithm>
+#include <bit>
+#include <cerrno>
+#include <functional>
+
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23  // Linux 5.14's value, for headers older than the kernel
+#endif
+
+namespace tetrapage {
+
+namespace {
+
+constexpr std::size_t kSmallestBlock = 512;  // smaller requests are a shard's few tiny arrays
+constexpr std::size_t kLargestBlock = std::size_t(4) << 20;
+constexpr std::size_t kBlockAlignment = 64;
+constexpr std::size_t kClassesPerDoubling = 8;
+constexpr std::size_t kRangeGranule = std::size_t(2) << 20;
+constexpr std::size_t kPageBytes = 4096;  // a divisor of every page size Linux uses
+// One madvise call populates this much: it holds the address space's lock for reading, which
+// delays the process's own mmap and brk calls until it returns.
+constexpr std::size_t kPopulateStep = std::size_t(256) << 10;
+
+// The class of a request of `bytes` in (kSmallestBlock, kLargestBlock], and its block size:
+// with 2^(p-1) < bytes <= 2^p, blocks of 9/8 .. 16/8 of 2^(p-1) in steps of 2^(p-4) (a
+// multiple of 64 from p = 10 on).
+std::size_t size_class(std::size_t bytes, std::size_t& block) {
+  const unsigned p = unsigned(std::bit_width(bytes - 1));
+  const std::size_t step = std::size_t(1) << (p - 4);
+  const std::size_t steps = (bytes + step - 1) / step;  // 9 .. 16
+  block = steps * step;
+  return (p - 10) * kClassesPerDoubling + (steps - 9);
+}
+
+bool in_classes(std::size_t bytes, std::size_t alignment) {
+  return bytes > kSmallestBlock && bytes <= kLargestBlock && alignment <= kBlockAlignment;
+}
+
+constexpr std::size_t kClassCount =
+    (std::bit_width(kLargestBlock - 1) - std::bit_width(kSmallestBlock) + 1) * kClassesPerDoubling;
+
+}  // namespace
+
+ShardArena::ShardArena(std::size_t capacity_bytes, std::size_t populate_ahead_bytes,
+                       std::pmr::memory_resource* upstream)
+    : upstream_(upstream), ahead_(populate_ahead_bytes), free_heads_(kClassCount, nullptr) {
+#if defined(__SANITIZE_ADDRESS__)
+  // AddressSanitizer sees blocks recycled here as live: leave every shard to malloc so that
+  // it still catches a shard used after its eviction.
+  capacity_bytes = 0;
+#endif
+  if (capacity_bytes > 0) {
+    const std::size_t rounded =
+        (capacity_bytes + kRangeGranule - 1) / kRangeGranule * kRangeGranule;
+    void* range = ::mmap(nullptr, rounded, PROT_READ | PROT_WRITE,
+                         MAP_PRIVATE | MAP_ANONYMOUS | MAP_NORESERVE, -1, 0);
+    if (range != MAP_FAILED) {
+      base_ = static_cast<std::byte*>(range);
+      capacity_ = rounded;
+    }
+  }
+  if (capacity_ > 0 && ahead_ > 0)
+    populator_ = std::jthread([this](std::stop_token stop) { populate(std::move(stop)); });
+}
+
+ShardArena::~ShardArena() {
+  if (populator_.joinable()) {
+    populator_.request_stop();
+    populator_.join();
+  }
+  if (base_ != nullptr) ::munmap(base_, capacity_);
+}
+
+std::size_t ShardArena::block_bytes(std::size_t bytes) {
+  if (!in_classes(bytes, 1)) return bytes;
+  std::size_t block = 0;
+  size_class(bytes, block);
+  return block;
+}
+
+bool ShardArena::owns(const void* p) const {
+  const auto* b = static_cast<const std::byte*>(p);
+  return base_ != nullptr && std::less_equal<const std::byte*>()(base_, b) &&
+         std::less<const std::byte*>()(b, base_ + capacity_);
+}
+
+void* ShardArena::do_allocate(std::size_t bytes, std::size_t alignment) {
+  if (capacity_ > 0 && in_classes(bytes, alignment)) {
+    std::size_t block = 0;
+    const std::size_t c = size_class(bytes, block);
+    bool wake = false;
+    void* p = nullptr;
+    {
+      const std::lock_guard lock(mutex_);
+      if (void* head = free_heads_[c]) {
+        free_heads_[c] = *static_cast<void**>(head);
+        p = head;
+      } else if (const std::size_t at = frontier_.load(std::memory_order_relaxed);
+                 block <= capacity_ - at) {
+        p = base_ + at;
+        frontier_.store(at + block, std::memory_order_relaxed);
+        // Wake the populating thread when the frontier has eaten into its lead.
+        wake = populated_.load(std::memory_order_relaxed) <
+               std::min(capacity_, at + block + ahead_ / 2);
+      }
+    }
+    if (wake) {
+      // Under its mutex, so that the wake cannot fall between its check and its wait.
+      { const std::lock_guard lock(populate_mutex_); }
+      populate_cv_.notify_one();
+    }
+    if (p != nullptr) {
+      arena_blocks_.fetch_add(1, std::memory_order_relaxed);
+      return p;
+    }
+  }
+  upstream_blocks_.fetch_add(1, std::memory_order_relaxed);
+  return upstream_->allocate(bytes, alignment);
+}
+
+void ShardArena::do_deallocate(void* p, std::size_t bytes, std::size_t alignment) {
+  if (!owns(p)) return upstream_->deallocate(p, bytes, alignment);
+  std::size_t block = 0;
+  const std::size_t c = size_class(bytes, block);
+  const std::lock_guard lock(mutex_);
+  *static_cast<void**>(p) = free_heads_[c];
+  free_heads_[c] = p;
+}
+
+std::size_t ShardArena::populate_target() const {
+  return std::min(capacity_, frontier_.load(std::memory_order_relaxed) + ahead_);
+}
+
+void ShardArena::populate(std::stop_token stop) {
+  std::unique_lock lock(populate_mutex_);
+  while (!stop.stop_requested()) {
+    if (!populate_cv_.wait(lock, stop, [this] {
+          return populated_.load(std::memory_order_relaxed) < populate_target();
+        }))
+      return;
+    // Whole pages: madvise wants a page-aligned start, and the frontier moves by 64 bytes.
+    const std::size_t from = populated_.load(std::memory_order_relaxed);
+    const std::size_t to =
+        std::min(capacity_, (std::min(populate_target(), from + kPopulateStep) + kPageBytes - 1) /
+                                kPageBytes * kPageBytes);
+    lock.unlock();
+    // Pages already in use are left as they are: populating only faults in missing ones.
+    const int result = ::madvise(base_ + from, to - from, MADV_POPULATE_WRITE);
+    lock.lock();
+    if (result != 0 && errno != EINTR && errno != EAGAIN) {
+      populate_failed_.store(true, std::memory_order_relaxed);  // EINVAL before Linux 5.14
+      return;
+    }
+    if (result == 0) populated_.store(to, std::memory_order_release);
+  }
+}
+
+}  // namespace tetrapage
