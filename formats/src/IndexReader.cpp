@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <array>
 #include <cerrno>
 #include <atomic>
@@ -19,6 +20,7 @@
 #include "ChunkCodec.h"
 #include "Hdf5Handle.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/SpinThenBlock.h"
 
 namespace tetrapage {
 
@@ -488,7 +490,8 @@ struct IndexReader::Impl {
     if (stored.size() < count) stored.resize(count);
     masks.resize(count);
     {
-      const std::lock_guard lock(chunk_read_mutex());
+      // Polled first: the other thread holds it for a few microseconds (SpinThenBlock.h).
+      const std::unique_lock lock = lock_spinning_first(chunk_read_mutex(), std::chrono::microseconds(100));
       for (std::uint64_t k = 0; k < count; ++k) read_stored_chunk(shard, k, masks[k], stored[k]);
     }
     for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload, scratch);

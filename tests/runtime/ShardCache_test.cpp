@@ -405,10 +405,16 @@ TEST(ShardCache, TimesOutWhenPinsAreNotReleased) {
   expect_consistent(*cache, index);
 }
 
-TEST(ShardCache, ConcurrentAcquiresOfOneShardLoadItOnce) {
+// The waiters sleep at once, poll and then sleep, or get the shard while they poll (the
+// load takes 20 ms).
+class ConcurrentAcquires : public ::testing::TestWithParam<std::chrono::microseconds> {};
+
+TEST_P(ConcurrentAcquires, OfOneShardLoadItOnce) {
   FakeIndex index(std::vector<std::uint64_t>(10, 100));
   index.delay = 20ms;
-  auto cache = index.make(1000, no_prefetcher());
+  ShardCacheOptions options = no_prefetcher();
+  options.spin_before_sleep = GetParam();
+  auto cache = index.make(1000, options);
   constexpr int kThreads = 8;
   std::latch start(kThreads);
   std::vector<const FakeShard*> seen(kThreads);
@@ -427,6 +433,9 @@ TEST(ShardCache, ConcurrentAcquiresOfOneShardLoadItOnce) {
   EXPECT_EQ(c.hits + c.misses, std::uint64_t(kThreads));
   EXPECT_GE(c.misses, 1u);
 }
+
+INSTANTIATE_TEST_SUITE_P(ShardCache, ConcurrentAcquires, ::testing::Values(0us, 200us, 50ms),
+                         [](const auto& info) { return std::to_string(info.param.count()) + "us"; });
 
 TEST(ShardCache, LoaderExceptionPropagatesAndLeavesTheCacheConsistent) {
   FakeIndex index(std::vector<std::uint64_t>(6, 100));

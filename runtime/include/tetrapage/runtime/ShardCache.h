@@ -13,7 +13,7 @@
 /// Worst-case frame time: no lock is held while a loader runs or a shard is destroyed, so
 /// queries on resident shards never wait behind a page-in or an eviction of another shard;
 /// several threads load different shards at once and concurrent requests for one shard wait
-/// for a single load.
+/// for a single load. Waits poll for up to options.spin_before_sleep before they sleep.
 ///
 /// Generic over the shard type (ShardCache<Shard> at run time, a fake type in the tests).
 
@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/SpinThenBlock.h"
 
 namespace tetrapage {
 
@@ -55,6 +56,10 @@ struct ShardCacheOptions {
   std::chrono::milliseconds pin_wait_timeout{5000};
   /// Page-in durations kept (a uniform reservoir sample) for the latency percentiles.
   std::size_t latency_reservoir = 4096;
+  /// How long a prefetch thread with nothing queued, and an acquire waiting for another
+  /// thread's load of its shard, poll before they sleep. On a virtual machine a sleep and its
+  /// wake-up cost about 25 us each way, more than a page-in from the page cache.
+  std::chrono::microseconds spin_before_sleep{200};
 };
 
 /// A snapshot of a ShardCache's counters (events since construction or the last reset) and
@@ -205,7 +210,7 @@ class ShardCache {
   std::uint64_t miss_count() const { return misses_.load(std::memory_order_relaxed); }
   /// The highest resident + reserved bytes so far (one lock; no latency sort).
   std::uint64_t peak_resident_bytes() const {
-    std::lock_guard lock(mutex_);
+    const std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
     return peak_;
   }
 
@@ -277,6 +282,7 @@ class ShardCache {
   mutable std::mutex mutex_;         // guards everything below up to the counters
   std::condition_variable room_cv_;  // bytes freed or pins released
   std::condition_variable load_cv_;  // a load finished (or failed)
+  std::atomic<std::uint64_t> loads_ended_{0};  // loads finished or failed, read without the lock
   std::vector<Entry> entries_;
   std::vector<ThreadRecord> threads_;
   std::uint32_t lru_head_ = kNone, lru_tail_ = kNone;  // oldest first, sorted by stamp
@@ -307,6 +313,8 @@ class ShardCache {
   std::condition_variable idle_cv_;       // the queue ran dry with no hint in progress
   std::deque<std::uint32_t> queue_;
   std::size_t hints_in_progress_ = 0;
+  std::size_t sleeping_workers_ = 0;          // waiting on queue_cv_
+  std::atomic<std::size_t> queued_hints_{0};  // queue_.size(), read without the lock
   std::vector<std::jthread> workers_;  // last: stopped and joined before the rest goes
 };
 
@@ -368,9 +376,9 @@ auto ShardCache<ShardType>::acquire(std::uint32_t shard) -> Pin {
                      std::to_string(budget_) + " bytes");
   const std::thread::id me = std::this_thread::get_id();
 
-  std::unique_lock lock(mutex_);
+  std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
   ++acquisitions_;
-  bool counted = false, waited = false;
+  bool counted = false, waited = false, spun = false;
   std::chrono::steady_clock::time_point deadline;
   for (;;) {
     Entry& entry = entries_[shard];
@@ -383,6 +391,14 @@ auto ShardCache<ShardType>::acquire(std::uint32_t shard) -> Pin {
       counted = true;
     }
     if (entry.state == State::loading) {  // someone else loads it: wait for that one load
+      if (!spun) {  // poll for a while first: the load is likely shorter than a sleep
+        spun = true;
+        const std::uint64_t ended = loads_ended_.load(std::memory_order_acquire);
+        lock.unlock();
+        spin_until([&] { return loads_ended_.load(std::memory_order_acquire) != ended; }, options_.spin_before_sleep);
+        lock_spinning_first(lock, options_.spin_before_sleep);
+        continue;
+      }
       load_cv_.wait(lock);
       continue;
     }
@@ -442,13 +458,13 @@ auto ShardCache<ShardType>::acquire(std::uint32_t shard) -> Pin {
     size = size_of_(*loaded);
   } catch (...) {
     loaded.reset();
-    lock.lock();
+    lock_spinning_first(lock, options_.spin_before_sleep);
     cancel_reservation(entries_[shard]);
     load_failures_.fetch_add(1, std::memory_order_relaxed);
     throw;
   }
   record_latency(std::chrono::steady_clock::now() - start);
-  lock.lock();
+  lock_spinning_first(lock, options_.spin_before_sleep);
   install(lock, shard, std::move(loaded), size, Eviction::any_unpinned);
   return take_pin(shard);
 }
@@ -469,6 +485,7 @@ void ShardCache<ShardType>::cancel_reservation(Entry& entry) {
   entry.bytes = 0;
   entry.state = State::empty;
   entry.prefetched_unused = false;
+  loads_ended_.fetch_add(1, std::memory_order_release);
   load_cv_.notify_all();
   notify_room();
 }
@@ -524,6 +541,7 @@ void ShardCache<ShardType>::install(std::unique_lock<std::mutex>& lock, std::uin
   ++entry.page_ins;
   page_ins_.fetch_add(1, std::memory_order_relaxed);
   bytes_loaded_.fetch_add(size, std::memory_order_relaxed);
+  loads_ended_.fetch_add(1, std::memory_order_release);
   load_cv_.notify_all();
   notify_room();
 }
@@ -551,7 +569,7 @@ auto ShardCache<ShardType>::take_pin(std::uint32_t shard) -> Pin {
 
 template <class ShardType>
 void ShardCache<ShardType>::release(std::uint32_t shard, std::thread::id owner) noexcept {
-  std::lock_guard lock(mutex_);
+  const std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
   Entry& entry = entries_[shard];
   if (ThreadRecord* record = find_record(owner)) {
     auto& pinned = record->pinned;
@@ -591,7 +609,7 @@ bool ShardCache<ShardType>::evict_one(std::unique_lock<std::mutex>& lock, Evicti
   evictions_.fetch_add(1, std::memory_order_relaxed);
   lock.unlock();
   shard.reset();
-  lock.lock();
+  lock_spinning_first(lock, options_.spin_before_sleep);
   releasing_ -= bytes;
   used_ -= bytes;
   notify_room();
@@ -713,6 +731,7 @@ void ShardCache<ShardType>::enqueue(std::span<const std::uint32_t> shards, bool 
     return;
   }
   std::uint64_t stale = 0;
+  bool wake = false;
   {
     std::lock_guard lock(queue_mutex_);
     if (urgent)
@@ -726,22 +745,29 @@ void ShardCache<ShardType>::enqueue(std::span<const std::uint32_t> shards, bool 
         queue_.pop_front();
       ++stale;
     }
+    queued_hints_.store(queue_.size(), std::memory_order_release);
+    wake = sleeping_workers_ > 0;  // a polling worker sees the hints without a wake-up
   }
   if (stale > 0) prefetch_dropped_.fetch_add(stale, std::memory_order_relaxed);
-  queue_cv_.notify_all();
+  if (wake) queue_cv_.notify_all();
 }
 
 template <class ShardType>
 void ShardCache<ShardType>::prefetch_worker(std::stop_token stop) {
   for (;;) {
     std::uint32_t shard = 0;
+    spin_until([&] { return queued_hints_.load(std::memory_order_acquire) > 0 || stop.stop_requested(); },
+               options_.spin_before_sleep);
     {
       std::unique_lock lock(queue_mutex_);
       // wait() returns true with hints still queued when stopped: those are dropped.
-      if (!queue_cv_.wait(lock, stop, [this] { return !queue_.empty(); }) || stop.stop_requested())
-        return;
+      ++sleeping_workers_;
+      const bool woken = queue_cv_.wait(lock, stop, [this] { return !queue_.empty(); });
+      --sleeping_workers_;
+      if (!woken || stop.stop_requested()) return;
       shard = queue_.front();
       queue_.pop_front();
+      queued_hints_.store(queue_.size(), std::memory_order_release);
       ++hints_in_progress_;
     }
     try {
@@ -771,7 +797,7 @@ void ShardCache<ShardType>::prefetch_one(std::uint32_t shard, const std::stop_to
   }
   if (need > budget_) return drop();
 
-  std::unique_lock lock(mutex_);
+  std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
   for (;;) {
     Entry& entry = entries_[shard];
     if (entry.state != State::empty) return;  // already resident or on its way
@@ -795,13 +821,13 @@ void ShardCache<ShardType>::prefetch_one(std::uint32_t shard, const std::stop_to
     loaded.reset();
   }
   if (!loaded) {  // the later acquire retries and reports the error
-    lock.lock();
+    lock_spinning_first(lock, options_.spin_before_sleep);
     cancel_reservation(entries_[shard]);
     load_failures_.fetch_add(1, std::memory_order_relaxed);
     return drop();
   }
   record_latency(std::chrono::steady_clock::now() - start);
-  lock.lock();
+  lock_spinning_first(lock, options_.spin_before_sleep);
   try {
     install(lock, shard, std::move(loaded), size, Eviction::old_unpinned);
   } catch (const Error&) {
@@ -813,7 +839,7 @@ void ShardCache<ShardType>::prefetch_one(std::uint32_t shard, const std::stop_to
 template <class ShardType>
 bool ShardCache<ShardType>::contains(std::uint32_t shard) const {
   check_shard(shard, "contains");
-  std::lock_guard lock(mutex_);
+  const std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
   return entries_[shard].state == State::resident;
 }
 
@@ -835,7 +861,7 @@ ShardCacheCounters ShardCache<ShardType>::counters() const {
   c.prefetch_evicted_unused = get(prefetch_evicted_unused_);
   c.budget_bytes = budget_;
   {
-    std::lock_guard lock(mutex_);
+    const std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
     c.resident_bytes = used_ - reserved_ - releasing_;
     c.reserved_bytes = reserved_;
     c.pinned_bytes = pinned_;
@@ -864,7 +890,7 @@ ShardCacheCounters ShardCache<ShardType>::counters() const {
 
 template <class ShardType>
 std::vector<std::uint32_t> ShardCache<ShardType>::page_ins_per_shard() const {
-  std::lock_guard lock(mutex_);
+  const std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
   std::vector<std::uint32_t> counts(entries_.size());
   for (std::size_t i = 0; i < entries_.size(); ++i) counts[i] = entries_[i].page_ins;
   return counts;
@@ -877,7 +903,7 @@ void ShardCache<ShardType>::reset_counters() {
                         &prefetch_dropped_, &prefetch_evicted_unused_})
     counter->store(0, std::memory_order_relaxed);
   {
-    std::lock_guard lock(mutex_);
+    const std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
     peak_ = used_;
     for (auto& entry : entries_) entry.page_ins = 0;
   }
