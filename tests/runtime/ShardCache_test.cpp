@@ -435,7 +435,7 @@ TEST_P(ConcurrentAcquires, OfOneShardLoadItOnce) {
 }
 
 INSTANTIATE_TEST_SUITE_P(ShardCache, ConcurrentAcquires, ::testing::Values(0us, 200us, 50ms),
-                         [](const auto& info) { return std::to_string(info.param.count()) + "us"; });
+                         [](const auto& case_info) { return std::to_string(case_info.param.count()) + "us"; });
 
 TEST(ShardCache, LoaderExceptionPropagatesAndLeavesTheCacheConsistent) {
   FakeIndex index(std::vector<std::uint64_t>(6, 100));

@@ -56,9 +56,11 @@ struct ShardCacheOptions {
   std::chrono::milliseconds pin_wait_timeout{5000};
   /// Page-in durations kept (a uniform reservoir sample) for the latency percentiles.
   std::size_t latency_reservoir = 4096;
-  /// How long a prefetch thread with nothing queued, and an acquire waiting for another
-  /// thread's load of its shard, poll before they sleep. On a virtual machine a sleep and its
-  /// wake-up cost about 25 us each way, more than a page-in from the page cache.
+  /// How long a thread waiting for the cache's lock, an acquire waiting for another thread's
+  /// load of its shard, and a prefetch thread with nothing queued poll before they sleep. On a
+  /// virtual machine a sleep and its wake-up cost about 25 us each way, more than a page-in
+  /// from the page cache. While hints keep coming (a flight), the prefetch thread thus keeps
+  /// its core busy; 0 makes every wait sleep at once.
   std::chrono::microseconds spin_before_sleep{200};
 };
 
