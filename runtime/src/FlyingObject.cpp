@@ -278,11 +278,23 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   if (keep_pins_) pins_.resize(shards_.size());
 
   if (index.options().prefetch) {
-    // The region's shards the box does not meet yet: it will within a few steps, so load them
-    // in the background now rather than synchronously then.
+    // The region's shards that the box does not meet yet but would within four more steps of
+    // its last motion: load them in the background now rather than synchronously then. (All
+    // the region's shards were loaded two to three times over for those the flights then
+    // used, and the useless loads evicted useful ones: docs/BENCHMARKS.md, eighteenth stop.)
+    constexpr double kHintSteps = 4;
+    geometry::Box ahead = region;
+    if (previous_valid_) {
+      ahead = box;
+      for (int a = 0; a < 3; ++a) {
+        const double d = kHintSteps * (current_box_.center()[a] - previous_box_.center()[a]);
+        (d < 0 ? ahead.lo[a] : ahead.hi[a]) += d;
+      }
+    }
     hints_.clear();
     for (std::size_t k = 0; k < shards_.size(); ++k)
-      if (!geometry::boxes_overlap(box, shard_reach_[k]) && !index.cache().contains(shards_[k]))
+      if (!geometry::boxes_overlap(box, shard_reach_[k]) && geometry::boxes_overlap(ahead, shard_reach_[k]) &&
+          !index.cache().contains(shards_[k]))
         hints_.push_back(shards_[k]);
     if (!hints_.empty()) index.cache().prefetch(hints_);
   }
