@@ -168,11 +168,12 @@ TEST(FlyingObject, ATightBudgetGivesTheSameAnswersWithinItself) {
   tight.memory_budget_bytes = probe->total_shard_bytes() / 20;  // 5 %
   std::uint64_t peak = 0;
   // No prefetcher; the region's shards; and the next region's; shards in malloc's memory
-  // instead of the arena.
-  for (const int variant : {0, 1, 2, 3}) {
-    tight.prefetch = variant == 1 || variant == 2;
+  // instead of the arena; the prefetcher with waits that sleep at once.
+  for (const int variant : {0, 1, 2, 3, 4}) {
+    tight.prefetch = variant == 1 || variant == 2 || variant == 4;
     tight.prefetch_ahead = variant == 2;
     tight.shard_arena = variant != 3;
+    tight.spin_before_sleep = variant == 4 ? std::chrono::microseconds(0) : std::chrono::microseconds(200);
     const std::vector<std::uint8_t> paged = fly(world, tight, &peak);
     EXPECT_EQ(paged, unlimited) << "variant " << variant;
     EXPECT_LE(peak, tight.memory_budget_bytes);

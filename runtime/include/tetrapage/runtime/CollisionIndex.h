@@ -4,6 +4,7 @@
 /// on demand by a byte-budgeted cache (ShardCache). Thread-safe: any number of flying objects,
 /// each used from its own thread, may share one CollisionIndex.
 
+#include <chrono>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -36,6 +37,9 @@ struct CollisionIndexOptions {
   /// eighth for its size classes) whose pages a background thread faults in ahead of use, so
   /// that page-ins do not take the page faults. Off: shards are allocated by malloc.
   bool shard_arena = true;
+  /// How long the cache's waits poll before they sleep (ShardCacheOptions::spin_before_sleep):
+  /// while hints keep coming the prefetch thread keeps a core busy; 0 makes every wait sleep.
+  std::chrono::microseconds spin_before_sleep{200};
 };
 
 class CollisionIndex {
