@@ -167,7 +167,8 @@ void BM_Query(benchmark::State& state) {
 
 // Paging in as the runtime does, per decoded byte: the shard written alone to an index file
 // (format 3: shuffled, LZ4, Fletcher-32), then IndexReader::read_shard into a kept buffer
-// (direct chunk reads, the file in the page cache) and Shard::decode. Args: scene, kind.
+// (direct chunk reads, the file in the page cache) and Shard::decode with the runtime's
+// checks (its structure). Args: scene, kind.
 void BM_PageIn(benchmark::State& state) {
   const BuiltShard built = build_shard(region(int(state.range(0))).view(),
                                        ShardKind(state.range(1)), StoredPrecision::float32);
@@ -185,7 +186,7 @@ void BM_PageIn(benchmark::State& state) {
     std::vector<std::byte> payload;
     for (auto _ : state) {
       reader.read_shard(0, payload);
-      const Shard shard = Shard::decode(payload);
+      const Shard shard = Shard::decode(payload, "shard", DecodeChecks::structure);
       benchmark::DoNotOptimize(shard.triangle_count());
     }
   }

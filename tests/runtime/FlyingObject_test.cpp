@@ -12,10 +12,12 @@
 #include <thread>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/ShardArena.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/MeshLibrary.h"
@@ -158,6 +160,34 @@ TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
     }
     EXPECT_EQ(every.contacts.size(), expected) << "step " << i;
   }
+}
+
+// Real shards decoded into an arena: the same shards, their large arrays in the arena, and
+// their bytes counted as the arena's blocks (at least what they hold, at most an eighth more).
+TEST(FlyingObject, ShardsDecodeIntoTheArenaAlike) {
+  const World world = make_world(Kind::scene, 30000, 500, 50, 11, 200);
+  const IndexReader reader(world.index_path);
+  ShardArena arena(std::size_t(64) << 20, 0);
+  ASSERT_GT(reader.shard_count(), 0u);
+  std::size_t plain_bytes = 0, kept_bytes = 0;
+  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    const std::vector<std::byte> payload = reader.read_shard(s);
+    const Shard plain = Shard::decode(payload);
+    const Shard kept = Shard::decode(payload, "shard", DecodeChecks::structure, &arena);
+    ASSERT_EQ(kept.triangle_count(), plain.triangle_count()) << "shard " << s;
+    for (std::uint32_t t = 0; t < plain.triangle_count(); ++t) {
+      ASSERT_EQ(kept.triangle(t), plain.triangle(t)) << "shard " << s;
+      ASSERT_EQ(kept.triangle_id(t), plain.triangle_id(t)) << "shard " << s;
+    }
+    EXPECT_GE(kept.memory_bytes(), plain.memory_bytes()) << "shard " << s;
+    EXPECT_LE(8 * kept.memory_bytes(), 9 * plain.memory_bytes()) << "shard " << s;
+    plain_bytes += plain.memory_bytes();
+    kept_bytes += kept.memory_bytes();
+  }
+#if !defined(__SANITIZE_ADDRESS__)  // there the arena leaves everything to malloc
+  EXPECT_GT(arena.arena_blocks(), 0u);
+  EXPECT_GT(kept_bytes, plain_bytes);  // the blocks' slack is counted
+#endif
 }
 
 TEST(FlyingObject, ATightBudgetGivesTheSameAnswersWithinItself) {

@@ -158,9 +158,9 @@ TEST_P(ShardTest, DecodesIntoAnArenaAlike) {
     EXPECT_EQ(in_arena.triangle_id(t), plain.triangle_id(t));
     EXPECT_EQ(in_arena.part_id(t), plain.part_id(t));
   }
-  // Its arrays are counted as the arena's blocks, never less than what they hold.
-  EXPECT_GE(in_arena.memory_bytes(), plain.memory_bytes());
-  const Shard moved = std::move(in_arena);  // keeps the arena's arrays
+  // A moved shard keeps its arrays (these tiny ones all go to the arena's upstream; the
+  // flying tests decode real shards into an arena).
+  const Shard moved = std::move(in_arena);
   EXPECT_EQ(moved.triangle(1), plain.triangle(1));
 }
 

@@ -25,6 +25,8 @@ struct FlyArguments {
   bool all_contacts = false;
   bool no_prefetch = false;
   bool prefetch_ahead = false;
+  bool no_shard_arena = false;
+  unsigned spin_before_sleep_us = 200;
   bool preload = false;
 };
 
@@ -37,6 +39,8 @@ void run_fly(const FlyArguments& args) {
   index_options.memory_budget_bytes = parse_byte_size(args.memory);
   index_options.prefetch = !args.no_prefetch;
   index_options.prefetch_ahead = args.prefetch_ahead;
+  index_options.shard_arena = !args.no_shard_arena;
+  index_options.spin_before_sleep = std::chrono::microseconds(args.spin_before_sleep_us);
 
   const TriangleSoup object_mesh = read_mesh(args.object);
   const std::vector<Pose> poses = read_poses(args.path);
@@ -115,6 +119,8 @@ void run_fly(const FlyArguments& args) {
                                {"accuracy", args.accuracy},
                                {"prefetch", !args.no_prefetch},
                                {"prefetch_ahead", !args.no_prefetch && args.prefetch_ahead},
+                               {"shard_arena", !args.no_shard_arena},
+                               {"spin_before_sleep_us", args.spin_before_sleep_us},
                                {"preloaded", args.preload},
                                {"preload_seconds", preload_seconds},
                                {"steps", poses.size()},
@@ -169,6 +175,13 @@ void add_fly_command(CLI::App& app) {
   command->add_flag("--prefetch-ahead", args->prefetch_ahead,
                     "Also prefetch the next region along the motion at each region change (a walk and a box "
                     "search on the flying thread; pays where page-ins wait for a disk)");
+  command->add_flag("--no-shard-arena", args->no_shard_arena,
+                    "Decode shards into malloc's memory instead of the arena whose pages a background "
+                    "thread faults in ahead of use");
+  command->add_option("--spin-before-sleep", args->spin_before_sleep_us,
+                      "Microseconds a wait between the flying thread and the prefetcher polls before it "
+                      "sleeps (0: sleep at once; polling keeps the prefetch thread's core busy)")
+      ->capture_default_str();
   command->add_flag("--preload", args->preload,
                     "Load every shard before the first step (needs --memory of at least the index's shards): "
                     "the all-resident reference; open-to-first-answer then excludes the preload");

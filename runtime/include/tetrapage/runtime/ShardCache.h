@@ -380,8 +380,8 @@ auto ShardCache<ShardType>::acquire(std::uint32_t shard) -> Pin {
 
   std::unique_lock lock = lock_spinning_first(mutex_, options_.spin_before_sleep);
   ++acquisitions_;
-  bool counted = false, waited = false, spun = false;
-  std::chrono::steady_clock::time_point deadline;
+  bool counted = false, waited = false, spinning = false;
+  std::chrono::steady_clock::time_point deadline, spin_until_time;
   for (;;) {
     Entry& entry = entries_[shard];
     if (entry.state == State::resident) {
@@ -393,11 +393,15 @@ auto ShardCache<ShardType>::acquire(std::uint32_t shard) -> Pin {
       counted = true;
     }
     if (entry.state == State::loading) {  // someone else loads it: wait for that one load
-      if (!spun) {  // poll for a while first: the load is likely shorter than a sleep
-        spun = true;
+      // Poll for a while first (the load is likely shorter than a sleep), until some load
+      // ends, then look again: another shard's load may have ended.
+      const auto now = std::chrono::steady_clock::now();
+      if (!spinning) spin_until_time = now + options_.spin_before_sleep, spinning = true;
+      if (now < spin_until_time) {
         const std::uint64_t ended = loads_ended_.load(std::memory_order_acquire);
         lock.unlock();
-        spin_until([&] { return loads_ended_.load(std::memory_order_acquire) != ended; }, options_.spin_before_sleep);
+        spin_until([&] { return loads_ended_.load(std::memory_order_acquire) != ended; },
+                   std::chrono::duration_cast<std::chrono::microseconds>(spin_until_time - now));
         lock_spinning_first(lock, options_.spin_before_sleep);
         continue;
       }
