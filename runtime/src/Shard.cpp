@@ -4,8 +4,13 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <string>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/ShardArena.h"
@@ -83,6 +88,20 @@ bool finite(const geometry::Point& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
+// x rounded down (up) to a float, so that float boxes enclose their double ones, then clamped
+// to the finite floats as the queries' are (Shard::relative_query): clamping both sides keeps
+// every overlap.
+float float_at_most(double x) {
+  float f = float(x);
+  if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return std::clamp(f, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
+}
+float float_at_least(double x) {
+  float f = float(x);
+  if (double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return std::clamp(f, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
+}
+
 bool box_contains_box(const geometry::Box& outer, const geometry::Box& inner) {
   for (int k = 0; k < 3; ++k)
     if (!(outer.lo[k] <= inner.lo[k] && inner.hi[k] <= outer.hi[k])) return false;
@@ -122,8 +141,10 @@ Shard::Marks::~Marks() {
 
 std::uint32_t Shard::part_id(std::uint32_t local) const {
   switch (part_index_bytes_) {
-    case 0: return part_palette_[0];
-    case 1: return part_palette_[part_indices_[local]];
+    case 0:
+      return part_palette_[0];
+    case 1:
+      return part_palette_[part_indices_[local]];
     case 2: {
       std::uint16_t i;
       std::memcpy(&i, part_indices_.data() + 2 * std::size_t(local), 2);
@@ -160,13 +181,38 @@ std::size_t Shard::memory_bytes() const {
   };
   return sizeof(Shard) + bytes(vertices32_) + bytes(vertices64_) + bytes(indices16_) +
          bytes(indices32_) + bytes(id_offsets32_) + bytes(id_offsets64_) + bytes(part_palette_) +
-         bytes(part_indices_) + bytes(cell_offsets_) + bytes(references16_) +
-         bytes(references32_) + bytes(nodes_);
+         bytes(part_indices_) + bytes(cell_offsets_) + bytes(references16_) + bytes(references32_) +
+         bytes(nodes_) + bytes(node_boxes_);
 }
 
-bool shard_format::grid_cell_range(double lo, double cell_size, std::uint32_t cells,
-                                   double low, double high, std::uint32_t& first,
-                                   std::uint32_t& last) {
+std::uint32_t Shard::children_overlapping(std::uint32_t first, std::uint32_t count,
+                                          const float lo[3], const float hi[3]) const {
+  const float* b = node_boxes_.data() + first;
+  const std::size_t n = node_stride_;
+  std::uint32_t mask = 0;
+#if defined(__SSE2__)
+  const __m128 lx = _mm_set1_ps(lo[0]), ly = _mm_set1_ps(lo[1]), lz = _mm_set1_ps(lo[2]);
+  const __m128 hx = _mm_set1_ps(hi[0]), hy = _mm_set1_ps(hi[1]), hz = _mm_set1_ps(hi[2]);
+  for (std::uint32_t c = 0; c < count; c += 4, b += 4) {
+    __m128 m =
+        _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b), hx), _mm_cmpge_ps(_mm_loadu_ps(b + 3 * n), lx));
+    m = _mm_and_ps(m, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + n), hy),
+                                 _mm_cmpge_ps(_mm_loadu_ps(b + 4 * n), ly)));
+    m = _mm_and_ps(m, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(b + 2 * n), hz),
+                                 _mm_cmpge_ps(_mm_loadu_ps(b + 5 * n), lz)));
+    mask |= std::uint32_t(_mm_movemask_ps(m)) << c;
+  }
+#else
+  for (std::uint32_t c = 0; c < count; ++c)
+    if (b[c] <= hi[0] && b[3 * n + c] >= lo[0] && b[n + c] <= hi[1] && b[4 * n + c] >= lo[1] &&
+        b[2 * n + c] <= hi[2] && b[5 * n + c] >= lo[2])
+      mask |= 1u << c;
+#endif
+  return mask & ((1u << count) - 1);
+}
+
+bool shard_format::grid_cell_range(double lo, double cell_size, std::uint32_t cells, double low,
+                                   double high, std::uint32_t& first, std::uint32_t& last) {
   auto boundary = [&](std::uint32_t i) { return grid_boundary(lo, cell_size, i); };
   if (!(low <= high) || high < boundary(0) || low > boundary(cells)) return false;
   // An estimate, then exact steps against the boundaries (a step or two at most, unless the
@@ -189,8 +235,8 @@ bool shard_format::grid_cell_range(double lo, double cell_size, std::uint32_t ce
   return true;
 }
 
-Shard Shard::decode(std::span<const std::byte> payload, std::string_view context, DecodeChecks checks,
-                    std::pmr::memory_resource* memory) {
+Shard Shard::decode(std::span<const std::byte> payload, std::string_view context,
+                    DecodeChecks checks, std::pmr::memory_resource* memory) {
   namespace sf = shard_format;
   const Reader in(payload, context);
   if (payload.size() < sf::kHeaderBytes)
@@ -231,8 +277,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   if (vertex_count == 0) in.fail("vertex_count", 0, "a shard holds at least one vertex");
   if (vertex_index_bytes != (vertex_count <= 65536 ? 2 : 4))
     in.fail("vertex_index_bytes", unsigned(vertex_index_bytes),
-            "2 when vertex_count <= 65536, else 4; vertex_count = " +
-                std::to_string(vertex_count));
+            "2 when vertex_count <= 65536, else 4; vertex_count = " + std::to_string(vertex_count));
   if (id_bytes != 4 && id_bytes != 8) in.fail("id_bytes", unsigned(id_bytes), "4 or 8");
   if (part_count == 0) in.fail("part_count", 0, "at least one part");
   const unsigned expected_part_bytes =
@@ -250,9 +295,9 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     offset[s] = in.at<std::uint64_t>(128 + 8 * s);
     const std::uint64_t previous = s == 0 ? sf::kHeaderBytes : offset[s - 1];
     if (offset[s] < previous || offset[s] > payload.size())
-      in.fail(std::string("offset of section ") + section_name(s), offset[s],
-              "must lie in [" + std::to_string(previous) + ", " +
-                  std::to_string(payload.size()) + "]");
+      in.fail(
+          std::string("offset of section ") + section_name(s), offset[s],
+          "must lie in [" + std::to_string(previous) + ", " + std::to_string(payload.size()) + "]");
   }
   if (offset[sf::section_count] != payload.size())
     in.fail("end offset", offset[sf::section_count],
@@ -263,9 +308,11 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   // Vertices.
   const std::uint64_t coordinates = 3 * std::uint64_t(vertex_count);
   if (shard.precision_ == StoredPrecision::float32)
-    in.array(shard.vertices32_, begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
+    in.array(shard.vertices32_, begin_of(sf::vertices), end_of(sf::vertices), coordinates,
+             "vertices");
   else
-    in.array(shard.vertices64_, begin_of(sf::vertices), end_of(sf::vertices), coordinates, "vertices");
+    in.array(shard.vertices64_, begin_of(sf::vertices), end_of(sf::vertices), coordinates,
+             "vertices");
   // The stored vertices, kept for the R-tree's leaf checks below (cheaper than each
   // triangle's box there: a vertex is shared by about six triangles).
   std::vector<geometry::Point> stored;
@@ -282,11 +329,11 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   // Triangles.
   const std::uint64_t corners = 3 * std::uint64_t(triangle_count);
   if (vertex_index_bytes == 2)
-    in.array(shard.indices16_, begin_of(sf::triangles), end_of(sf::triangles),
-                                               corners, "triangles");
+    in.array(shard.indices16_, begin_of(sf::triangles), end_of(sf::triangles), corners,
+             "triangles");
   else
-    in.array(shard.indices32_, begin_of(sf::triangles), end_of(sf::triangles),
-                                               corners, "triangles");
+    in.array(shard.indices32_, begin_of(sf::triangles), end_of(sf::triangles), corners,
+             "triangles");
   for (std::uint32_t t = 0; t < triangle_count; ++t)
     for (int k = 0; k < 3; ++k)
       if (shard.corner(t, k) >= vertex_count)
@@ -298,11 +345,10 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     in.array(shard.id_offsets32_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
   else
     in.array(shard.id_offsets64_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
-  in.array(shard.part_palette_, begin_of(sf::part_palette),
-                                                end_of(sf::part_palette), part_count,
-                                                "part_palette");
+  in.array(shard.part_palette_, begin_of(sf::part_palette), end_of(sf::part_palette), part_count,
+           "part_palette");
   in.array(shard.part_indices_, begin_of(sf::part_indices), end_of(sf::part_indices),
-                             std::uint64_t(triangle_count) * part_index_bytes, "part_indices");
+           std::uint64_t(triangle_count) * part_index_bytes, "part_indices");
   // One loop per index width: a copy of a variable width per triangle was an eighth of decode.
   auto check_part_indices = [&]<class Index>() {
     for (std::uint32_t t = 0; t < triangle_count; ++t) {
@@ -329,10 +375,10 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
                     std::to_string(structure_count));
       if (!(std::isfinite(shard.grid_lo_[k]) && std::isfinite(shard.grid_cell_size_[k]) &&
             shard.grid_cell_size_[k] > 0 && std::isfinite(shard.grid_boundary(k, n))))
-        in.fail("grid lo / cell size along axis " + std::to_string(k),
-                std::to_string(shard.grid_lo_[k]) + " / " +
-                    std::to_string(shard.grid_cell_size_[k]),
-                "finite, with a positive cell size");
+        in.fail(
+            "grid lo / cell size along axis " + std::to_string(k),
+            std::to_string(shard.grid_lo_[k]) + " / " + std::to_string(shard.grid_cell_size_[k]),
+            "finite, with a positive cell size");
       if (!(shard.grid_boundary(k, 0) <= shard.bounds_.lo[k] &&
             shard.bounds_.hi[k] <= shard.grid_boundary(k, n)))
         in.fail("grid extent along axis " + std::to_string(k),
@@ -346,23 +392,23 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     if (reference_bytes != (triangle_count <= 65536 ? 2 : 4))
       in.fail("reference_bytes", unsigned(reference_bytes),
               "2 when triangle_count <= 65536, else 4");
-    in.array(shard.cell_offsets_, begin_of(sf::structure),
-                                                  end_of(sf::structure), cells + 1, "structure");
+    in.array(shard.cell_offsets_, begin_of(sf::structure), end_of(sf::structure), cells + 1,
+             "structure");
     if (shard.cell_offsets_[0] != 0) in.fail("offset of cell 0", shard.cell_offsets_[0], "0");
     for (std::uint64_t c = 0; c < cells; ++c)
       if (shard.cell_offsets_[c + 1] < shard.cell_offsets_[c])
-        in.fail("offset of cell " + std::to_string(c + 1), shard.cell_offsets_[c + 1],
-                "offsets must not decrease; the previous is " +
-                    std::to_string(shard.cell_offsets_[c]));
+        in.fail(
+            "offset of cell " + std::to_string(c + 1), shard.cell_offsets_[c + 1],
+            "offsets must not decrease; the previous is " + std::to_string(shard.cell_offsets_[c]));
     if (shard.cell_offsets_[cells] != reference_count)
       in.fail("last cell offset", shard.cell_offsets_[cells],
               "must equal reference_count " + std::to_string(reference_count));
     if (reference_bytes == 2)
-      in.array(shard.references16_, 
-          begin_of(sf::references), end_of(sf::references), reference_count, "references");
+      in.array(shard.references16_, begin_of(sf::references), end_of(sf::references),
+               reference_count, "references");
     else
-      in.array(shard.references32_, 
-          begin_of(sf::references), end_of(sf::references), reference_count, "references");
+      in.array(shard.references32_, begin_of(sf::references), end_of(sf::references),
+               reference_count, "references");
     for (std::uint32_t r = 0; r < reference_count; ++r) {
       const std::uint32_t t =
           reference_bytes == 2 ? shard.references16_[r] : shard.references32_[r];
@@ -382,6 +428,12 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
               "the structure section holds " + std::to_string(end_of(sf::structure) - begin) +
                   " bytes of " + std::to_string(record) + "-byte nodes");
     shard.nodes_.resize(structure_count);
+    shard.node_stride_ = std::size_t(structure_count) + kNodeBoxPadding;
+    // The padding holds empty boxes (never read into a result: children past a node's count
+    // are masked off).
+    shard.node_boxes_.assign(6 * shard.node_stride_, 0.0f);
+    std::vector<geometry::Box> boxes;  // in double, for the enclosure checks
+    if (check_boxes) boxes.resize(structure_count);
     std::vector<std::uint32_t> depth(structure_count, 0);
     std::vector<std::uint8_t> has_parent(structure_count, 0);
     std::vector<std::uint8_t> covered(triangle_count, 0);
@@ -389,6 +441,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     for (std::uint32_t i = 0; i < structure_count; ++i) {
       Node& node = shard.nodes_[i];
       const std::size_t at = begin + std::size_t(i) * record;
+      geometry::Box box;
       for (int k = 0; k < 3; ++k) {
         const double lo = shard.precision_ == StoredPrecision::float32
                               ? double(in.at<float>(at + 4 * k))
@@ -396,15 +449,20 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
         const double hi = shard.precision_ == StoredPrecision::float32
                               ? double(in.at<float>(at + 12 + 4 * k))
                               : in.at<double>(at + 24 + 8 * k);
-        node.box.lo[k] = shard.origin_[k] + lo;
-        node.box.hi[k] = shard.origin_[k] + hi;
+        box.lo[k] = shard.origin_[k] + lo;
+        box.hi[k] = shard.origin_[k] + hi;
+        shard.node_boxes_[k * shard.node_stride_ + i] = float_at_most(lo);
+        shard.node_boxes_[(3 + k) * shard.node_stride_ + i] = float_at_least(hi);
+        if (std::fabs(lo) > std::numeric_limits<float>::max() ||
+            std::fabs(hi) > std::numeric_limits<float>::max())
+          shard.clamped_node_boxes_ = true;
       }
       node.first = in.at<std::uint32_t>(at + record - 8);
       node.count = in.at<std::uint32_t>(at + record - 4);
-      if (!finite(node.box.lo) || !finite(node.box.hi))
+      if (!finite(box.lo) || !finite(box.hi))
         in.fail("box of R-tree node", i, "its coordinates are not finite");
-      if (i > 0 && !has_parent[i])
-        in.fail("R-tree node", i, "no node lists it as a child");
+      if (check_boxes) boxes[i] = box;
+      if (i > 0 && !has_parent[i]) in.fail("R-tree node", i, "no node lists it as a child");
       const std::uint32_t count = node.count & ~sf::kLeafFlag;
       if (node.count & sf::kLeafFlag) {
         if (count == 0 || node.first > triangle_count || count > triangle_count - node.first)
@@ -416,7 +474,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
           covered[t] = 1;
           if (check_boxes)
             for (int k = 0; k < 3; ++k)
-              if (!geometry::box_contains(node.box, stored[shard.corner(t, k)]))
+              if (!geometry::box_contains(box, stored[shard.corner(t, k)]))
                 in.fail("box of R-tree leaf " + std::to_string(i), "",
                         "does not enclose its triangle " + std::to_string(t));
         }
@@ -446,7 +504,7 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
       const Node& node = shard.nodes_[i];
       if (node.count & sf::kLeafFlag) continue;
       for (std::uint32_t c = node.first; c < node.first + node.count; ++c)
-        if (!box_contains_box(node.box, shard.nodes_[c].box))
+        if (!box_contains_box(boxes[i], boxes[c]))
           in.fail("box of R-tree node " + std::to_string(i), "",
                   "does not enclose its child " + std::to_string(c));
     }

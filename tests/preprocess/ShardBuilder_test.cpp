@@ -201,8 +201,8 @@ int check_queries(const Shard& shard, const std::vector<Box>& boxes, const std::
         clipped.lo[k] = std::max(box.lo[k], own.lo[k]);
         clipped.hi[k] = std::min(box.hi[k], own.hi[k]);
       }
-      const bool expected = geometry::boxes_overlap(own, box) &&
-                            geometry::triangle_intersects_box(tri, clipped);
+      const bool expected =
+          geometry::boxes_overlap(own, box) && geometry::triangle_intersects_box(tri, clipped);
       if (seen[t] != int(expected)) {
         if (++failures <= 5)
           ADD_FAILURE() << what << " query " << q << " box [" << box.lo[0] << "," << box.lo[1]
@@ -255,7 +255,8 @@ TEST_P(ShardBuilderTest, StoredVerticesIdsAndPartsRoundTrip) {
       const Triangle stored = shard.triangle(t);
       for (int c = 0; c < 3; ++c) {
         double squared = 0;
-        for (int k = 0; k < 3; ++k) squared += (in[c][k] - stored[c][k]) * (in[c][k] - stored[c][k]);
+        for (int k = 0; k < 3; ++k)
+          squared += (in[c][k] - stored[c][k]) * (in[c][k] - stored[c][k]);
         max_distance = std::max(max_distance, std::sqrt(squared));
       }
       inputs.erase(it);
@@ -343,26 +344,27 @@ TEST_P(ShardBuilderTest, TruncatedAndCorruptedPayloadsThrowOrDecode) {
       ++decoded;
       // A valid but different shard: queries must still terminate and stay in range.
       for (const Box& box : query_boxes(shard, 33))
-        shard.for_each_candidate(box, [&](std::uint32_t t) { ASSERT_LT(t, shard.triangle_count()); });
+        shard.for_each_candidate(box,
+                                 [&](std::uint32_t t) { ASSERT_LT(t, shard.triangle_count()); });
     } catch (const FormatError&) {
     }
   }
   RecordProperty("decoded_after_flips", decoded);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    KindsAndPrecisions, ShardBuilderTest,
-    ::testing::Combine(::testing::Values(ShardKind::grid, ShardKind::rtree),
-                       ::testing::Values(StoredPrecision::float32, StoredPrecision::float64)),
-    [](const auto& case_info) {
-      return std::string(to_string(std::get<0>(case_info.param))) + "_" +
-             std::string(to_string(std::get<1>(case_info.param)));
-    });
+INSTANTIATE_TEST_SUITE_P(KindsAndPrecisions, ShardBuilderTest,
+                         ::testing::Combine(::testing::Values(ShardKind::grid, ShardKind::rtree),
+                                            ::testing::Values(StoredPrecision::float32,
+                                                              StoredPrecision::float64)),
+                         [](const auto& case_info) {
+                           return std::string(to_string(std::get<0>(case_info.param))) + "_" +
+                                  std::string(to_string(std::get<1>(case_info.param)));
+                         });
 
 TEST(ShardBuilder, ErrorMessagesNameTheFieldAndValue) {
   const Region region = soup(41, 30, {0, 0, 0}, 1, 0.2);
-  std::vector<std::byte> payload = build_shard(region.view(), ShardKind::grid,
-                                               StoredPrecision::float32).payload;
+  std::vector<std::byte> payload =
+      build_shard(region.view(), ShardKind::grid, StoredPrecision::float32).payload;
   auto message = [](std::vector<std::byte> bytes) {
     try {
       Shard::decode(bytes, "test.tpi shard 3");
@@ -382,8 +384,7 @@ TEST(ShardBuilder, ErrorMessagesNameTheFieldAndValue) {
   std::uint64_t triangles_at;
   std::memcpy(&triangles_at, bad.data() + 128 + 8, 8);
   std::memcpy(bad.data() + triangles_at, &huge, 2);
-  EXPECT_NE(message(bad).find("corner 0 of triangle 0 = 65535"), std::string::npos)
-      << message(bad);
+  EXPECT_NE(message(bad).find("corner 0 of triangle 0 = 65535"), std::string::npos) << message(bad);
 }
 
 TEST(ShardBuilder, RejectsBadInput) {
@@ -400,6 +401,11 @@ TEST(ShardBuilder, RejectsBadInput) {
   huge.triangles[0][0][0] = 1e300;
   EXPECT_THROW(build_shard(huge.view(), ShardKind::rtree, StoredPrecision::float32), InputError);
   EXPECT_NO_THROW(build_shard(huge.view(), ShardKind::rtree, StoredPrecision::float64));
+  // Node boxes beyond float range from the origin (the runtime keeps them as floats, clamped)
+  // still find every triangle.
+  const Shard wide =
+      Shard::decode(build_shard(huge.view(), ShardKind::rtree, StoredPrecision::float64).payload);
+  EXPECT_EQ(check_queries(wide, query_boxes(wide, 12), "1e300 corner"), 0);
   ShardLayout fanout;
   fanout.rtree_fanout = 17;
   EXPECT_THROW(build_shard(region.view(), ShardKind::rtree, StoredPrecision::float32, fanout),
@@ -425,11 +431,13 @@ TEST(ShardBuilder, RtreeLeavesAreMedianCutsAlongTheLongestSide) {
   // every cut is along x, so, in tree order, leaf k holds exactly the triangles of x ranks
   // 16k .. 16k + 15 (every leaf but the last full), each leaf's in input order. A selection
   // that cut anywhere else still answers queries right, which the brute-force tests cannot see.
-  for (const std::size_t n : {std::size_t(17), std::size_t(389), std::size_t(2048), std::size_t(3001)}) {
+  for (const std::size_t n :
+       {std::size_t(17), std::size_t(389), std::size_t(2048), std::size_t(3001)}) {
     Random r(n);
     std::vector<std::size_t> rank_of(n);
     std::iota(rank_of.begin(), rank_of.end(), 0);
-    for (std::size_t i = n; i > 1; --i) std::swap(rank_of[i - 1], rank_of[r.below(std::uint32_t(i))]);
+    for (std::size_t i = n; i > 1; --i)
+      std::swap(rank_of[i - 1], rank_of[r.below(std::uint32_t(i))]);
     Region region;
     for (std::size_t i = 0; i < n; ++i) {
       const double x = double(rank_of[i]) - 0.25 * double(n);  // negative and positive centres
@@ -440,7 +448,8 @@ TEST(ShardBuilder, RtreeLeavesAreMedianCutsAlongTheLongestSide) {
     }
     ShardLayout layout;
     layout.rtree_leaf_size = 16;
-    const BuiltShard built = build_shard(region.view(), ShardKind::rtree, StoredPrecision::float64, layout);
+    const BuiltShard built =
+        build_shard(region.view(), ShardKind::rtree, StoredPrecision::float64, layout);
     const Shard shard = Shard::decode(built.payload);
     ASSERT_EQ(shard.triangle_count(), n);
     for (std::uint32_t t = 0; t < n; ++t) {
@@ -456,8 +465,8 @@ TEST(ShardBuilder, RtreeLeavesAreMedianCutsAlongTheLongestSide) {
 TEST(ShardCostModel, BothKindsFindTheSameCandidatesAndTheChoiceIsTheCheaper) {
   for (const Region& region : {soup(51, 1500, {0, 0, 0}, 1, 0.02), regions()[7]}) {
     const ShardCostModel model;
-    const ShardCostReport report =
-        estimate_shard_costs(region.view(), 0.1, StoredPrecision::float32, model, GridTrials::always);
+    const ShardCostReport report = estimate_shard_costs(
+        region.view(), 0.1, StoredPrecision::float32, model, GridTrials::always);
     // The model measures count-only queries: they must examine exactly the cells, nodes and
     // references a deciding query examines.
     for (const auto* estimate : {&report.grid, &report.rtree}) {
@@ -471,7 +480,8 @@ TEST(ShardCostModel, BothKindsFindTheSameCandidatesAndTheChoiceIsTheCheaper) {
         }
         ShardQueryCounters counted, decided;
         shard.count_query(box, counted);
-        shard.for_each_candidate(box, [](std::uint32_t) {}, decided);
+        shard.for_each_candidate(
+            box, [](std::uint32_t) {}, decided);
         EXPECT_EQ(counted.visited, decided.visited);
         EXPECT_EQ(counted.references, decided.references);
         EXPECT_GT(decided.candidates, 0u);
@@ -486,9 +496,9 @@ TEST(ShardCostModel, BothKindsFindTheSameCandidatesAndTheChoiceIsTheCheaper) {
     EXPECT_EQ(report.chosen, cheaper);
     EXPECT_EQ(choose_shard_kind(region.view(), 0.1, model), cheaper);
   }
-  EXPECT_THROW(estimate_shard_costs(regions()[0].view(), -1, StoredPrecision::float32,
-                                    ShardCostModel{}),
-               InputError);
+  EXPECT_THROW(
+      estimate_shard_costs(regions()[0].view(), -1, StoredPrecision::float32, ShardCostModel{}),
+      InputError);
 }
 
 TEST(ShardCostModel, TheGridFloorIsBelowEveryGridAndSkippingByItChoosesTheSame) {
@@ -504,15 +514,20 @@ TEST(ShardCostModel, TheGridFloorIsBelowEveryGridAndSkippingByItChoosesTheSame) 
     for (const double extent : {0.0, 0.05, 0.5})
       for (const StoredPrecision precision : {StoredPrecision::float32, StoredPrecision::float64})
         for (const ShardCostModel& model : {ShardCostModel{}, rare_paging}) {
-          if (precision == StoredPrecision::float32 && region.name.find("1e+09") != std::string::npos) continue;
+          if (precision == StoredPrecision::float32 &&
+              region.name.find("1e+09") != std::string::npos)
+            continue;
           const ShardCostReport always =
               estimate_shard_costs(region.view(), extent, precision, model, GridTrials::always);
-          const ShardCostReport pruned = estimate_shard_costs(region.view(), extent, precision, model);
+          const ShardCostReport pruned =
+              estimate_shard_costs(region.view(), extent, precision, model);
           ASSERT_TRUE(always.grid_measured);
-          EXPECT_LE(always.grid_floor_seconds, always.grid.total_seconds() * (1 + 1e-12)) << region.name;
+          EXPECT_LE(always.grid_floor_seconds, always.grid.total_seconds() * (1 + 1e-12))
+              << region.name;
           EXPECT_EQ(always.grid_floor_seconds, pruned.grid_floor_seconds) << region.name;
           EXPECT_EQ(pruned.chosen, always.chosen) << region.name << " extent " << extent;
-          EXPECT_EQ(pruned.chosen_estimate().built.payload, always.chosen_estimate().built.payload) << region.name;
+          EXPECT_EQ(pruned.chosen_estimate().built.payload, always.chosen_estimate().built.payload)
+              << region.name;
           skipped += !pruned.grid_measured;
           grids += always.chosen == ShardKind::grid;
         }

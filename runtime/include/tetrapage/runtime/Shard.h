@@ -10,8 +10,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <memory_resource>
 #include <optional>
 #include <span>
@@ -142,8 +144,8 @@ class Shard {
   /// what `accept(node_box, triangles)` rejects as well (a conservative filter of the
   /// caller's, e.g. an oriented box): the shard's bounds and R-tree inner nodes with
   /// triangles 0, R-tree leaves and grid cells (whose closed box holds every point of a
-  /// triangle that a query can reach through that cell) with the number they hold. A triangle is visited
-  /// when some leaf or cell holding it is accepted. No state is shared between concurrent
+  /// triangle that a query can reach through that cell) with the number they hold. A triangle is
+  /// visited when some leaf or cell holding it is accepted. No state is shared between concurrent
   /// queries.
   template <class Accept, class Visit>
   void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
@@ -176,12 +178,36 @@ class Shard {
   /// Empty, its arrays in `memory`.
   explicit Shard(std::pmr::memory_resource* memory);
 
-  /// An R-tree node with its box converted to stored (absolute) coordinates at decode.
+  /// An R-tree node; its box is in node_boxes_.
   struct Node {
-    geometry::Box box;
     std::uint32_t first = 0;  ///< first child node, or first triangle of a leaf
     std::uint32_t count = 0;  ///< children, or triangles (with kLeafFlag for a leaf)
   };
+  /// Floats past the last node in each of node_boxes_' six arrays: children are tested four
+  /// at a time, and the last group may run past the end.
+  static constexpr std::size_t kNodeBoxPadding = 4;
+  /// A box of node i's triangles in stored (absolute) coordinates: the origin plus its
+  /// outward-rounded floats, where these were clamped the shard's bounds.
+  geometry::Box node_box(std::uint32_t i) const {
+    const float* b = node_boxes_.data() + i;
+    geometry::Box box{
+        {origin_[0] + double(b[0]), origin_[1] + double(b[node_stride_]),
+         origin_[2] + double(b[2 * node_stride_])},
+        {origin_[0] + double(b[3 * node_stride_]), origin_[1] + double(b[4 * node_stride_]),
+         origin_[2] + double(b[5 * node_stride_])}};
+    if (clamped_node_boxes_) {
+      constexpr float kMost = std::numeric_limits<float>::max();
+      for (int k = 0; k < 3; ++k) {
+        if (std::fabs(b[k * node_stride_]) == kMost) box.lo[k] = bounds_.lo[k];
+        if (std::fabs(b[(3 + k) * node_stride_]) == kMost) box.hi[k] = bounds_.hi[k];
+      }
+    }
+    return box;
+  }
+  /// Bit c set for each child first + c (c < count <= kMaxFanout) whose float box overlaps
+  /// the query's (lo, hi: relative to the origin, rounded outward).
+  std::uint32_t children_overlapping(std::uint32_t first, std::uint32_t count, const float lo[3],
+                                     const float hi[3]) const;
 
   /// Per-thread marks that report a grid triangle once per query (defined in Shard.cpp).
   class Marks {
@@ -228,7 +254,6 @@ class Shard {
            geometry::triangle_intersects_box(t, box);
   }
 
-
   // What a traversal does with each triangle reference it reaches.
   enum class QueryMode {
     decide,  ///< visit(local) for each triangle that meets the box (exact), once
@@ -239,7 +264,8 @@ class Shard {
 
   // The one traversal of both kinds; `accept` may prune R-tree nodes (and the whole shard).
   template <QueryMode kMode, class Accept, class Visit>
-  void query(const geometry::Box& box, const Accept& accept, Visit& visit, ShardQueryCounters& counters) const {
+  void query(const geometry::Box& box, const Accept& accept, Visit& visit,
+             ShardQueryCounters& counters) const {
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
     if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_, 0u)) return;
@@ -267,11 +293,12 @@ class Shard {
   }
 
   template <QueryMode kMode, class Accept, class Reach>
-  void query_grid(const geometry::Box& box, const Accept& accept, Reach& reach, ShardQueryCounters& counters) const {
+  void query_grid(const geometry::Box& box, const Accept& accept, Reach& reach,
+                  ShardQueryCounters& counters) const {
     std::array<std::uint32_t, 3> first{}, last{};
     for (int k = 0; k < 3; ++k)
-      if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k],
-                                         box.lo[k], box.hi[k], first[k], last[k]))
+      if (!shard_format::grid_cell_range(grid_lo_[k], grid_cell_size_[k], grid_cells_[k], box.lo[k],
+                                         box.hi[k], first[k], last[k]))
         return;
     // Marks report a triangle referenced by several cells once (not needed to count).
     std::optional<Marks> marks;
@@ -287,8 +314,9 @@ class Shard {
           if constexpr (kMode == QueryMode::count) continue;
           if constexpr (kMode == QueryMode::boxes) {
             if (begin == end) continue;
-            const geometry::Box cell_box{{grid_boundary(0, x), grid_boundary(1, y), grid_boundary(2, z)},
-                                         {grid_boundary(0, x + 1), grid_boundary(1, y + 1), grid_boundary(2, z + 1)}};
+            const geometry::Box cell_box{
+                {grid_boundary(0, x), grid_boundary(1, y), grid_boundary(2, z)},
+                {grid_boundary(0, x + 1), grid_boundary(1, y + 1), grid_boundary(2, z + 1)}};
             if (!accept(cell_box, end - begin)) continue;
           }
           for (std::uint32_t r = begin; r < end; ++r) {
@@ -299,25 +327,57 @@ class Shard {
   }
 
   template <QueryMode kMode, class Accept, class Reach>
-  void query_rtree(const geometry::Box& box, const Accept& accept, Reach& reach, ShardQueryCounters& counters) const {
+  void query_rtree(const geometry::Box& box, const Accept& accept, Reach& reach,
+                   ShardQueryCounters& counters) const {
     // Depth is at most kMaxDepth and each level leaves at most kMaxFanout - 1 siblings
     // pending, which the decoder checked.
+    float lo[3], hi[3];
+    relative_query(box, lo, hi);
     std::array<std::uint32_t, shard_format::kMaxDepth * shard_format::kMaxFanout + 1> stack;
     std::size_t size = 0;
+    // A node is counted as visited when its box is tested, as each child is with its siblings.
+    ++counters.visited;
+    if (children_overlapping(0, 1, lo, hi) == 0) return;
     stack[size++] = 0;
     while (size > 0) {
-      const Node& node = nodes_[stack[--size]];
-      ++counters.visited;
+      const std::uint32_t at = stack[--size];
+      const Node& node = nodes_[at];
       const bool leaf = (node.count & shard_format::kLeafFlag) != 0;
       const std::uint32_t count = leaf ? node.count & ~shard_format::kLeafFlag : 0;
-      if (!geometry::boxes_overlap(node.box, box) || !accept(node.box, count)) continue;
+      if constexpr (kMode == QueryMode::boxes) {
+        if (!accept(node_box(at), count)) continue;
+      }
       if (leaf) {
         counters.references += count;
         if constexpr (kMode == QueryMode::count) continue;
         for (std::uint32_t t = node.first; t < node.first + count; ++t) reach(t);
       } else {
-        for (std::uint32_t c = node.count; c-- > 0;) stack[size++] = node.first + c;
+        counters.visited += node.count;
+        // Pushed last to first, so that the first child is visited first.
+        for (std::uint32_t mask = children_overlapping(node.first, node.count, lo, hi);
+             mask != 0;) {
+          const int c = 31 - __builtin_clz(mask);
+          mask &= ~(1u << c);
+          stack[size++] = node.first + std::uint32_t(c);
+        }
       }
+    }
+  }
+  /// The query box relative to the origin in float, grown beyond the roundings (it only
+  /// prunes): the subtraction's and the node boxes' (the origin plus their stored values),
+  /// relative to the coordinates (2^-40 of them), and the float's (2^-24 of the value, or
+  /// FLT_MIN near zero).
+  void relative_query(const geometry::Box& box, float lo[3], float hi[3]) const {
+    for (int k = 0; k < 3; ++k) {
+      const double l = box.lo[k] - origin_[k], h = box.hi[k] - origin_[k];
+      const double margin =
+          (std::fabs(origin_[k]) + std::fabs(box.lo[k]) + std::fabs(box.hi[k])) * 0x1p-40 +
+          std::numeric_limits<float>::min();
+      // Clamped to the finite floats as the nodes' are (beyond float range only for
+      // coordinates far beyond any model's).
+      constexpr double kMost = std::numeric_limits<float>::max();
+      lo[k] = float(std::clamp(l - std::fabs(l) * 0x1p-23 - margin, -kMost, kMost));
+      hi[k] = float(std::clamp(h + std::fabs(h) * 0x1p-23 + margin, -kMost, kMost));
     }
   }
 
@@ -347,6 +407,12 @@ class Shard {
   std::pmr::vector<std::uint32_t> references32_;
 
   std::pmr::vector<Node> nodes_;
+  /// The nodes' boxes relative to the origin, rounded outward to float, as six arrays of
+  /// node_stride_ floats (lo x, y, z, hi x, y, z): a node's children are tested together.
+  std::pmr::vector<float> node_boxes_;
+  std::size_t node_stride_ = 0;
+  /// Some node coordinate lay beyond float range from the origin (node_box then widens).
+  bool clamped_node_boxes_ = false;
 };
 
 }  // namespace tetrapage
