@@ -172,6 +172,16 @@ std::optional<Point> walk_reference_point(const TetMesh& mesh, std::uint32_t tet
 
 WalkResult locate_point(const TetMesh& mesh, std::uint32_t start_tet, const Point& p) {
   check_arguments(mesh, start_tet, p, "point");
+  // Most calls locate a point that has stayed strictly inside the last tet (a flying object's
+  // steps): the walk, from a reference point, would end there too. Points on its boundary
+  // take the walk, whose perturbation decides their tet.
+  const auto here = geometry::locate_in_tetrahedron(p, mesh.corners(start_tet));
+  if (here.position == geometry::TetrahedronPosition::inside) {
+    WalkResult result;
+    result.tet = start_tet;
+    result.location = here;
+    return result;
+  }
   const StartPoint start = start_point(mesh, start_tet);
   const WalkEnd end =
       walk(mesh, start.tet, start.point, kReferenceId, p, kTargetId, [](std::uint32_t) {});

@@ -184,6 +184,15 @@ TEST(MeshWalk, FromEveryStartTet) {
   for (const Point& p : targets)
     for (std::uint32_t start = 0; start < mesh.tet_count() && failures < 5; ++start)
       if (!check_walk(mesh, start, p, "seed 77")) ++failures;
+  // A point strictly inside the start tet is located there without a walk.
+  for (std::uint32_t start = 0; start < mesh.tet_count(); ++start) {
+    const auto inside = walk_reference_point(mesh, start);
+    if (!inside) continue;
+    const WalkResult found = locate_point(mesh, start, *inside);
+    EXPECT_EQ(found.tet, start);
+    EXPECT_EQ(found.tets_crossed, 0u);
+    EXPECT_EQ(found.location.position, geometry::TetrahedronPosition::inside);
+  }
 }
 
 /// For lattice meshes every special point is exact: vertices, edge midpoints, dyadic face
