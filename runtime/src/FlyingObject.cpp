@@ -559,7 +559,8 @@ void FlyingObject::check_containment(const geometry::Box& box, QueryResult& resu
                                      std::chrono::steady_clock::time_point start) {
   // The object inside an obstacle: with no surface contact, one vertex decides for all.
   if (index_->has_interiors()) {
-    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(model_->mesh.triangles[0][0]), interior_memo_);
+    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(model_->mesh.triangles[0][0]),
+                                                      interior_memo_, std::span<const ShardPin>(pins_));
     if (inside.containment == ObstacleContainment::inside) {
       result.collides = true;
       result.containment = Containment::object_inside_obstacle;

@@ -67,6 +67,16 @@ bool on_closed_surface(const CollisionIndex& index, const Shard& shard, const ge
   return on;
 }
 
+// The shard from the caller's pins when it holds it (a step holds its region's), else pinned
+// into `own`.
+const Shard& shard_for(const CollisionIndex& index, std::uint32_t shard_id, std::span<const ShardPin> held,
+                       ShardPin& own) {
+  for (const ShardPin& pin : held)
+    if (pin && pin.id() == shard_id) return *pin;
+  own = index.cache().acquire(shard_id);
+  return *own;
+}
+
 // The answer of a decided point from the closed parts holding it.
 ObstacleQuery decided(ObstacleQuery answer, const std::vector<std::uint32_t>& parts) {
   if (parts.empty()) {
@@ -81,7 +91,7 @@ ObstacleQuery decided(ObstacleQuery answer, const std::vector<std::uint32_t>& pa
 // From the tet's reference point (the tet holds p); `parts` receives the closed parts holding
 // p when the answer is inside or outside.
 ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet, const geometry::Point& p,
-                             std::vector<std::uint32_t>& parts) {
+                             std::vector<std::uint32_t>& parts, std::span<const ShardPin> held) {
   ObstacleQuery answer;
   answer.tet = tet;
   if (!index.interior_decided(tet)) return answer;
@@ -99,8 +109,8 @@ ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet, con
     answer.paths_tried = 1;
     return finish();  // no stored triangle near the segment: nothing to cross
   }
-  const auto pin = index.cache().acquire(shard_id);
-  const Shard& shard = *pin;
+  ShardPin own;
+  const Shard& shard = shard_for(index, shard_id, held, own);
   ++answer.paths_tried;
   if (count_crossings(index, shard, {reference, p}, parts, answer.triangle_tests)) return finish();
   if (on_closed_surface(index, shard, p, answer.triangle_tests)) {
@@ -136,7 +146,7 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
 }
 
 ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
-                                  const geometry::Point& p, ObstacleMemo& memo) {
+                                  const geometry::Point& p, ObstacleMemo& memo, std::span<const ShardPin> held) {
   ObstacleQuery answer;
   if (!index.has_interiors()) return answer;
   const WalkResult located = locate_point(index.mesh(), hint_tet, p);
@@ -159,14 +169,15 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
       memo.point = p;
       return decided(answer, memo.parts);
     }
-    const auto pin = index.cache().acquire(shard_id);
-    if (count_crossings(index, *pin, {memo.point, p}, memo.parts, answer.triangle_tests)) {
+    ShardPin own;
+    if (count_crossings(index, shard_for(index, shard_id, held, own), {memo.point, p}, memo.parts,
+                        answer.triangle_tests)) {
       memo.point = p;
       return decided(answer, memo.parts);
     }
     // A degenerate short path: decide from the reference point (which resets memo.parts).
   }
-  answer = from_reference(index, located.tet, p, memo.parts);
+  answer = from_reference(index, located.tet, p, memo.parts, held);
   memo.valid = answer.containment == ObstacleContainment::inside ||
                answer.containment == ObstacleContainment::outside;
   memo.tet = located.tet;

@@ -180,8 +180,12 @@ TEST(Interiors, AMovingPointDecidedFromItsLastAnswerAgreesWithTheOracle) {
   Random random(23);
   const BoundingBox box = m.environment.bounds();
   geometry::Point p{};
-  std::uint32_t hint = 0, plain_hint = 0;
-  ObstacleMemo memo;
+  std::uint32_t hint = 0, plain_hint = 0, held_hint = 0;
+  ObstacleMemo memo, held_memo;
+  // The same walk again with every other shard pinned by the caller (a flying object's
+  // region): the pinned ones are read from there.
+  std::vector<ShardPin> held;
+  for (std::uint32_t s = 0; s < index.shard_count(); s += 2) held.push_back(index.cache().acquire(s));
   int inside = 0, from_memo = 0, wrong = 0;
   const int steps = 20000;
   for (int i = 0; i < steps; ++i) {
@@ -196,6 +200,9 @@ TEST(Interiors, AMovingPointDecidedFromItsLastAnswerAgreesWithTheOracle) {
     from_memo += same_tet && answer.tet == memo_tet;
     const ObstacleQuery plain = locate_in_obstacles(index, plain_hint, p);
     EXPECT_EQ(answer.containment, plain.containment) << "step " << i;
+    const ObstacleQuery from_held = locate_in_obstacles(index, held_hint, p, held_memo, held);
+    EXPECT_EQ(from_held.containment, answer.containment) << "step " << i;
+    EXPECT_EQ(from_held.part, answer.part) << "step " << i;
     if (answer.containment != ObstacleContainment::inside && answer.containment != ObstacleContainment::outside)
       continue;
     EXPECT_EQ(answer.part, plain.part) << "step " << i;

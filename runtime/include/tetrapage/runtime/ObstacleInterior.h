@@ -9,6 +9,7 @@
 /// edge or vertex, or lies in its plane, is bent through another point strictly inside the tet
 /// (parity along a closed surface does not depend on the path).
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "tetrapage/runtime/CollisionIndex.h"
@@ -47,8 +48,13 @@ struct ObstacleMemo {
   std::vector<std::uint32_t> parts;
 };
 
+using ShardPin = ShardCache<Shard>::Pin;
+
 /// The same answer, using and updating `memo` (one per moving point, e.g. per flying object).
+/// A shard among `held` (pins the caller keeps, e.g. a flying object's region) is read from
+/// there rather than acquired again from the cache.
 ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
-                                  const geometry::Point& p, ObstacleMemo& memo);
+                                  const geometry::Point& p, ObstacleMemo& memo,
+                                  std::span<const ShardPin> held = {});
 
 }  // namespace tetrapage
