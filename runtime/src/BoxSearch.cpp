@@ -209,8 +209,8 @@ bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box)
 // Breadth-first from start_tet through the tets `meets` accepts; those form a connected set
 // when `meets` is exact (the tets meeting a convex box) or a superset of it (box overlaps).
 template <bool kExact>
-BoxSearchResult search(const TetMesh& mesh, std::uint32_t start_tet, const geometry::Box& box,
-                       std::vector<std::uint32_t>& stamps, std::uint32_t& stamp_counter,
+BoxSearchResult search(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds, std::uint32_t start_tet,
+                       const geometry::Box& box, std::vector<std::uint32_t>& stamps, std::uint32_t& stamp_counter,
                        std::vector<std::uint32_t>& found) {
   if (start_tet >= mesh.tet_count())
     throw InputError("box search: start tet " + std::to_string(start_tet) +
@@ -220,9 +220,11 @@ BoxSearchResult search(const TetMesh& mesh, std::uint32_t start_tet, const geome
   found.clear();
   BoxSearchResult result;
   if (geometry::inverted(box)) return result;
+  // The exact search has no precomputed boxes (empty): it computes them.
+  const auto bounds = [&](std::uint32_t tet) { return tet_bounds.empty() ? mesh.bounds(tet) : tet_bounds[tet]; };
   const auto meets = [&](std::uint32_t tet) {
     if constexpr (kExact) return geometry::tetrahedron_intersects_box(mesh.corners(tet), box);
-    else return geometry::boxes_overlap(mesh.bounds(tet), box) && no_face_separates(mesh.corners(tet), box);
+    else return geometry::boxes_overlap(bounds(tet), box) && no_face_separates(mesh.corners(tet), box);
   };
   if (!meets(start_tet))
     throw InputError("box search: start tet " + std::to_string(start_tet) +
@@ -247,7 +249,7 @@ BoxSearchResult search(const TetMesh& mesh, std::uint32_t start_tet, const geome
       if (next == TetMesh::no_neighbour || stamps[next] == stamp) continue;
       stamps[next] = stamp;
       ++result.tets_visited;
-      if (!geometry::boxes_overlap(mesh.bounds(next), box)) continue;
+      if (!geometry::boxes_overlap(bounds(next), box)) continue;
       if constexpr (kExact) {
         ++result.exact_tests;
         if (!geometry::tetrahedron_intersects_box(mesh.corners(next), box)) continue;
@@ -266,12 +268,21 @@ BoxSearchResult search(const TetMesh& mesh, std::uint32_t start_tet, const geome
 
 BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_tet,
                                      const geometry::Box& box, BoxSearchScratch& scratch) {
-  return search<true>(mesh, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
+  return search<true>(mesh, {}, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
 }
 
-BoxSearchResult tets_near_box(const TetMesh& mesh, std::uint32_t start_tet, const geometry::Box& box,
-                              BoxSearchScratch& scratch) {
-  return search<false>(mesh, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
+BoxSearchResult tets_near_box(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds,
+                              std::uint32_t start_tet, const geometry::Box& box, BoxSearchScratch& scratch) {
+  if (tet_bounds.size() != mesh.tet_count())
+    throw InputError("box search: " + std::to_string(tet_bounds.size()) + " tet bounding boxes for " +
+                     std::to_string(mesh.tet_count()) + " tets");
+  return search<false>(mesh, tet_bounds, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
+}
+
+std::vector<geometry::Box> tet_bounding_boxes(const TetMesh& mesh) {
+  std::vector<geometry::Box> boxes(mesh.tet_count());
+  for (std::size_t t = 0; t < boxes.size(); ++t) boxes[t] = mesh.bounds(t);
+  return boxes;
 }
 
 }  // namespace tetrapage

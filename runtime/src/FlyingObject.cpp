@@ -244,7 +244,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   start = Clock::now();
   // Bounding boxes are enough here: the region only has to cover the steps' boxes, and each
   // step skips the shards whose stored bounds miss its box.
-  const BoxSearchResult found = tets_near_box(mesh, located.tet, region, search_);
+  const BoxSearchResult found = tets_near_box(mesh, index.tet_bounds(), located.tet, region, search_);
   counters.tets_visited = found.tets_visited;
   counters.tets_overlapping = std::uint32_t(found.tets.size());
   shards_.clear();
@@ -255,7 +255,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     // A shard's triangles that meet a step's box there meet it inside the shard's tet, or
     // inside another tet of the region (whose shard holds them too): a step needs the shard
     // only when its box meets both the tet's box and the stored bounds.
-    const geometry::Box tet_box = mesh.bounds(tet);
+    const geometry::Box& tet_box = index.tet_bounds()[tet];
     const geometry::Box& stored = index.shard_bounds(shard);
     geometry::Box reach;
     for (int a = 0; a < 3; ++a) {
@@ -320,7 +320,7 @@ void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_
   const WalkResult ahead = locate_point(mesh, from_tet, centre_in_mesh_box(next_region, index));
   if (ahead.tet == TetMesh::no_neighbour || !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet))) return;
   hints_.clear();
-  for (const std::uint32_t tet : tets_near_box(mesh, ahead.tet, next_region, prefetch_search_).tets) {
+  for (const std::uint32_t tet : tets_near_box(mesh, index.tet_bounds(), ahead.tet, next_region, prefetch_search_).tets) {
     const std::uint32_t shard = index.shard_of_tet(tet);
     if (shard != TetMesh::no_neighbour && geometry::boxes_overlap(next_region, index.shard_bounds(shard)) &&
         !index.cache().contains(shard))

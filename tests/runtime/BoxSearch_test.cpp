@@ -225,7 +225,8 @@ void check_search(const TetMesh& mesh, const Box& box, std::uint32_t walk_start,
 
   // The cheap search (the flying object's region) keeps every tet that meets the box; what it
   // keeps beyond them has a bounding box that meets it.
-  const BoxSearchResult near = tets_near_box(mesh, start, box, scratch);
+  const std::vector<geometry::Box> tet_bounds = tet_bounding_boxes(mesh);
+  const BoxSearchResult near = tets_near_box(mesh, tet_bounds, start, box, scratch);
   std::vector<std::uint32_t> near_tets(near.tets.begin(), near.tets.end());
   std::sort(near_tets.begin(), near_tets.end());
   std::vector<std::uint32_t> near_missed;
@@ -330,6 +331,11 @@ TEST(BoxSearch, RejectsBadArguments) {
   Box inverted = box;
   inverted.lo[2] = 0.6;
   EXPECT_TRUE(tets_overlapping_box(mesh, inside, inverted, scratch).tets.empty());
+  // The near search needs one bounding box per tet.
+  std::vector<Box> tet_bounds = tet_bounding_boxes(mesh);
+  EXPECT_FALSE(tets_near_box(mesh, tet_bounds, inside, box, scratch).tets.empty());
+  tet_bounds.pop_back();
+  EXPECT_THROW(tets_near_box(mesh, tet_bounds, inside, box, scratch), InputError);
 }
 
 }  // namespace

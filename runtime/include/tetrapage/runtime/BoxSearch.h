@@ -51,7 +51,8 @@ class BoxSearchScratch {
  private:
   friend BoxSearchResult tets_overlapping_box(const TetMesh&, std::uint32_t, const geometry::Box&,
                                               BoxSearchScratch&);
-  friend BoxSearchResult tets_near_box(const TetMesh&, std::uint32_t, const geometry::Box&, BoxSearchScratch&);
+  friend BoxSearchResult tets_near_box(const TetMesh&, std::span<const geometry::Box>, std::uint32_t,
+                                       const geometry::Box&, BoxSearchScratch&);
   std::vector<std::uint32_t> stamps_;  ///< stamps_[tet] == stamp_: reached in this query
   std::uint32_t stamp_ = 0;
   std::vector<std::uint32_t> found_;  ///< the answer, which is also the breadth-first queue
@@ -69,8 +70,14 @@ BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_te
 /// bounding boxes overlap and no face plane separates, in double with a wide margin): a
 /// superset of tets_overlapping_box's answer (exact_tests stays 0), for callers that only need
 /// to cover the box (the flying object's searched region).
-/// @throw InputError as tets_overlapping_box (the start tet's bounding box must meet the box).
-BoxSearchResult tets_near_box(const TetMesh& mesh, std::uint32_t start_tet, const geometry::Box& box,
-                              BoxSearchScratch& scratch);
+/// `tet_bounds` are the tets' bounding boxes (tet_bounding_boxes: a search reaches each tet's
+/// box once or twice, and computing it was a third of the search).
+/// @throw InputError as tets_overlapping_box (the start tet's bounding box must meet the box),
+///        or if tet_bounds does not hold one box per tet.
+BoxSearchResult tets_near_box(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds,
+                              std::uint32_t start_tet, const geometry::Box& box, BoxSearchScratch& scratch);
+
+/// The bounding box of each tet, by tet index.
+std::vector<geometry::Box> tet_bounding_boxes(const TetMesh& mesh);
 
 }  // namespace tetrapage

@@ -58,6 +58,8 @@ class CollisionIndex {
   const CollisionIndexOptions& options() const { return options_; }
   /// The box of the coarse mesh: every stored triangle lies inside it.
   const BoundingBox& mesh_bounds() const { return mesh_bounds_; }
+  /// Each tet's bounding box, by tet index (for the box searches).
+  std::span<const geometry::Box> tet_bounds() const { return tet_bounds_; }
 
   /// The shard of a tet, or TetMesh::no_neighbour for an empty region.
   std::uint32_t shard_of_tet(std::uint32_t tet) const { return tet_shard_[tet]; }
@@ -105,6 +107,7 @@ class CollisionIndex {
   CollisionIndexOptions options_;
   TetMesh mesh_;
   BoundingBox mesh_bounds_;
+  std::vector<geometry::Box> tet_bounds_;
   std::vector<std::uint32_t> tet_shard_;
   std::vector<std::uint64_t> shard_bytes_;
   std::vector<geometry::Box> shard_bounds_;
