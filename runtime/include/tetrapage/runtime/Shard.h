@@ -142,12 +142,13 @@ class Shard {
   /// Calls visit(local, triangle) once for each stored triangle whose box overlaps `box` (no
   /// exact triangle/box test: for callers that decide each triangle exactly anyway), pruning
   /// what `accept(node_box, triangles)` rejects as well (a conservative filter of the
-  /// caller's, e.g. an oriented box): the shard's bounds with triangles 0, R-tree leaves and
-  /// grid cells (whose closed box holds every point of a triangle that a query can reach
-  /// through that cell) with the number they hold. Inner R-tree nodes are pruned by `box`
-  /// alone: an object's own box rejected about one in twenty of them on the benchmark flights,
-  /// which did not pay for the tests. A triangle is visited when some leaf or cell holding it
-  /// is accepted. No state is shared between concurrent queries.
+  /// caller's, e.g. an oriented box): R-tree leaves and grid cells (whose closed box holds
+  /// every point of a triangle that a query can reach through that cell) with the number they
+  /// hold. The shard's bounds and inner R-tree nodes are pruned by `box` alone: an object's own
+  /// box rejected about one in twenty of the inner nodes on the benchmark flights, which did
+  /// not pay for the tests (a caller that pages shards in asks its filter of a shard before).
+  /// A triangle is visited when some leaf or cell holding it is accepted. No state is shared
+  /// between concurrent queries.
   template <class Accept, class Visit>
   void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
     ShardQueryCounters counters;
@@ -269,7 +270,7 @@ class Shard {
              ShardQueryCounters& counters) const {
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
-    if (!geometry::boxes_overlap(box, bounds_) || !accept(bounds_, 0u)) return;
+    if (!geometry::boxes_overlap(box, bounds_)) return;
     // A triangle meets the box iff it meets the box clipped to the shard's bounds, which is
     // finite even when the query is not.
     geometry::Box clipped;
