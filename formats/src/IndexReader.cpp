@@ -129,6 +129,7 @@ struct ChunkLocation {
 
 struct IndexReader::Impl {
   std::filesystem::path path;
+  std::chrono::microseconds spin_before_sleep{100};
   IndexHeader header;
   std::uint64_t file_bytes = 0;
   Descriptor descriptor;
@@ -491,7 +492,7 @@ struct IndexReader::Impl {
     masks.resize(count);
     {
       // Polled first: the other thread holds it for a few microseconds (SpinThenBlock.h).
-      const std::unique_lock lock = lock_spinning_first(chunk_read_mutex(), std::chrono::microseconds(100));
+      const std::unique_lock lock = lock_spinning_first(chunk_read_mutex(), spin_before_sleep);
       for (std::uint64_t k = 0; k < count; ++k) read_stored_chunk(shard, k, masks[k], stored[k]);
     }
     for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload, scratch);
@@ -729,6 +730,10 @@ std::vector<std::byte> IndexReader::read_shard(std::uint32_t shard) const {
 
 void IndexReader::read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const {
   impl_->read_shard(shard, payload);
+}
+
+void IndexReader::set_spin_before_sleep(std::chrono::microseconds limit) {
+  impl_->spin_before_sleep = std::max(limit, std::chrono::microseconds(0));
 }
 
 std::vector<std::byte> IndexReader::read_shard_through_hdf5(std::uint32_t shard) const {

@@ -47,6 +47,8 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   ShardCacheOptions cache_options;
   cache_options.prefetch_threads = options_.prefetch ? std::max<std::size_t>(1, options_.prefetch_threads) : 0;
   cache_options.spin_before_sleep = options_.spin_before_sleep;
+  // The chunk reads hold their lock for a few microseconds: the reader polls for at most 100.
+  reader_.set_spin_before_sleep(std::min(options_.spin_before_sleep, std::chrono::microseconds(100)));
   if (options_.shard_arena) {
     const std::uint64_t most = std::min(options_.memory_budget_bytes, total_shard_bytes_);
     arena_ = std::make_unique<ShardArena>(std::size_t(most + most / 8));

@@ -183,27 +183,31 @@ TEST(IndexFile, ShardsReadConcurrentlyFromSeveralThreads) {
   SCOPED_TRACE("seed " + std::to_string(seed));
   const auto folder = scratch_folder("threads");
   const WrittenIndex written = write_sample(folder, seed);
-  const IndexReader reader(written.path);
-  for (int threads : {2, 4}) {
-    std::vector<int> mismatches(static_cast<std::size_t>(threads), 0);
-    std::vector<std::thread> workers;
-    for (int w = 0; w < threads; ++w)
-      workers.emplace_back([&, w] {
-        for (int round = 0; round < 20; ++round)
-          for (std::uint32_t i = 0; i < reader.shard_count(); ++i) {
-            // Different threads walk the shards in different orders.
-            const auto s = static_cast<std::uint32_t>((i * (2 * w + 1) + round) %
-                                                      reader.shard_count());
-            const bool through_hdf5 = (round + w) % 2 == 1;
-            const auto payload =
-                through_hdf5 ? reader.read_shard_through_hdf5(s) : reader.read_shard(s);
-            if (payload != written.shards[s]) ++mismatches[static_cast<std::size_t>(w)];
-          }
-      });
-    for (auto& worker : workers) worker.join();
-    for (int w = 0; w < threads; ++w)
-      EXPECT_EQ(mismatches[static_cast<std::size_t>(w)], 0) << threads << " threads, thread " << w;
-  }
+  IndexReader reader(written.path);
+  // Waits for the chunk read lock that poll (the default) and that sleep at once.
+  for (const auto spin : {std::chrono::microseconds(100), std::chrono::microseconds(0)})
+    for (int threads : {2, 4}) {
+      reader.set_spin_before_sleep(spin);
+      std::vector<int> mismatches(static_cast<std::size_t>(threads), 0);
+      std::vector<std::thread> workers;
+      for (int w = 0; w < threads; ++w)
+        workers.emplace_back([&, w] {
+          for (int round = 0; round < 20; ++round)
+            for (std::uint32_t i = 0; i < reader.shard_count(); ++i) {
+              // Different threads walk the shards in different orders.
+              const auto s =
+                  static_cast<std::uint32_t>((i * (2 * w + 1) + round) % reader.shard_count());
+              const bool through_hdf5 = (round + w) % 2 == 1;
+              const auto payload =
+                  through_hdf5 ? reader.read_shard_through_hdf5(s) : reader.read_shard(s);
+              if (payload != written.shards[s]) ++mismatches[static_cast<std::size_t>(w)];
+            }
+        });
+      for (auto& worker : workers) worker.join();
+      for (int w = 0; w < threads; ++w)
+        EXPECT_EQ(mismatches[static_cast<std::size_t>(w)], 0)
+            << threads << " threads, thread " << w << ", polling " << spin.count() << " us";
+    }
 }
 
 TEST(IndexFile, WriterWithoutCommitLeavesNothing) {
@@ -248,13 +252,12 @@ TEST(IndexFile, WriterRejectsBadInput) {
   expect_error<InputError>([&] { writer.write_table("a/b", std::span(values)); }, {"a/b"});
   expect_error<InputError>([&] { writer.write_table("", std::span(values)); }, {"table name"});
   writer.write_table("t", std::span(values));
-  expect_error<InputError>([&] { writer.write_table("t", std::span(values)); },
-                           {"'t'", "twice"});
+  expect_error<InputError>([&] { writer.write_table("t", std::span(values)); }, {"'t'", "twice"});
   TetMesh mesh;
   mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   mesh.tets = {{0, 1, 2, 4}};
-  mesh.neighbours = {{TetMesh::no_neighbour, TetMesh::no_neighbour, TetMesh::no_neighbour,
-                      TetMesh::no_neighbour}};
+  mesh.neighbours = {
+      {TetMesh::no_neighbour, TetMesh::no_neighbour, TetMesh::no_neighbour, TetMesh::no_neighbour}};
   expect_error<InputError>([&] { writer.write_mesh(mesh); }, {"tet 0", "corner 3", "vertex 4"});
   mesh.tets = {{0, 1, 2, 3}};
   mesh.neighbours[0][2] = 1;
@@ -313,8 +316,8 @@ std::vector<std::byte> stored_by_hdf5(const std::filesystem::path& path,
 
 /// Stores `encoded` as the one chunk of a dataset with /shards/data's pipeline and reads it
 /// back through HDF5 (the LZ4 plugin decompresses it).
-std::vector<std::byte> read_by_hdf5(const std::filesystem::path& path, const detail::EncodedChunk& encoded,
-                                    std::size_t size) {
+std::vector<std::byte> read_by_hdf5(const std::filesystem::path& path,
+                                    const detail::EncodedChunk& encoded, std::size_t size) {
   const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   const hsize_t words = size / 8;
   const hid_t space = H5Screate_simple(1, &words, nullptr);
@@ -430,13 +433,15 @@ TEST(IndexFile, Fletcher32EqualsTheWordByWordSums) {
     for (const int fill : {-1, 0x00, 0xff}) {
       std::vector<std::byte> data(size);
       for (auto& b : data) b = std::byte(fill < 0 ? random.below(256) : std::uint64_t(fill));
-      ASSERT_EQ(detail::fletcher32(data), fletcher32_word_by_word(data)) << "size " << size << " fill " << fill;
+      ASSERT_EQ(detail::fletcher32(data), fletcher32_word_by_word(data))
+          << "size " << size << " fill " << fill;
     }
   }
   std::vector<std::byte> large(1 << 20, std::byte{0xff});
   EXPECT_EQ(detail::fletcher32(large), fletcher32_word_by_word(large));
   for (auto& b : large) b = std::byte(random.below(256));
-  EXPECT_EQ(detail::fletcher32(std::span(large).subspan(3)), fletcher32_word_by_word(std::span(large).subspan(3)));
+  EXPECT_EQ(detail::fletcher32(std::span(large).subspan(3)),
+            fletcher32_word_by_word(std::span(large).subspan(3)));
 }
 
 TEST(IndexFile, ChunkCodecRejectsMalformedFramesWithValidChecksums) {
@@ -449,7 +454,8 @@ TEST(IndexFile, ChunkCodecRejectsMalformedFramesWithValidChecksums) {
   ASSERT_EQ(encoded.filter_mask, 0u);
   const std::size_t frame_bytes = encoded.bytes.size() - detail::kChecksumBytes;
   auto with = [&](const std::function<void(std::vector<std::byte>&)>& change) {
-    std::vector<std::byte> frame(encoded.bytes.begin(), encoded.bytes.begin() + std::ptrdiff_t(frame_bytes));
+    std::vector<std::byte> frame(encoded.bytes.begin(),
+                                 encoded.bytes.begin() + std::ptrdiff_t(frame_bytes));
     change(frame);
     const std::uint32_t sum = detail::fletcher32(frame);
     for (int i = 0; i < 4; ++i) frame.push_back(std::byte((sum >> (8 * i)) & 0xff));
@@ -457,17 +463,23 @@ TEST(IndexFile, ChunkCodecRejectsMalformedFramesWithValidChecksums) {
     return detail::decode_chunk(frame, 0, out);
   };
   EXPECT_EQ(with([](auto&) {}), "");
-  EXPECT_NE(with([](auto& f) { f[7] = std::byte{0x01}; }).find("decodes to 4097 bytes"), std::string::npos);
-  EXPECT_NE(with([](auto& f) { f[8] = f[9] = f[10] = f[11] = std::byte{0}; }).find("blocks of 0 bytes"),
+  EXPECT_NE(with([](auto& f) { f[7] = std::byte{0x01}; }).find("decodes to 4097 bytes"),
             std::string::npos);
-  EXPECT_NE(with([](auto& f) { f[12] = std::byte{0x7f}; }).find("runs past the frame"), std::string::npos);
-  EXPECT_NE(with([](auto& f) { f.resize(12); }).find("ends inside a block header"), std::string::npos);
+  EXPECT_NE(
+      with([](auto& f) { f[8] = f[9] = f[10] = f[11] = std::byte{0}; }).find("blocks of 0 bytes"),
+      std::string::npos);
+  EXPECT_NE(with([](auto& f) { f[12] = std::byte{0x7f}; }).find("runs past the frame"),
+            std::string::npos);
+  EXPECT_NE(with([](auto& f) { f.resize(12); }).find("ends inside a block header"),
+            std::string::npos);
   EXPECT_NE(with([](auto& f) { f.resize(5); }).find("too short"), std::string::npos);
-  EXPECT_NE(with([](auto& f) { f.push_back(std::byte{0}); }).find("follow the LZ4 frame"), std::string::npos);
+  EXPECT_NE(with([](auto& f) { f.push_back(std::byte{0}); }).find("follow the LZ4 frame"),
+            std::string::npos);
   // The block's stored size one short: LZ4 runs out of input.
   EXPECT_NE(with([](auto& f) {
               const std::uint32_t shorter = static_cast<std::uint32_t>(f.size() - 16 - 1);
-              for (int i = 0; i < 4; ++i) f[std::size_t(12 + i)] = std::byte((shorter >> (8 * (3 - i))) & 0xff);
+              for (int i = 0; i < 4; ++i)
+                f[std::size_t(12 + i)] = std::byte((shorter >> (8 * (3 - i))) & 0xff);
               f.pop_back();
             }).find("cannot decompress"),
             std::string::npos);
@@ -533,11 +545,11 @@ TEST(IndexFile, MissingForeignAndWrongVersionFilesAreRejected) {
     H5Aclose(attribute);
     H5Sclose(space);
   });
-  expect_error<FormatError>([&] { IndexReader reader(written.path); },
-                            {"model.tpi", "version " + std::to_string(kIndexVersion + 1), "rebuild"});
-  set_root_attribute(written.path, "version", [&](hid_t root) {
-    write_string(root, "version", "1");
-  });
+  expect_error<FormatError>(
+      [&] { IndexReader reader(written.path); },
+      {"model.tpi", "version " + std::to_string(kIndexVersion + 1), "rebuild"});
+  set_root_attribute(written.path, "version",
+                     [&](hid_t root) { write_string(root, "version", "1"); });
   expect_error<FormatError>([&] { IndexReader reader(written.path); },
                             {"model.tpi", "'version'", "string"});
 }
@@ -591,9 +603,9 @@ TEST(IndexFile, TruncatedFilesThrowNeverCrash) {
   const WrittenIndex written = write_sample(folder, 8);
   const std::string whole = test::read_file(written.path);
   const auto truncated = folder / "truncated.tpi";
-  for (std::size_t length : {std::size_t{0}, std::size_t{7}, std::size_t{100}, std::size_t{2048},
-                             whole.size() / 3, whole.size() / 2, whole.size() - 4096,
-                             whole.size() - 1}) {
+  for (std::size_t length :
+       {std::size_t{0}, std::size_t{7}, std::size_t{100}, std::size_t{2048}, whole.size() / 3,
+        whole.size() / 2, whole.size() - 4096, whole.size() - 1}) {
     SCOPED_TRACE("truncated to " + std::to_string(length) + " of " + std::to_string(whole.size()));
     test::write_file(truncated, std::string_view(whole).substr(0, length));
     expect_error<FormatError>([&] { IndexReader reader(truncated); }, {"truncated.tpi"});

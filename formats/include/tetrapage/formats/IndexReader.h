@@ -5,6 +5,7 @@
 /// then checked (Fletcher-32) and decompressed outside HDF5, so several threads page shards in
 /// at once instead of queueing behind HDF5's global lock.
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -85,6 +86,9 @@ class IndexReader {
   /// loop that keeps one buffer per thread touches no fresh memory. Same errors; after one,
   /// `payload`'s bytes are unspecified.
   void read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const;
+  /// How long a read_shard waiting for another thread's chunk reads polls before it sleeps
+  /// (SpinThenBlock.h; 100 us unless set; 0: it sleeps at once). Set it before reads begin.
+  void set_spin_before_sleep(std::chrono::microseconds limit);
 
   /// The same payload through H5Dread of the shard's byte range (HDF5 checks and decompresses,
   /// under its global lock, with the LZ4 filter plugin that the HDF Group distributes). For

@@ -37,8 +37,9 @@ struct CollisionIndexOptions {
   /// eighth for its size classes) whose pages a background thread faults in ahead of use, so
   /// that page-ins do not take the page faults. Off: shards are allocated by malloc.
   bool shard_arena = true;
-  /// How long the cache's waits poll before they sleep (ShardCacheOptions::spin_before_sleep):
-  /// while hints keep coming the prefetch thread keeps a core busy; 0 makes every wait sleep.
+  /// How long the cache's waits poll before they sleep (ShardCacheOptions::spin_before_sleep),
+  /// and the index reader's wait for the chunk read lock (at most 100 us of it): while hints
+  /// keep coming the prefetch thread keeps a core busy; 0 makes every wait sleep.
   std::chrono::microseconds spin_before_sleep{200};
 };
 
