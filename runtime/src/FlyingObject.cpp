@@ -467,8 +467,10 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     shard.for_each_box_candidate(box, meets_own_box, [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       // The environment triangle in the object's frame (rounded: it only prunes).
+      const std::array<Vec3, 3> framed{to_object_frame(environment[0]), to_object_frame(environment[1]),
+                                       to_object_frame(environment[2])};
       geometry::Box query;
-      for (const auto& p : environment) query.extend(to_object_frame(p));
+      for (const auto& p : framed) query.extend(p);
       // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
       double magnitude = model_->radius;
       for (const auto& p : environment)
@@ -493,7 +495,27 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
           geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
           in_object_box(environment[0]))
         enclosed_.emplace_back(environment[0], shard.part_id(local));
-      model_->bvh.for_each_in_box(query, [&](std::uint32_t object_triangle) {
+      // Object triangles that can meet the environment triangle lie within `grow` of its
+      // plane, in the object's frame (its corners taken there round by less than `grow`).
+      const Vec3& p0 = framed[0];
+      const Vec3 u{framed[1][0] - p0[0], framed[1][1] - p0[1], framed[1][2] - p0[2]};
+      const Vec3 v{framed[2][0] - p0[0], framed[2][1] - p0[1], framed[2][2] - p0[2]};
+      const Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+      const double n_size = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+      const double uv_size = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
+                             (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]));
+      auto near_plane = [&](const geometry::Box& b) {
+        double lowest = 0, highest = 0, far = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double l = b.lo[a] - p0[a], h = b.hi[a] - p0[a];
+          lowest += n[a] * (n[a] > 0 ? l : h);
+          highest += n[a] * (n[a] > 0 ? h : l);
+          far = std::max({far, std::fabs(l), std::fabs(h)});
+        }
+        const double bound = 2 * grow * n_size + uv_size * far * 0x1p-40;
+        return !(lowest > bound || highest < -bound);
+      };
+      model_->bvh.for_each_in_box(query, near_plane, [&](std::uint32_t object_triangle) {
         ++counters.triangle_tests;
         if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;
         result.collides = true;

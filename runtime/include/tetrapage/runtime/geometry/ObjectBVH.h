@@ -63,6 +63,13 @@ class ObjectBVH {
   /// rounded outwards, and the query box is rounded outwards to float.
   template <class Visit>
   void for_each_in_box(const Box& box, Visit&& visit, QueryCounters* counters = nullptr) const {
+    for_each_in_box(box, [](const Box&) { return true; }, visit, counters);
+  }
+  /// The same, also skipping the triangles whose box `near(box)` rejects (a conservative
+  /// filter of the caller's, e.g. the box misses a slab around a plane; asked of the nodes
+  /// too, it cost more than it pruned on objects whose queries reach few triangles).
+  template <class Near, class Visit>
+  void for_each_in_box(const Box& box, Near&& near, Visit&& visit, QueryCounters* counters = nullptr) const {
     FloatBox q;
     for (int k = 0; k < 3; ++k) {
       q.lo[k] = float_below(box.lo[k]);
@@ -83,7 +90,8 @@ class ObjectBVH {
       if (node.count > 0) {
         for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
           ++tests;
-          if (boxes_overlap(box, box_of(triangles_[i])) && !visit(original_[i])) {
+          const Box own = box_of(triangles_[i]);
+          if (boxes_overlap(box, own) && near(own) && !visit(original_[i])) {
             top = 0;
             break;
           }
