@@ -247,6 +247,10 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   const BoxSearchResult found = tets_near_box(mesh, index.tet_bounds(), located.tet, region, search_);
   counters.tets_visited = found.tets_visited;
   counters.tets_overlapping = std::uint32_t(found.tets.size());
+  // The last region's pins, for the shards the new region keeps: releasing them and acquiring
+  // them again took the cache's lock twice each.
+  previous_shards_.swap(shards_);
+  previous_pins_.swap(pins_);
   shards_.clear();
   shard_reach_.clear();
   for (const std::uint32_t tet : found.tets) {
@@ -275,7 +279,15 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   std::uint64_t region_bytes = 0;
   for (const std::uint32_t shard : shards_) region_bytes += index.shard_bytes(shard);
   keep_pins_ = region_bytes <= index.options().memory_budget_bytes / 8;
-  if (keep_pins_) pins_.resize(shards_.size());
+  if (keep_pins_) {
+    pins_.resize(shards_.size());
+    for (std::size_t k = 0; k < previous_pins_.size(); ++k) {
+      if (!previous_pins_[k]) continue;
+      const auto kept = std::find(shards_.begin(), shards_.end(), previous_shards_[k]);
+      if (kept != shards_.end()) pins_[std::size_t(kept - shards_.begin())] = std::move(previous_pins_[k]);
+    }
+  }
+  previous_pins_.clear();  // the rest are released
 
   if (index.options().prefetch) {
     // The region's shards that the box does not meet yet but would within four more steps of

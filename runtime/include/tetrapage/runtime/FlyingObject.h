@@ -209,6 +209,9 @@ class FlyingObject {
   std::vector<std::uint32_t> shards_;
   std::vector<geometry::Box> shard_reach_;  ///< parallel to shards_: tet box and stored bounds, intersected
   std::vector<ShardCache<Shard>::Pin> pins_;  ///< parallel to shards_; empty until needed
+  // The last region's shards and pins while a search builds the next (reused buffers).
+  std::vector<std::uint32_t> previous_shards_;
+  std::vector<ShardCache<Shard>::Pin> previous_pins_;
   bool keep_pins_ = false;
   std::vector<std::uint32_t> hints_;
 };
