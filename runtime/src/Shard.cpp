@@ -88,19 +88,6 @@ bool finite(const geometry::Point& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
-// x rounded down (up) to a float, so that float boxes enclose their double ones, then clamped
-// to the finite floats as the queries' are (Shard::relative_query): clamping both sides keeps
-// every overlap.
-float float_at_most(double x) {
-  float f = float(x);
-  if (double(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
-  return std::clamp(f, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
-}
-float float_at_least(double x) {
-  float f = float(x);
-  if (double(f) < x) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-  return std::clamp(f, -std::numeric_limits<float>::max(), std::numeric_limits<float>::max());
-}
 
 bool box_contains_box(const geometry::Box& outer, const geometry::Box& inner) {
   for (int k = 0; k < 3; ++k)
@@ -432,6 +419,9 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
     // The padding holds empty boxes (never read into a result: children past a node's count
     // are masked off).
     shard.node_boxes_.assign(6 * shard.node_stride_, 0.0f);
+    // The stored coordinates by axis, converted to floats in one pass after the loop.
+    thread_local std::vector<double> relative;
+    relative.resize(6 * std::size_t(structure_count));
     std::vector<geometry::Box> boxes;  // in double, for the enclosure checks
     if (check_boxes) boxes.resize(structure_count);
     std::vector<std::uint32_t> depth(structure_count, 0);
@@ -451,11 +441,8 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
                               : in.at<double>(at + 24 + 8 * k);
         box.lo[k] = shard.origin_[k] + lo;
         box.hi[k] = shard.origin_[k] + hi;
-        shard.node_boxes_[k * shard.node_stride_ + i] = float_at_most(lo);
-        shard.node_boxes_[(3 + k) * shard.node_stride_ + i] = float_at_least(hi);
-        if (std::fabs(lo) > std::numeric_limits<float>::max() ||
-            std::fabs(hi) > std::numeric_limits<float>::max())
-          shard.clamped_node_boxes_ = true;
+        relative[k * structure_count + i] = lo;
+        relative[(3 + k) * structure_count + i] = hi;
       }
       node.first = in.at<std::uint32_t>(at + record - 8);
       node.count = in.at<std::uint32_t>(at + record - 4);
@@ -496,6 +483,22 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
         }
       }
     }
+    // Rounded outward by a float's unit in the last place (at least; subnormals by the
+    // smallest float), clamped to the finite floats: one vectorisable pass.
+    constexpr double kMost = std::numeric_limits<float>::max();
+    constexpr float kTiny = std::numeric_limits<float>::denorm_min();
+    double largest = 0;
+    for (std::size_t k = 0; k < 6; ++k) {
+      const double* from = relative.data() + k * structure_count;
+      float* to = shard.node_boxes_.data() + k * shard.node_stride_;
+      const float side = k < 3 ? -1.0f : 1.0f;
+      for (std::uint32_t i = 0; i < structure_count; ++i) {
+        largest = std::max(largest, std::fabs(from[i]));
+        const float f = float(std::clamp(from[i], -kMost, kMost));
+        to[i] = std::clamp(f + side * (std::fabs(f) * 0x1p-23f + kTiny), -float(kMost), float(kMost));
+      }
+    }
+    shard.clamped_node_boxes_ = largest > kMost;
     if (leaf_triangles != triangle_count)
       in.fail("triangles in R-tree leaves", leaf_triangles,
               "must equal triangle_count " + std::to_string(triangle_count));
