@@ -39,18 +39,22 @@ bool count_crossings(const CollisionIndex& index, const Shard& shard,
   box.extend(segment[0]);
   box.extend(segment[1]);
   bool generic = true;
-  shard.for_each_candidate(box, [&](std::uint32_t local) {
-    if (!generic) return;
-    const std::uint32_t part = shard.part_id(local);
-    if (!index.part_closed(part)) return;
-    ++tests;
-    const auto hit = geometry::classify_segment_triangle(segment, shard.triangle(local));
-    if (!hit) return;
-    if (hit.contact == geometry::SegmentTriangleContact::interior && !hit.at_endpoint)
-      toggle(parts, part);
-    else
-      generic = false;
-  });
+  // Triangles whose boxes meet the segment's: the exact segment test decides (an exact
+  // triangle/box test first cost more than it spared).
+  shard.for_each_box_candidate(
+      box, [](const geometry::Box&, std::uint32_t) { return true; },
+      [&](std::uint32_t local, const geometry::Triangle& triangle) {
+        if (!generic) return;
+        const std::uint32_t part = shard.part_id(local);
+        if (!index.part_closed(part)) return;
+        ++tests;
+        const auto hit = geometry::classify_segment_triangle(segment, triangle);
+        if (!hit) return;
+        if (hit.contact == geometry::SegmentTriangleContact::interior && !hit.at_endpoint)
+          toggle(parts, part);
+        else
+          generic = false;
+      });
   return generic;
 }
 
@@ -69,8 +73,8 @@ bool on_closed_surface(const CollisionIndex& index, const Shard& shard, const ge
 
 // The shard from the caller's pins when it holds it (a step holds its region's), else pinned
 // into `own`.
-const Shard& shard_for(const CollisionIndex& index, std::uint32_t shard_id, std::span<const ShardPin> held,
-                       ShardPin& own) {
+const Shard& shard_for(const CollisionIndex& index, std::uint32_t shard_id,
+                       std::span<const ShardPin> held, ShardPin& own) {
   for (const ShardPin& pin : held)
     if (pin && pin.id() == shard_id) return *pin;
   own = index.cache().acquire(shard_id);
@@ -90,8 +94,9 @@ ObstacleQuery decided(ObstacleQuery answer, const std::vector<std::uint32_t>& pa
 
 // From the tet's reference point (the tet holds p); `parts` receives the closed parts holding
 // p when the answer is inside or outside.
-ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet, const geometry::Point& p,
-                             std::vector<std::uint32_t>& parts, std::span<const ShardPin> held) {
+ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet,
+                             const geometry::Point& p, std::vector<std::uint32_t>& parts,
+                             std::span<const ShardPin> held) {
   ObstacleQuery answer;
   answer.tet = tet;
   if (!index.interior_decided(tet)) return answer;
@@ -146,7 +151,8 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
 }
 
 ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
-                                  const geometry::Point& p, ObstacleMemo& memo, std::span<const ShardPin> held) {
+                                  const geometry::Point& p, ObstacleMemo& memo,
+                                  std::span<const ShardPin> held) {
   ObstacleQuery answer;
   if (!index.has_interiors()) return answer;
   const WalkResult located = locate_point(index.mesh(), hint_tet, p);
@@ -165,7 +171,8 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
     geometry::Box reach;
     reach.extend(memo.point);
     reach.extend(p);
-    if (shard_id == TetMesh::no_neighbour || !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
+    if (shard_id == TetMesh::no_neighbour ||
+        !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
       memo.point = p;
       return decided(answer, memo.parts);
     }
