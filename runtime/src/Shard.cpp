@@ -88,7 +88,6 @@ bool finite(const geometry::Point& p) {
   return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
 }
 
-
 bool box_contains_box(const geometry::Box& outer, const geometry::Box& inner) {
   for (int k = 0; k < 3; ++k)
     if (!(outer.lo[k] <= inner.lo[k] && inner.hi[k] <= outer.hi[k])) return false;
@@ -303,14 +302,41 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
   // The stored vertices, kept for the R-tree's leaf checks below (cheaper than each
   // triangle's box there: a vertex is shared by about six triangles).
   std::vector<geometry::Point> stored;
-  if (check_boxes && shard.kind_ == ShardKind::rtree) stored.resize(vertex_count);
-  for (std::uint32_t v = 0; v < vertex_count; ++v) {
-    const geometry::Point p = shard.precision_ == StoredPrecision::float32
-                                  ? shard.stored_vertex<float>(v)
-                                  : shard.stored_vertex<double>(v);
-    if (!finite(p)) in.fail("stored vertex", v, "its coordinates are not finite");
-    shard.bounds_.extend(p);
-    if (!stored.empty()) stored[v] = p;
+  if (check_boxes && shard.kind_ == ShardKind::rtree) {
+    stored.resize(vertex_count);
+    for (std::uint32_t v = 0; v < vertex_count; ++v)
+      stored[v] = shard.precision_ == StoredPrecision::float32 ? shard.stored_vertex<float>(v)
+                                                               : shard.stored_vertex<double>(v);
+  }
+  // The bounds from the extreme stored values per axis (o + double(r) rounds monotonically in
+  // r), in loops the compiler vectorises; the stored vertices are finite when their bounds are.
+  auto extremes = [&](const auto& relative) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    bool nan = false;
+    for (std::uint32_t v = 0; v < vertex_count; ++v)
+      for (int k = 0; k < 3; ++k) {
+        const double r = double(relative[3 * std::size_t(v) + std::size_t(k)]);
+        nan |= r != r;
+        lo[k] = std::min(lo[k], r);
+        hi[k] = std::max(hi[k], r);
+      }
+    for (int k = 0; k < 3; ++k) {
+      shard.bounds_.lo[k] = shard.origin_[k] + lo[k];
+      shard.bounds_.hi[k] = shard.origin_[k] + hi[k];
+    }
+    return !nan && finite(shard.bounds_.lo) && finite(shard.bounds_.hi);
+  };
+  const bool all_finite = shard.precision_ == StoredPrecision::float32
+                              ? extremes(shard.vertices32_)
+                              : extremes(shard.vertices64_);
+  if (!all_finite) {
+    for (std::uint32_t v = 0; v < vertex_count; ++v) {
+      const geometry::Point p = shard.precision_ == StoredPrecision::float32
+                                    ? shard.stored_vertex<float>(v)
+                                    : shard.stored_vertex<double>(v);
+      if (!finite(p)) in.fail("stored vertex", v, "its coordinates are not finite");
+    }
+    in.fail("stored vertices' bounds are not finite");
   }
 
   // Triangles.
@@ -495,7 +521,8 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
       for (std::uint32_t i = 0; i < structure_count; ++i) {
         largest = std::max(largest, std::fabs(from[i]));
         const float f = float(std::clamp(from[i], -kMost, kMost));
-        to[i] = std::clamp(f + side * (std::fabs(f) * 0x1p-23f + kTiny), -float(kMost), float(kMost));
+        to[i] =
+            std::clamp(f + side * (std::fabs(f) * 0x1p-23f + kTiny), -float(kMost), float(kMost));
       }
     }
     shard.clamped_node_boxes_ = largest > kMost;

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -224,6 +225,20 @@ TEST(Shard, NamesTheFieldAtFault) {
   std::memcpy(bad.data() + at + 2 * 32 + 20, &lowered, 4);
   EXPECT_NE(message(bad).find("box of R-tree leaf 2"), std::string::npos) << message(bad);
   EXPECT_NE(message(bad).find("does not enclose its triangle 1"), std::string::npos) << message(bad);
+  // A stored vertex that is not finite is named (by either kind of checks).
+  for (const DecodeChecks checks : {DecodeChecks::full, DecodeChecks::structure}) {
+    std::vector<std::byte> nan = tiny_shard(ShardKind::rtree);
+    std::uint64_t vertices;
+    std::memcpy(&vertices, nan.data() + 128, 8);
+    const float not_a_number = std::numeric_limits<float>::quiet_NaN();
+    std::memcpy(nan.data() + vertices + 3 * 4 * 2 + 4, &not_a_number, 4);  // vertex 2's y
+    try {
+      Shard::decode(nan, "m.tpi shard 2", checks);
+      ADD_FAILURE() << "a NaN vertex decoded";
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("stored vertex = 2"), std::string::npos) << e.what();
+    }
+  }
   // A page-in's checks leave the boxes to the writer and the checksums: the same payload
   // decodes, and every count and index is still checked.
   const Shard unchecked = Shard::decode(bad, "m.tpi shard 2", DecodeChecks::structure);
