@@ -187,6 +187,16 @@ namespace {
 // No face plane of the tet puts the whole box strictly outside, in double with a margin far
 // beyond the roundings: a cheap conservative stand-in for the exact test (it keeps some tets
 // that only an edge-axis plane would separate, never drops one that meets the box).
+bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box);
+
+}  // namespace
+
+bool tet_may_meet_box(const TetMesh& mesh, std::uint32_t tet, const geometry::Box& box) {
+  return no_face_separates(mesh.corners(tet), box);
+}
+
+namespace {
+
 bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box) {
   double scale = 0;
   for (const auto& p : t)

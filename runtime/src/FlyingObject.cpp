@@ -253,6 +253,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   previous_pins_.swap(pins_);
   shards_.clear();
   shard_reach_.clear();
+  shard_tet_.clear();
   for (const std::uint32_t tet : found.tets) {
     const std::uint32_t shard = index.shard_of_tet(tet);
     if (shard == TetMesh::no_neighbour) continue;
@@ -269,6 +270,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     if (!geometry::boxes_overlap(region, reach)) continue;
     shards_.push_back(shard);
     shard_reach_.push_back(reach);
+    shard_tet_.push_back(tet);
   }
   counters.search_seconds = seconds_since(start);
 
@@ -346,6 +348,7 @@ void FlyingObject::release_region() {
   pins_.clear();
   shards_.clear();
   shard_reach_.clear();
+  shard_tet_.clear();
   searched_valid_ = false;
 }
 
@@ -545,9 +548,12 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // is pinned (a page-in is dearer than the test), the object's own box meets it in its frame:
   // a contact point, or a point of a triangle inside the object, lies in the object and in some
   // tet of the region, within that tet's reach, and that tet's shard holds the triangle.
+  // Before a page-in also the tet itself, by its face planes: the coarse tets are slivers
+  // whose boxes reach far beyond them.
   auto needs = [&](std::size_t k) {
     return geometry::boxes_overlap(box, shard_reach_[k]) &&
-           ((keep_pins_ && pins_[k]) || meets_own_box(shard_reach_[k], 0));
+           ((keep_pins_ && pins_[k]) ||
+            (meets_own_box(shard_reach_[k], 0) && tet_may_meet_box(index.mesh(), shard_tet_[k], box)));
   };
   if (index.options().prefetch) {
     // Several shards to page in: the prefetch thread loads them from the last while this

@@ -203,6 +203,11 @@ void check_search(const TetMesh& mesh, const Box& box, std::uint32_t walk_start,
   const auto expected = brute_force(mesh, box, false);
   EXPECT_EQ(expected, brute_force(mesh, box, true)) << what << ": the exact test disagrees with "
                                                     << "the face/box oracle";
+  // The face-plane filter (a flying object's test before a page-in) keeps every tet that
+  // meets the box.
+  for (const std::uint32_t tet : expected)
+    EXPECT_TRUE(tet_may_meet_box(mesh, tet, box)) << what << ": tet " << tet << ", box " << hex(box.lo) << " .. "
+                                                  << hex(box.hi);
   if (expected.empty()) return;
   std::uint32_t start = locate_point(mesh, walk_start, box.lo).tet;
   if (start == TetMesh::no_neighbour) start = expected[expected.size() / 2];

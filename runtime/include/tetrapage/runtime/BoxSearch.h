@@ -77,6 +77,11 @@ BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_te
 BoxSearchResult tets_near_box(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds,
                               std::uint32_t start_tet, const geometry::Box& box, BoxSearchScratch& scratch);
 
+/// False only when one of the tet's face planes leaves the whole box outside (in double, with
+/// a margin far beyond the roundings): tets_near_box's test beyond the bounding boxes.
+/// Conservative: true for every tet that meets the box. `tet` must be in range (unchecked).
+bool tet_may_meet_box(const TetMesh& mesh, std::uint32_t tet, const geometry::Box& box);
+
 /// The bounding box of each tet, by tet index.
 std::vector<geometry::Box> tet_bounding_boxes(const TetMesh& mesh);
 

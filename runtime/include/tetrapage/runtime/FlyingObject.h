@@ -208,6 +208,7 @@ class FlyingObject {
   Vec3 searched_centre_{};
   std::vector<std::uint32_t> shards_;
   std::vector<geometry::Box> shard_reach_;  ///< parallel to shards_: tet box and stored bounds, intersected
+  std::vector<std::uint32_t> shard_tet_;    ///< parallel to shards_: the shard's tet
   std::vector<ShardCache<Shard>::Pin> pins_;  ///< parallel to shards_; empty until needed
   // The last region's shards and pins while a search builds the next (reused buffers).
   std::vector<std::uint32_t> previous_shards_;
