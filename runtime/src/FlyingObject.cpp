@@ -308,7 +308,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     hints_.clear();
     for (std::size_t k = 0; k < shards_.size(); ++k)
       if (!geometry::boxes_overlap(box, shard_reach_[k]) && geometry::boxes_overlap(ahead, shard_reach_[k]) &&
-          !index.cache().contains(shards_[k]))
+          tet_may_meet_box(mesh, shard_tet_[k], ahead) && !index.cache().contains(shards_[k]))
         hints_.push_back(shards_[k]);
     if (!hints_.empty()) index.cache().prefetch(hints_);
   }
