@@ -156,7 +156,8 @@ Shard::Shard(std::pmr::memory_resource* memory)
       cell_offsets_(memory),
       references16_(memory),
       references32_(memory),
-      nodes_(memory) {}
+      nodes_(memory),
+      node_boxes_(memory) {}
 
 std::size_t Shard::memory_bytes() const {
   auto bytes = [](const auto& v) {

@@ -10,6 +10,7 @@
 
 #include <cstring>
 #include <limits>
+#include <memory_resource>
 #include <random>
 #include <string>
 #include <vector>
@@ -163,6 +164,34 @@ TEST_P(ShardTest, DecodesIntoAnArenaAlike) {
   // flying tests decode real shards into an arena).
   const Shard moved = std::move(in_arena);
   EXPECT_EQ(moved.triangle(1), plain.triangle(1));
+}
+
+// Hands out memory from new/delete and counts the bytes it holds.
+class CountingResource : public std::pmr::memory_resource {
+ public:
+  std::size_t held = 0;
+
+ private:
+  void* do_allocate(std::size_t bytes, std::size_t alignment) override {
+    held += bytes;
+    return std::pmr::new_delete_resource()->allocate(bytes, alignment);
+  }
+  void do_deallocate(void* p, std::size_t bytes, std::size_t alignment) override {
+    held -= bytes;
+    std::pmr::new_delete_resource()->deallocate(p, bytes, alignment);
+  }
+  bool do_is_equal(const std::pmr::memory_resource& other) const noexcept override { return this == &other; }
+};
+
+TEST_P(ShardTest, EveryArrayLivesInTheGivenMemory) {
+  // A page-in decodes into the index's arena: every array of the shard must come from there.
+  CountingResource memory;
+  {
+    const Shard shard = Shard::decode(tiny_shard(GetParam()), "shard", DecodeChecks::full, &memory);
+    EXPECT_GT(memory.held, 0u);
+    EXPECT_EQ(memory.held + sizeof(Shard), shard.memory_bytes());
+  }
+  EXPECT_EQ(memory.held, 0u);
 }
 
 TEST_P(ShardTest, EveryTruncationThrows) {
