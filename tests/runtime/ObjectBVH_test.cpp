@@ -7,6 +7,7 @@
 
 #include "GeometryTestSupport.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/runtime/geometry/FloatRounding.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 
 namespace tetrapage::geometry {
@@ -178,6 +179,27 @@ TEST(ObjectBVH, BoxQueriesWithAFilterVisitWhatBruteForceKeeps) {
   }
   disagreements.expect_none(1800);
   EXPECT_GT(visited_total, 100u) << "the queries must reach triangles";
+}
+
+TEST(FloatRounding, BelowAndAboveAreTheNearestFloatsOnTheirSide) {
+  // Against std::nextafter, on random doubles of every magnitude, zero, exact floats and the
+  // ends of float's range.
+  Generator g{31};
+  std::vector<double> values{0.0, -0.0, 1.0, -1.0, 0x1p-149, -0x1p-149, 1e-46, -1e-46,
+                             double(std::numeric_limits<float>::max()), 1e39, -1e39, 1e300};
+  for (int i = 0; i < 20000; ++i) values.push_back(g.uniform(-1, 1) * std::ldexp(1.0, int(g.integer(-160, 140))));
+  for (const double x : values) {
+    const float below = float_below(x), above = float_above(x);
+    EXPECT_LE(double(below), x) << x;
+    EXPECT_GE(double(above), x) << x;
+    if (std::fabs(x) <= double(std::numeric_limits<float>::max())) {
+      const float f = float(x);
+      const float expected_below = double(f) > x ? std::nextafter(f, -INFINITY) : f;
+      const float expected_above = double(f) < x ? std::nextafter(f, INFINITY) : f;
+      EXPECT_EQ(below, expected_below) << x;
+      EXPECT_EQ(above, expected_above) << x;
+    }
+  }
 }
 
 TEST(ObjectBVH, RejectsBadObjectsNamingTheElement) {

@@ -19,6 +19,7 @@
 
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/geometry/FloatRounding.h"
 
 namespace tetrapage::geometry {
 
@@ -124,25 +125,6 @@ class ObjectBVH {
   struct FloatBox {
     float lo[3], hi[3];
   };
-  // A float no larger (float_below) or no smaller (float_above) than x, also for x beyond
-  // float's range (NaN stays NaN and overlaps nothing): node boxes and query boxes both round
-  // outwards, so float boxes never drop a pair the double boxes keep.
-  static float float_below(double x) {
-    constexpr float max = std::numeric_limits<float>::max();
-    constexpr float infinity = std::numeric_limits<float>::infinity();
-    if (x > double(max)) return max;
-    if (x < -double(max)) return -infinity;
-    const float f = static_cast<float>(x);
-    return double(f) > x ? std::nextafter(f, -infinity) : f;
-  }
-  static float float_above(double x) {
-    constexpr float max = std::numeric_limits<float>::max();
-    constexpr float infinity = std::numeric_limits<float>::infinity();
-    if (x < -double(max)) return -max;
-    if (x > double(max)) return infinity;
-    const float f = static_cast<float>(x);
-    return double(f) < x ? std::nextafter(f, infinity) : f;
-  }
   static constexpr int kMaxStack = 128;  // the build bounds the depth well below this
   struct BuildItem;
 
