@@ -184,42 +184,10 @@ std::string format_box(const geometry::Box& box) {
 
 namespace {
 
-// No face plane of the tet puts the whole box strictly outside, in double with a margin far
-// beyond the roundings: a cheap conservative stand-in for the exact test (it keeps some tets
-// that only an edge-axis plane would separate, never drops one that meets the box).
-bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box);
-
-}  // namespace
-
-bool tet_may_meet_box(const TetMesh& mesh, std::uint32_t tet, const geometry::Box& box) {
-  return no_face_separates(mesh.corners(tet), box);
-}
-
-namespace {
-
-bool no_face_separates(const geometry::Tetrahedron& t, const geometry::Box& box) {
-  double scale = 0;
-  for (const auto& p : t)
-    for (int a = 0; a < 3; ++a) scale = std::max(scale, std::fabs(p[a]));
-  for (int a = 0; a < 3; ++a) scale = std::max({scale, std::fabs(box.lo[a]), std::fabs(box.hi[a])});
-  for (int k = 0; k < 4; ++k) {
-    const geometry::Point& a = t[geometry::kTetrahedronFaces[k][0]];
-    auto [n, size] = geometry::face_normal(t, k);
-    const geometry::Point& opposite = t[k];
-    const double inside = n[0] * (opposite[0] - a[0]) + n[1] * (opposite[1] - a[1]) + n[2] * (opposite[2] - a[2]);
-    if (inside < 0) n = {-n[0], -n[1], -n[2]};
-    // The box corner farthest into the tet's side of the plane.
-    double reach = 0;
-    for (int axis = 0; axis < 3; ++axis) reach += n[axis] * ((n[axis] > 0 ? box.hi[axis] : box.lo[axis]) - a[axis]);
-    if (reach < -size * scale * 0x1p-40) return false;
-  }
-  return true;
-}
-
 // Breadth-first from start_tet through the tets `meets` accepts; those form a connected set
 // when `meets` is exact (the tets meeting a convex box) or a superset of it (box overlaps).
 template <bool kExact>
-BoxSearchResult search(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds, std::uint32_t start_tet,
+BoxSearchResult search(const TetMesh& mesh, const TetBoxFilter* filter, std::uint32_t start_tet,
                        const geometry::Box& box, std::vector<std::uint32_t>& stamps, std::uint32_t& stamp_counter,
                        std::vector<std::uint32_t>& found) {
   if (start_tet >= mesh.tet_count())
@@ -230,11 +198,12 @@ BoxSearchResult search(const TetMesh& mesh, std::span<const geometry::Box> tet_b
   found.clear();
   BoxSearchResult result;
   if (geometry::inverted(box)) return result;
-  // The exact search has no precomputed boxes (empty): it computes them.
-  const auto bounds = [&](std::uint32_t tet) { return tet_bounds.empty() ? mesh.bounds(tet) : tet_bounds[tet]; };
+  // The exact search has no filter: it computes the boxes.
+  const auto bounds = [&](std::uint32_t tet) { return filter == nullptr ? mesh.bounds(tet) : filter->bounds(tet); };
+  const double box_magnitude = TetBoxFilter::magnitude(box);
   const auto meets = [&](std::uint32_t tet) {
     if constexpr (kExact) return geometry::tetrahedron_intersects_box(mesh.corners(tet), box);
-    else return geometry::boxes_overlap(bounds(tet), box) && no_face_separates(mesh.corners(tet), box);
+    else return geometry::boxes_overlap(bounds(tet), box) && filter->planes_may_meet(tet, box, box_magnitude);
   };
   if (!meets(start_tet))
     throw InputError("box search: start tet " + std::to_string(start_tet) +
@@ -265,7 +234,7 @@ BoxSearchResult search(const TetMesh& mesh, std::span<const geometry::Box> tet_b
         if (!geometry::tetrahedron_intersects_box(mesh.corners(next), box)) continue;
       } else {
         // Sliver tets' boxes reach far beyond them: a face plane keeps most of those out.
-        if (!no_face_separates(mesh.corners(next), box)) continue;
+        if (!filter->planes_may_meet(next, box, box_magnitude)) continue;
       }
       found.push_back(next);
     }
@@ -278,21 +247,15 @@ BoxSearchResult search(const TetMesh& mesh, std::span<const geometry::Box> tet_b
 
 BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_tet,
                                      const geometry::Box& box, BoxSearchScratch& scratch) {
-  return search<true>(mesh, {}, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
+  return search<true>(mesh, nullptr, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
 }
 
-BoxSearchResult tets_near_box(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds,
-                              std::uint32_t start_tet, const geometry::Box& box, BoxSearchScratch& scratch) {
-  if (tet_bounds.size() != mesh.tet_count())
-    throw InputError("box search: " + std::to_string(tet_bounds.size()) + " tet bounding boxes for " +
+BoxSearchResult tets_near_box(const TetMesh& mesh, const TetBoxFilter& filter, std::uint32_t start_tet,
+                              const geometry::Box& box, BoxSearchScratch& scratch) {
+  if (filter.tet_count() != mesh.tet_count())
+    throw InputError("box search: a tet filter of " + std::to_string(filter.tet_count()) + " tets for " +
                      std::to_string(mesh.tet_count()) + " tets");
-  return search<false>(mesh, tet_bounds, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
-}
-
-std::vector<geometry::Box> tet_bounding_boxes(const TetMesh& mesh) {
-  std::vector<geometry::Box> boxes(mesh.tet_count());
-  for (std::size_t t = 0; t < boxes.size(); ++t) boxes[t] = mesh.bounds(t);
-  return boxes;
+  return search<false>(mesh, &filter, start_tet, box, scratch.stamps_, scratch.stamp_, scratch.found_);
 }
 
 }  // namespace tetrapage

@@ -14,7 +14,7 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   if (options_.memory_budget_bytes == 0) throw InputError("the shard memory budget must be positive");
   mesh_ = reader_.read_mesh();  // checks every vertex and neighbour index
   for (const auto& v : mesh_.vertices) mesh_bounds_.extend(v);
-  tet_bounds_ = tet_bounding_boxes(mesh_);
+  tet_filter_ = TetBoxFilter(mesh_);
   tet_shard_ = reader_.read_table_uint32("tet_shard");
   const std::string where = path.string() + ": ";
   if (tet_shard_.size() != mesh_.tet_count())

@@ -244,7 +244,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   start = Clock::now();
   // Bounding boxes are enough here: the region only has to cover the steps' boxes, and each
   // step skips the shards whose stored bounds miss its box.
-  const BoxSearchResult found = tets_near_box(mesh, index.tet_bounds(), located.tet, region, search_);
+  const BoxSearchResult found = tets_near_box(mesh, index.tet_filter(), located.tet, region, search_);
   counters.tets_visited = found.tets_visited;
   counters.tets_overlapping = std::uint32_t(found.tets.size());
   // The last region's pins, for the shards the new region keeps: releasing them and acquiring
@@ -260,7 +260,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     // A shard's triangles that meet a step's box there meet it inside the shard's tet, or
     // inside another tet of the region (whose shard holds them too): a step needs the shard
     // only when its box meets both the tet's box and the stored bounds.
-    const geometry::Box& tet_box = index.tet_bounds()[tet];
+    const geometry::Box& tet_box = index.tet_filter().bounds(tet);
     const geometry::Box& stored = index.shard_bounds(shard);
     geometry::Box reach;
     for (int a = 0; a < 3; ++a) {
@@ -308,7 +308,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     hints_.clear();
     for (std::size_t k = 0; k < shards_.size(); ++k)
       if (!geometry::boxes_overlap(box, shard_reach_[k]) && geometry::boxes_overlap(ahead, shard_reach_[k]) &&
-          tet_may_meet_box(mesh, shard_tet_[k], ahead) && !index.cache().contains(shards_[k]))
+          index.tet_filter().planes_may_meet(shard_tet_[k], ahead) && !index.cache().contains(shards_[k]))
         hints_.push_back(shards_[k]);
     if (!hints_.empty()) index.cache().prefetch(hints_);
   }
@@ -334,7 +334,7 @@ void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_
   const WalkResult ahead = locate_point(mesh, from_tet, centre_in_mesh_box(next_region, index));
   if (ahead.tet == TetMesh::no_neighbour || !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet))) return;
   hints_.clear();
-  for (const std::uint32_t tet : tets_near_box(mesh, index.tet_bounds(), ahead.tet, next_region, prefetch_search_).tets) {
+  for (const std::uint32_t tet : tets_near_box(mesh, index.tet_filter(), ahead.tet, next_region, prefetch_search_).tets) {
     const std::uint32_t shard = index.shard_of_tet(tet);
     if (shard != TetMesh::no_neighbour && geometry::boxes_overlap(next_region, index.shard_bounds(shard)) &&
         !index.cache().contains(shard))
@@ -553,7 +553,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   auto needs = [&](std::size_t k) {
     return geometry::boxes_overlap(box, shard_reach_[k]) &&
            ((keep_pins_ && pins_[k]) ||
-            (meets_own_box(shard_reach_[k], 0) && tet_may_meet_box(index.mesh(), shard_tet_[k], box)));
+            (meets_own_box(shard_reach_[k], 0) && index.tet_filter().planes_may_meet(shard_tet_[k], box)));
   };
   if (index.options().prefetch) {
     // Several shards to page in: the prefetch thread loads them from the last while this

@@ -197,16 +197,15 @@ std::vector<std::uint32_t> brute_force(const TetMesh& mesh, const Box& box, bool
 
 /// Searches from the tet located for a corner of the box (or any tet meeting it, when the
 /// corner is outside the mesh) and compares with brute force.
-void check_search(const TetMesh& mesh, const Box& box, std::uint32_t walk_start,
+void check_search(const TetMesh& mesh, const TetBoxFilter& filter, const Box& box, std::uint32_t walk_start,
                   BoxSearchScratch& scratch, const std::string& what, int& failures,
                   double& visited_per_found) {
   const auto expected = brute_force(mesh, box, false);
   EXPECT_EQ(expected, brute_force(mesh, box, true)) << what << ": the exact test disagrees with "
                                                     << "the face/box oracle";
-  // The face-plane filter (a flying object's test before a page-in) keeps every tet that
-  // meets the box.
+  // The filter (a flying object's test before a page-in) keeps every tet that meets the box.
   for (const std::uint32_t tet : expected)
-    EXPECT_TRUE(tet_may_meet_box(mesh, tet, box)) << what << ": tet " << tet << ", box " << hex(box.lo) << " .. "
+    EXPECT_TRUE(filter.may_meet(tet, box)) << what << ": tet " << tet << ", box " << hex(box.lo) << " .. "
                                                   << hex(box.hi);
   if (expected.empty()) return;
   std::uint32_t start = locate_point(mesh, walk_start, box.lo).tet;
@@ -230,8 +229,7 @@ void check_search(const TetMesh& mesh, const Box& box, std::uint32_t walk_start,
 
   // The cheap search (the flying object's region) keeps every tet that meets the box; what it
   // keeps beyond them has a bounding box that meets it.
-  const std::vector<geometry::Box> tet_bounds = tet_bounding_boxes(mesh);
-  const BoxSearchResult near = tets_near_box(mesh, tet_bounds, start, box, scratch);
+  const BoxSearchResult near = tets_near_box(mesh, filter, start, box, scratch);
   std::vector<std::uint32_t> near_tets(near.tets.begin(), near.tets.end());
   std::sort(near_tets.begin(), near_tets.end());
   std::vector<std::uint32_t> near_missed;
@@ -257,6 +255,7 @@ TEST(BoxSearch, FindsExactlyTheTetsMeetingTheBoxInRandomMeshes) {
                        Case{500, 30, 1e18, 100}, Case{5000, 0, 1e6, 60}}) {
     const std::uint64_t seed = 42 + c.sites + std::uint64_t(c.exponent + 64);
     const TetMesh mesh = random_mesh(c.sites, seed, c.exponent, c.offset);
+    const TetBoxFilter filter(mesh);
     Generator g(seed + 0x51ed);  // not the sites' sequence
     BoxSearchScratch scratch;
     const std::string what = std::to_string(c.sites) + " sites, seed " + std::to_string(seed) +
@@ -276,7 +275,7 @@ TEST(BoxSearch, FindsExactlyTheTetsMeetingTheBoxInRandomMeshes) {
       const Box box = box_between(place({centre[0] - half[0], centre[1] - half[1], centre[2] - half[2]}),
                                   place({centre[0] + half[0], centre[1] + half[1], centre[2] + half[2]}));
       const auto walk_start = std::uint32_t(g.integer(0, std::int64_t(mesh.tet_count()) - 1));
-      check_search(mesh, box, walk_start, scratch, what, failures, visited_per_found);
+      check_search(mesh, filter, box, walk_start, scratch, what, failures, visited_per_found);
       ++searched;
     }
     std::printf("%s: %d boxes, %.2f tets visited per tet found\n", what.c_str(), searched,
@@ -286,6 +285,7 @@ TEST(BoxSearch, FindsExactlyTheTetsMeetingTheBoxInRandomMeshes) {
 
 TEST(BoxSearch, LatticeBoxesTouchingFacesEdgesAndVertices) {
   const TetMesh mesh = lattice_mesh(6);
+  const TetBoxFilter filter(mesh);
   Generator g(8);
   BoxSearchScratch scratch;
   int failures = 0;
@@ -295,7 +295,7 @@ TEST(BoxSearch, LatticeBoxesTouchingFacesEdgesAndVertices) {
     auto coordinate = [&] { return double(g.integer(-2, 12)) / 2; };
     Point a{coordinate(), coordinate(), coordinate()}, b{coordinate(), coordinate(), coordinate()};
     if (q % 5 == 0) b = a;  // a point box, often a vertex
-    check_search(mesh, box_between(a, b), std::uint32_t(g.integer(0, std::int64_t(mesh.tet_count()) - 1)),
+    check_search(mesh, filter, box_between(a, b), std::uint32_t(g.integer(0, std::int64_t(mesh.tet_count()) - 1)),
                  scratch, "lattice 6^3, seed 8", failures, visited_per_found);
   }
 }
@@ -336,11 +336,9 @@ TEST(BoxSearch, RejectsBadArguments) {
   Box inverted = box;
   inverted.lo[2] = 0.6;
   EXPECT_TRUE(tets_overlapping_box(mesh, inside, inverted, scratch).tets.empty());
-  // The near search needs one bounding box per tet.
-  std::vector<Box> tet_bounds = tet_bounding_boxes(mesh);
-  EXPECT_FALSE(tets_near_box(mesh, tet_bounds, inside, box, scratch).tets.empty());
-  tet_bounds.pop_back();
-  EXPECT_THROW(tets_near_box(mesh, tet_bounds, inside, box, scratch), InputError);
+  // The near search needs a filter made for the mesh.
+  EXPECT_FALSE(tets_near_box(mesh, TetBoxFilter(mesh), inside, box, scratch).tets.empty());
+  EXPECT_THROW(tets_near_box(mesh, TetBoxFilter(lattice_mesh(2)), inside, box, scratch), InputError);
 }
 
 }  // namespace

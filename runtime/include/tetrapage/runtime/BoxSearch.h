@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tetrapage/formats/TetMesh.h"
+#include "tetrapage/runtime/TetBoxFilter.h"
 #include "tetrapage/runtime/geometry/Box.h"
 
 namespace tetrapage {
@@ -51,8 +52,8 @@ class BoxSearchScratch {
  private:
   friend BoxSearchResult tets_overlapping_box(const TetMesh&, std::uint32_t, const geometry::Box&,
                                               BoxSearchScratch&);
-  friend BoxSearchResult tets_near_box(const TetMesh&, std::span<const geometry::Box>, std::uint32_t,
-                                       const geometry::Box&, BoxSearchScratch&);
+  friend BoxSearchResult tets_near_box(const TetMesh&, const TetBoxFilter&, std::uint32_t, const geometry::Box&,
+                                       BoxSearchScratch&);
   std::vector<std::uint32_t> stamps_;  ///< stamps_[tet] == stamp_: reached in this query
   std::uint32_t stamp_ = 0;
   std::vector<std::uint32_t> found_;  ///< the answer, which is also the breadth-first queue
@@ -67,22 +68,12 @@ BoxSearchResult tets_overlapping_box(const TetMesh& mesh, std::uint32_t start_te
                                      const geometry::Box& box, BoxSearchScratch& scratch);
 
 /// The same breadth-first search with a cheap conservative test instead of the exact one (the
-/// bounding boxes overlap and no face plane separates, in double with a wide margin): a
-/// superset of tets_overlapping_box's answer (exact_tests stays 0), for callers that only need
-/// to cover the box (the flying object's searched region).
-/// `tet_bounds` are the tets' bounding boxes (tet_bounding_boxes: a search reaches each tet's
-/// box once or twice, and computing it was a third of the search).
-/// @throw InputError as tets_overlapping_box (the start tet's bounding box must meet the box),
-///        or if tet_bounds does not hold one box per tet.
-BoxSearchResult tets_near_box(const TetMesh& mesh, std::span<const geometry::Box> tet_bounds,
-                              std::uint32_t start_tet, const geometry::Box& box, BoxSearchScratch& scratch);
-
-/// False only when one of the tet's face planes leaves the whole box outside (in double, with
-/// a margin far beyond the roundings): tets_near_box's test beyond the bounding boxes.
-/// Conservative: true for every tet that meets the box. `tet` must be in range (unchecked).
-bool tet_may_meet_box(const TetMesh& mesh, std::uint32_t tet, const geometry::Box& box);
-
-/// The bounding box of each tet, by tet index.
-std::vector<geometry::Box> tet_bounding_boxes(const TetMesh& mesh);
+/// filter's bounding boxes overlap and no face plane separates): a superset of
+/// tets_overlapping_box's answer (exact_tests stays 0), for callers that only need to cover the
+/// box (the flying object's searched region).
+/// @throw InputError as tets_overlapping_box (the start tet must pass the filter), or if the
+///        filter was not made for a mesh of as many tets.
+BoxSearchResult tets_near_box(const TetMesh& mesh, const TetBoxFilter& filter, std::uint32_t start_tet,
+                              const geometry::Box& box, BoxSearchScratch& scratch);
 
 }  // namespace tetrapage

@@ -17,6 +17,7 @@
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/ShardArena.h"
 #include "tetrapage/runtime/ShardCache.h"
+#include "tetrapage/runtime/TetBoxFilter.h"
 #include "tetrapage/runtime/geometry/Box.h"
 
 namespace tetrapage {
@@ -59,8 +60,8 @@ class CollisionIndex {
   const CollisionIndexOptions& options() const { return options_; }
   /// The box of the coarse mesh: every stored triangle lies inside it.
   const BoundingBox& mesh_bounds() const { return mesh_bounds_; }
-  /// Each tet's bounding box, by tet index (for the box searches).
-  std::span<const geometry::Box> tet_bounds() const { return tet_bounds_; }
+  /// Each tet's bounding box and face planes, by tet index (for the box searches).
+  const TetBoxFilter& tet_filter() const { return tet_filter_; }
 
   /// The shard of a tet, or TetMesh::no_neighbour for an empty region.
   std::uint32_t shard_of_tet(std::uint32_t tet) const { return tet_shard_[tet]; }
@@ -108,7 +109,7 @@ class CollisionIndex {
   CollisionIndexOptions options_;
   TetMesh mesh_;
   BoundingBox mesh_bounds_;
-  std::vector<geometry::Box> tet_bounds_;
+  TetBoxFilter tet_filter_;
   std::vector<std::uint32_t> tet_shard_;
   std::vector<std::uint64_t> shard_bytes_;
   std::vector<geometry::Box> shard_bounds_;
