@@ -117,6 +117,30 @@ TEST(FlyingObject, ExactAnswersEqualTheOracleOnScenesTetrasAndTerrains) {
   expect_same_answers(fly(terrain, {}), terrain, "terrain");
 }
 
+TEST(FlyingObject, StepsInFreeBoxesAgreeWithTheOracle) {
+  // Most billiard steps are far from obstacles: they find a box around them that holds no
+  // triangle, or lie in the last one found, and skip phase I. Their answers are the oracle's.
+  const World scene = make_world(Kind::scene, 30000, 500, 2000, 11);
+  auto index = std::make_shared<const CollisionIndex>(scene.index_path);
+  FlyingObject object(index, scene.object);
+  std::vector<std::uint8_t> answers;
+  std::size_t in_free_box = 0, found_free_box = 0;
+  QueryResult result;
+  for (const Pose& pose : scene.flight.poses) {
+    object.query(pose, {}, result);
+    answers.push_back(result.collides ? 1 : 0);
+    if (result.counters.in_free_box) {
+      ++in_free_box;
+      EXPECT_EQ(result.counters.shards_touched, 0u);
+    }
+    found_free_box += result.counters.found_free_box;
+    EXPECT_FALSE(result.counters.in_free_box && result.collides);
+  }
+  expect_same_answers(answers, scene, "scene");
+  EXPECT_GT(in_free_box, scene.flight.poses.size() / 4) << "steps inside a free box";
+  EXPECT_GT(found_free_box, scene.flight.poses.size() / 20) << "steps that found a free box";
+}
+
 TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
   const World world = make_world(Kind::scene, 10000, 116, 400, 4, 200);
   auto index = std::make_shared<const CollisionIndex>(world.index_path);

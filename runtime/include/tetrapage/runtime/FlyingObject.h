@@ -92,6 +92,13 @@ struct StepCounters {
   double shard_seconds = 0;         ///< acquiring shards (page-ins included)
   double test_seconds = 0;          ///< phase I and II
   double interior_seconds = 0;      ///< the containment checks of a step without contact
+  /// The box lay inside the free box of an earlier step (a box that holds no environment
+  /// triangle): nothing else ran, and the step is free.
+  bool in_free_box = false;
+  /// A new free box was found around the step's box, so phase I did not run: the step is free,
+  /// or the object inside an obstacle.
+  bool found_free_box = false;
+  double free_box_seconds = 0;  ///< looking for a new free box (found or not)
 };
 
 /// A collision without touching surfaces: one closed body holds the other.
@@ -162,6 +169,12 @@ class FlyingObject {
   // tell): p must not lie on the object's surface.
   bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box);
   bool in_object_box(const geometry::Point& p) const;
+  // After a free step whose box is `box`: a box around it holding no environment triangle
+  // (free_box_), grown towards where the object heads; false when none was found.
+  bool find_free_box(const geometry::Box& box);
+  // A step whose box is outside the free box: its answer when a new free box around it was
+  // found (free, or inside an obstacle), else false and the step goes on to phase I.
+  bool step_in_new_free_box(const geometry::Box& box, QueryResult& result);
   // How far from the object's box or surface a world point must be for the frame change's
   // rounding not to matter.
   double frame_margin(const geometry::Point& p) const;
@@ -215,6 +228,14 @@ class FlyingObject {
   std::vector<ShardCache<Shard>::Pin> previous_pins_;
   bool keep_pins_ = false;
   std::vector<std::uint32_t> hints_;
+  // A box that meets no environment triangle, around the box of a step whose answer was free
+  // (no contact, the object in no obstacle). Any later step whose box lies strictly inside it
+  // is free too: it has no candidates, and the object's containment vertex lies in the same
+  // connected, surface-free box, so on the same side of every closed part.
+  geometry::Box free_box_;
+  bool free_box_valid_ = false;
+  std::uint32_t free_box_backoff_ = 0;  ///< steps to wait after a failed search, doubled per failure
+  std::uint32_t free_box_wait_ = 0;
 };
 
 }  // namespace tetrapage
