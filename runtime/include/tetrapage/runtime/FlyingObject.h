@@ -87,7 +87,9 @@ struct StepCounters {
   /// the object's frame, meet its own box
   std::uint64_t candidates = 0;
   std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
-  double locate_seconds = 0;        ///< the object's box, and the walk when it searched
+  /// The object's box, and the walk when it searched. While the object holds a free box, the
+  /// box is not timed: a step that ends inside the free box reads no clock at all.
+  double locate_seconds = 0;
   double search_seconds = 0;
   double shard_seconds = 0;         ///< acquiring shards (page-ins included)
   double test_seconds = 0;          ///< phase I and II
