@@ -497,8 +497,18 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     if (!model_->closed) return false;
     return model_->interior_grid.classify(in_frame.center(), margin) != ObjectInteriorGrid::Side::outside;
   };
+  // Inner R-tree nodes are asked of the object's own box too when the world box is much
+  // looser than it (a turned tetrahedron's is up to five times its volume): the subtrees it
+  // prunes then pay for the tests, which did not pay for a round object (measured 1 to 3
+  // times: 4 triangles +7 % on the 1M and 10M scenes, the others within 1 %).
+  constexpr double kLoose = 1.5;
+  const double own_volume = (model_->box.hi[0] - model_->box.lo[0] + 2 * reach) *
+                            (model_->box.hi[1] - model_->box.lo[1] + 2 * reach) *
+                            (model_->box.hi[2] - model_->box.lo[2] + 2 * reach);
+  const double world_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
+  const bool prune_inner = own_frame && world_volume > kLoose * own_volume;
   auto test_shard = [&](const Shard& shard) {
-    shard.for_each_box_candidate(box, meets_own_box, [&](std::uint32_t local, const geometry::Triangle& environment) {
+    auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       // The environment triangle in the object's frame (rounded: it only prunes).
       const std::array<Vec3, 3> framed{to_object_frame(environment[0]), to_object_frame(environment[1]),
@@ -558,7 +568,11 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         if (!all) stop = true;
         return all;
       });
-    });
+    };
+    if (prune_inner)
+      shard.for_each_box_candidate_pruning_inner_nodes(box, meets_own_box, visit);
+    else
+      shard.for_each_box_candidate(box, meets_own_box, visit);
   };
   // One clock pair around the loop (a free step is a few microseconds; a clock read per shard
   // cost a tenth of it): the tests' time is the loop's less the acquisitions'.

@@ -237,6 +237,58 @@ TEST_P(ShardBuilderTest, QueriesMatchBruteForceOnAdversarialRegions) {
   }
 }
 
+TEST_P(ShardBuilderTest, BoxCandidatesHonourAFilterOnLeavesAndInnerNodes) {
+  // for_each_box_candidate (and its variant that also asks inner R-tree nodes) visits, once,
+  // every triangle that meets both the query and a filter box (a conservative filter: it
+  // keeps every node or cell whose box overlaps the filter's), and nothing whose box misses
+  // the query.
+  const auto [kind, precision] = GetParam();
+  int failures = 0;
+  std::size_t inner_asked = 0;
+  for (const Region& region : regions()) {
+    for (const ShardLayout& layout : {ShardLayout{}, ShardLayout{{0, 0, 0}, 8.0, 2, 2}}) {
+      const std::string what = region.name + " as " + std::string(to_string(kind)) + "/" +
+                               std::string(to_string(precision)) + " leaf " + std::to_string(layout.rtree_leaf_size);
+      const Shard shard = Shard::decode(build_shard(region.view(), kind, precision, layout).payload, what);
+      const std::vector<Box> boxes = query_boxes(shard, 13);
+      for (std::size_t q = 0; q + 1 < boxes.size(); q += 2) {
+        const Box& box = boxes[q];
+        const Box& filter = boxes[q + 1];
+        for (const bool inner : {false, true}) {
+          std::vector<int> seen(shard.triangle_count(), 0);
+          auto accept = [&](const Box& node, std::uint32_t triangles) {
+            if (triangles == 0) ++inner_asked;
+            return geometry::boxes_overlap(node, filter);
+          };
+          auto visit = [&](std::uint32_t t, const Triangle& triangle) {
+            ++seen[t];
+            if (triangle != shard.triangle(t) && ++failures <= 5) ADD_FAILURE() << what << ": triangle " << t;
+          };
+          if (inner)
+            shard.for_each_box_candidate_pruning_inner_nodes(box, accept, visit);
+          else
+            shard.for_each_box_candidate(box, accept, visit);
+          Box both;
+          for (int k = 0; k < 3; ++k) {
+            both.lo[k] = std::max(box.lo[k], filter.lo[k]);
+            both.hi[k] = std::min(box.hi[k], filter.hi[k]);
+          }
+          for (std::uint32_t t = 0; t < shard.triangle_count(); ++t) {
+            const Box own = geometry::box_of(shard.triangle(t));
+            const bool must = geometry::boxes_overlap(both, both) && geometry::triangle_intersects_box(shard.triangle(t), both);
+            const bool may = geometry::boxes_overlap(own, box);
+            if ((seen[t] > 1 || (must && seen[t] == 0) || (!may && seen[t] > 0)) && ++failures <= 5)
+              ADD_FAILURE() << what << " query " << q << (inner ? " (inner nodes)" : "") << ": triangle " << t
+                            << " visited " << seen[t] << " times";
+          }
+        }
+      }
+    }
+  }
+  EXPECT_EQ(failures, 0);
+  if (kind == ShardKind::rtree) EXPECT_GT(inner_asked, 0u) << "the filter was never asked of an inner node";
+}
+
 TEST_P(ShardBuilderTest, StoredVerticesIdsAndPartsRoundTrip) {
   const auto [kind, precision] = GetParam();
   for (const Region& region : regions()) {

@@ -127,7 +127,7 @@ class Shard {
   template <class Visit>
   std::size_t for_each_candidate(const geometry::Box& box, Visit&& visit) const {
     ShardQueryCounters counters;
-    query<QueryMode::decide>(box, always, visit, counters);
+    query<QueryMode::decide>(box, always, visit, counters, false);
     return counters.visited;
   }
   /// The same, adding what the query did to `counters`.
@@ -135,7 +135,7 @@ class Shard {
   std::size_t for_each_candidate(const geometry::Box& box, Visit&& visit,
                                  ShardQueryCounters& counters) const {
     const std::uint64_t before = counters.visited;
-    query<QueryMode::decide>(box, always, visit, counters);
+    query<QueryMode::decide>(box, always, visit, counters, false);
     return counters.visited - before;
   }
 
@@ -146,20 +146,29 @@ class Shard {
   /// every point of a triangle that a query can reach through that cell) with the number they
   /// hold. The shard's bounds and inner R-tree nodes are pruned by `box` alone: an object's own
   /// box rejected about one in twenty of the inner nodes on the benchmark flights, which did
-  /// not pay for the tests (a caller that pages shards in asks its filter of a shard before).
+  /// not pay for the tests (a caller that pages shards in asks its filter of a shard before),
+  /// unless the object's world box is much looser than its own (see the next).
   /// A triangle is visited when some leaf or cell holding it is accepted. No state is shared
   /// between concurrent queries.
   template <class Accept, class Visit>
   void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
     ShardQueryCounters counters;
-    query<QueryMode::boxes>(box, accept, visit, counters);
+    query<QueryMode::boxes>(box, accept, visit, counters, false);
+  }
+  /// The same, with `accept` also asked of the inner R-tree nodes below the root (with 0
+  /// triangles): for a filter much tighter than `box`, where the subtrees it prunes pay for
+  /// the tests.
+  template <class Accept, class Visit>
+  void for_each_box_candidate_pruning_inner_nodes(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
+    ShardQueryCounters counters;
+    query<QueryMode::boxes>(box, accept, visit, counters, true);
   }
 
   /// Counts the cells or nodes and the references a query of `box` examines, without deciding
   /// any triangle (what the cost model measures: the exact tests are the same for every layout).
   void count_query(const geometry::Box& box, ShardQueryCounters& counters) const {
     auto ignore = [](std::uint32_t) {};
-    query<QueryMode::count>(box, always, ignore, counters);
+    query<QueryMode::count>(box, always, ignore, counters, false);
   }
   // Read-only views of the decoded structure, for inspection, tests and the builder's checks.
   std::array<std::uint32_t, 3> grid_cells() const { return grid_cells_; }
@@ -266,8 +275,8 @@ class Shard {
 
   // The one traversal of both kinds; `accept` may prune R-tree nodes (and the whole shard).
   template <QueryMode kMode, class Accept, class Visit>
-  void query(const geometry::Box& box, const Accept& accept, Visit& visit,
-             ShardQueryCounters& counters) const {
+  void query(const geometry::Box& box, const Accept& accept, Visit& visit, ShardQueryCounters& counters,
+             bool accept_inner_nodes) const {
     for (int k = 0; k < 3; ++k)
       if (!(box.lo[k] <= box.hi[k])) return;  // empty, or NaN
     if (!geometry::boxes_overlap(box, bounds_)) return;
@@ -291,7 +300,7 @@ class Shard {
     if (kind_ == ShardKind::grid)
       query_grid<kMode>(clipped, accept, reach, counters);
     else
-      query_rtree<kMode>(clipped, accept, reach, counters);
+      query_rtree<kMode>(clipped, accept, reach, counters, accept_inner_nodes);
   }
 
   template <QueryMode kMode, class Accept, class Reach>
@@ -329,8 +338,8 @@ class Shard {
   }
 
   template <QueryMode kMode, class Accept, class Reach>
-  void query_rtree(const geometry::Box& box, const Accept& accept, Reach& reach,
-                   ShardQueryCounters& counters) const {
+  void query_rtree(const geometry::Box& box, const Accept& accept, Reach& reach, ShardQueryCounters& counters,
+                   bool accept_inner_nodes) const {
     // Depth is at most kMaxDepth and each level leaves at most kMaxFanout - 1 siblings
     // pending, which the decoder checked.
     float lo[3], hi[3];
@@ -347,7 +356,7 @@ class Shard {
       const bool leaf = (node.count & shard_format::kLeafFlag) != 0;
       const std::uint32_t count = leaf ? node.count & ~shard_format::kLeafFlag : 0;
       if constexpr (kMode == QueryMode::boxes) {
-        if (leaf && !accept(node_box(at), count)) continue;
+        if ((leaf || (accept_inner_nodes && at != 0)) && !accept(node_box(at), count)) continue;
       }
       if (leaf) {
         counters.references += count;
