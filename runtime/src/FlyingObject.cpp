@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "ConvexHull.h"
 #include "tetrapage/formats/Error.h"
@@ -621,6 +622,13 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       counters.shard_seconds += seconds_since(acquire_start);
     }
     test_shard(keep_pins_ ? *pins_[k] : *local_pin);
+  }
+  if (all && result.contacts.size() > 1) {
+    // A triangle that crosses regions is stored in each of their shards: report a pair once.
+    auto key = [](const Contact& c) { return std::tie(c.environment_triangle, c.object_triangle); };
+    std::sort(result.contacts.begin(), result.contacts.end(),
+              [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
+    result.contacts.erase(std::unique(result.contacts.begin(), result.contacts.end()), result.contacts.end());
   }
   const auto loop_end = Clock::now();
   counters.test_seconds =
