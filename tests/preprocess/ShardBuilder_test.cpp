@@ -262,7 +262,9 @@ TEST_P(ShardBuilderTest, BoxCandidatesHonourAFilterOnLeavesAndInnerNodes) {
           };
           auto visit = [&](std::uint32_t t, const Triangle& triangle) {
             ++seen[t];
-            if (triangle != shard.triangle(t) && ++failures <= 5) ADD_FAILURE() << what << ": triangle " << t;
+            if (triangle != shard.triangle(t) && ++failures <= 5) {
+              ADD_FAILURE() << what << ": triangle " << t;
+            }
           };
           if (inner)
             shard.for_each_box_candidate_pruning_inner_nodes(box, accept, visit);
@@ -277,9 +279,10 @@ TEST_P(ShardBuilderTest, BoxCandidatesHonourAFilterOnLeavesAndInnerNodes) {
             const Box own = geometry::box_of(shard.triangle(t));
             const bool must = geometry::boxes_overlap(both, both) && geometry::triangle_intersects_box(shard.triangle(t), both);
             const bool may = geometry::boxes_overlap(own, box);
-            if ((seen[t] > 1 || (must && seen[t] == 0) || (!may && seen[t] > 0)) && ++failures <= 5)
+            if ((seen[t] > 1 || (must && seen[t] == 0) || (!may && seen[t] > 0)) && ++failures <= 5) {
               ADD_FAILURE() << what << " query " << q << (inner ? " (inner nodes)" : "") << ": triangle " << t
                             << " visited " << seen[t] << " times";
+            }
           }
         }
       }
