@@ -289,7 +289,9 @@ TEST_P(ShardBuilderTest, BoxCandidatesHonourAFilterOnLeavesAndInnerNodes) {
     }
   }
   EXPECT_EQ(failures, 0);
-  if (kind == ShardKind::rtree) EXPECT_GT(inner_asked, 0u) << "the filter was never asked of an inner node";
+  if (kind == ShardKind::rtree) {
+    EXPECT_GT(inner_asked, 0u) << "the filter was never asked of an inner node";
+  }
 }
 
 TEST_P(ShardBuilderTest, StoredVerticesIdsAndPartsRoundTrip) {
