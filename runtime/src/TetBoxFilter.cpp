@@ -7,10 +7,6 @@
 
 namespace tetrapage {
 
-// The roundings: normal . x in double, for |normal|_1 < 2, is off by less than 2^-50 of the
-// largest coordinate's magnitude; both the offset and the query are given 2^-45 of theirs.
-constexpr double kRelativeMargin = 0x1p-45;
-
 double TetBoxFilter::magnitude(const geometry::Box& box) {
   return std::max({std::fabs(box.lo[0]), std::fabs(box.lo[1]), std::fabs(box.lo[2]), std::fabs(box.hi[0]),
                    std::fabs(box.hi[1]), std::fabs(box.hi[2])});
@@ -36,29 +32,15 @@ TetBoxFilter::TetBoxFilter(const TetMesh& mesh) {
       if (n[0] * (opposite[0] - a[0]) + n[1] * (opposite[1] - a[1]) + n[2] * (opposite[2] - a[2]) < 0)
         n = {-n[0], -n[1], -n[2]};
       const double size = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
-      for (int i = 0; i < 3; ++i) planes.normal[k][i] = size > 0 ? float(n[i] / size) : 0.0f;
+      for (int i = 0; i < 3; ++i) planes.normal[i][k] = size > 0 ? float(n[i] / size) : 0.0f;
       // The smallest value over the corners bounds it over the tet (their convex hull).
       double lowest = INFINITY;
-      for (const auto& p : corners) {
-        const auto& m = planes.normal[k];
-        lowest = std::min(lowest, double(m[0]) * p[0] + double(m[1]) * p[1] + double(m[2]) * p[2]);
-      }
+      for (const auto& p : corners)
+        lowest = std::min(lowest, double(planes.normal[0][k]) * p[0] + double(planes.normal[1][k]) * p[1] +
+                                      double(planes.normal[2][k]) * p[2]);
       planes.offset[k] = lowest - corner_magnitude * kRelativeMargin;
     }
   }
-}
-
-bool TetBoxFilter::planes_may_meet(std::uint32_t tet, const geometry::Box& box, double box_magnitude) const {
-  const Planes& planes = planes_[tet];
-  const double margin = box_magnitude * kRelativeMargin;
-  for (int k = 0; k < 4; ++k) {
-    const auto& m = planes.normal[k];
-    // The box corner farthest into the tet's side.
-    double highest = 0;
-    for (int a = 0; a < 3; ++a) highest += double(m[a]) * (m[a] > 0 ? box.hi[a] : box.lo[a]);
-    if (highest < planes.offset[k] - margin) return false;
-  }
-  return true;
 }
 
 }  // namespace tetrapage

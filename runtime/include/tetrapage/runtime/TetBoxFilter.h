@@ -5,6 +5,7 @@
 /// opens (80 bytes a tet beyond the box) so that a search reads no corners and forms no normals.
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -28,7 +29,28 @@ class TetBoxFilter {
     return planes_may_meet(tet, box, magnitude(box));
   }
   /// The same with magnitude(box) computed by the caller (a search asks many tets of one box).
-  bool planes_may_meet(std::uint32_t tet, const geometry::Box& box, double box_magnitude) const;
+  bool planes_may_meet(std::uint32_t tet, const geometry::Box& box, double box_magnitude) const {
+    // The box's farthest corner along a normal n, as n . centre + |n| . half-extents: no
+    // branch per axis, and the four planes side by side (the centre's and the half extents'
+    // roundings, 2^-52 of the magnitude, are within the margin).
+    const Planes& planes = planes_[tet];
+    double centre[3], half[3];
+    for (int a = 0; a < 3; ++a) {
+      centre[a] = 0.5 * (box.lo[a] + box.hi[a]);
+      half[a] = 0.5 * (box.hi[a] - box.lo[a]);
+    }
+    const double margin = box_magnitude * kRelativeMargin;
+    bool separated = false;
+    for (int k = 0; k < 4; ++k) {
+      double highest = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double n = planes.normal[a][k];
+        highest += n * centre[a] + std::fabs(n) * half[a];
+      }
+      separated |= highest < planes.offset[k] - margin;
+    }
+    return !separated;
+  }
   /// The bounding boxes overlap and planes_may_meet.
   bool may_meet(std::uint32_t tet, const geometry::Box& box) const {
     return geometry::boxes_overlap(bounds_[tet], box) && planes_may_meet(tet, box);
@@ -38,11 +60,15 @@ class TetBoxFilter {
   std::size_t memory_bytes() const { return bounds_.capacity() * sizeof(geometry::Box) + planes_.capacity() * sizeof(Planes); }
 
  private:
+  // The roundings: normal . x in double, for |normal|_1 < 2, is off by less than 2^-48 of the
+  // largest coordinate's magnitude (the query's centre and half extents included); both the
+  // offset and the query are given 2^-45 of theirs.
+  static constexpr double kRelativeMargin = 0x1p-45;
   // Face k's normal, pointing into the tet and scaled to about unit 1-norm, rounded to float
   // (any direction would do: the offset is taken from the rounded normal), and an offset no
   // larger than the smallest value of normal . x over the tet's corners.
   struct Planes {
-    std::array<std::array<float, 3>, 4> normal;
+    std::array<std::array<float, 4>, 3> normal;  ///< normal[axis][face]
     std::array<double, 4> offset;
   };
   std::vector<geometry::Box> bounds_;
