@@ -164,12 +164,23 @@ std::uint64_t load_be(const std::byte* in, int bytes) {
 constexpr std::size_t kFrameHeaderBytes = 12;  // decoded size, block size
 constexpr std::size_t kBlockHeaderBytes = 4;   // the block's stored size
 
-}  // namespace
-
-void encode_chunk(std::span<const std::byte> chunk, EncodedChunk& out) {
+void check_encodable(std::span<const std::byte> chunk) {
   if (chunk.empty() || chunk.size() > (std::size_t{1} << 30) || chunk.size() % kShuffleElementBytes != 0)
     throw InputError("cannot encode a chunk of " + std::to_string(chunk.size()) +
                      " bytes: not whole 8-byte elements between 8 bytes and 1 GiB");
+}
+
+/// Appends the Fletcher-32 of the first `filtered_bytes` of `out` and trims what follows.
+void seal(EncodedChunk& out, std::size_t filtered_bytes) {
+  const std::uint32_t checksum = fletcher32({out.bytes.data(), filtered_bytes});
+  out.bytes.resize(filtered_bytes + kChecksumBytes);
+  store_le32(out.bytes.data() + filtered_bytes, checksum);
+}
+
+}  // namespace
+
+void encode_chunk(std::span<const std::byte> chunk, EncodedChunk& out) {
+  check_encodable(chunk);
   // Byte planes: the high bytes of coordinates and indices repeat and the noisy low ones stay
   // together (LZ4 stores 0.738 of the 10M scene's 16 KiB chunks shuffled, 0.938 unshuffled).
   thread_local std::vector<std::byte> shuffled;
@@ -197,9 +208,54 @@ void encode_chunk(std::span<const std::byte> chunk, EncodedChunk& out) {
     store_be32(frame + 8, static_cast<std::uint32_t>(chunk.size()));
     store_be32(frame + kFrameHeaderBytes, static_cast<std::uint32_t>(compressed));
   }
-  const std::uint32_t checksum = fletcher32({frame, filtered_bytes});
-  store_le32(frame + filtered_bytes, checksum);
-  out.bytes.resize(filtered_bytes + kChecksumBytes);
+  seal(out, filtered_bytes);
+}
+
+void encode_chunk_uncompressed(std::span<const std::byte> chunk, std::size_t payload_bytes, EncodedChunk& out) {
+  check_encodable(chunk);
+  if (payload_bytes == 0 || payload_bytes > chunk.size())
+    throw InputError("cannot encode a chunk of " + std::to_string(chunk.size()) + " bytes with " +
+                     std::to_string(payload_bytes) + " payload bytes");
+  for (std::size_t i = payload_bytes; i < chunk.size(); ++i)
+    if (chunk[i] != std::byte{0})
+      throw InputError("cannot store a chunk's padding uncompressed: byte " + std::to_string(i) + " is not zero");
+  if (payload_bytes == chunk.size()) {
+    out.bytes.resize(chunk.size() + kChecksumBytes);
+    std::memcpy(out.bytes.data(), chunk.data(), chunk.size());
+    out.filter_mask = kShuffleSkipped | kCompressionSkipped;
+    seal(out, chunk.size());
+    return;
+  }
+  // Blocks of at least a sixteenth of the chunk (1 KiB of the index's 16 KiB), so that the
+  // padding takes at most 15 blocks of a few bytes; the first holds the payload (and, for a
+  // shorter one, some zeros) as it is.
+  const std::size_t block = std::max(payload_bytes, (chunk.size() + 15) / 16);
+  const std::size_t blocks = (chunk.size() + block - 1) / block;
+  out.bytes.resize(kFrameHeaderBytes + blocks * (kBlockHeaderBytes + std::size_t(LZ4_compressBound(int(block)))) +
+                   block + kChecksumBytes);
+  std::byte* frame = out.bytes.data();
+  store_be64(frame, chunk.size());
+  store_be32(frame + 8, static_cast<std::uint32_t>(block));
+  std::size_t at = kFrameHeaderBytes;
+  for (std::size_t done = 0; done < chunk.size(); done += block) {
+    const std::size_t bytes = std::min(block, chunk.size() - done);
+    int stored = 0;
+    if (done > 0) {
+      stored = LZ4_compress_default(reinterpret_cast<const char*>(chunk.data() + done),
+                                    reinterpret_cast<char*>(frame + at + kBlockHeaderBytes), int(bytes),
+                                    LZ4_compressBound(int(bytes)));
+    }
+    // A block whose stored size equals its decoded size is read as it is: the payload's, and
+    // any LZ4 could not shrink.
+    if (stored <= 0 || std::size_t(stored) >= bytes) {
+      std::memcpy(frame + at + kBlockHeaderBytes, chunk.data() + done, bytes);
+      stored = int(bytes);
+    }
+    store_be32(frame + at, static_cast<std::uint32_t>(stored));
+    at += kBlockHeaderBytes + std::size_t(stored);
+  }
+  out.filter_mask = kShuffleSkipped;
+  seal(out, at);
 }
 
 namespace {

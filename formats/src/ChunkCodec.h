@@ -46,6 +46,14 @@ struct EncodedChunk {
 /// @throw InputError for an empty chunk, one over 1 GiB or one that is not whole 8-byte elements.
 void encode_chunk(std::span<const std::byte> chunk, EncodedChunk& out);
 
+/// Stores `chunk` uncompressed: the first `payload_bytes` as they are (nothing to decompress
+/// or unshuffle on reading), the rest, which must be zero (a shard's padding), as at most 15 LZ4
+/// blocks of a few bytes each. A full chunk is stored as it is (shuffle and LZ4 skipped in the mask);
+/// a padded one as an LZ4 filter frame (shuffle skipped) whose first block is stored as it is.
+/// @throw InputError as encode_chunk, or when payload_bytes is 0 or past the chunk, or a byte
+///        past payload_bytes is not zero.
+void encode_chunk_uncompressed(std::span<const std::byte> chunk, std::size_t payload_bytes, EncodedChunk& out);
+
 /// Checks the checksum of `stored` and decodes it into `out`, which must receive exactly
 /// out.size() bytes (the chunk size). Returns "" on success, else what is wrong (the caller
 /// names the file, shard and chunk).

@@ -317,6 +317,16 @@ void IndexWriter::write_table(std::string_view name, std::span<const double> val
   impl_->write_table(name, values);
 }
 
+ChunkCompression parse_chunk_compression(std::string_view name) {
+  if (name == "lz4") return ChunkCompression::lz4;
+  if (name == "none") return ChunkCompression::none;
+  throw InputError("unknown chunk compression '" + std::string(name) + "' (expected lz4 or none)");
+}
+
+std::string_view to_string(ChunkCompression compression) {
+  return compression == ChunkCompression::none ? "none" : "lz4";
+}
+
 EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterOptions& options) {
   if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes ||
       options.chunk_bytes % kWordBytes != 0)
@@ -336,7 +346,11 @@ EncodedShard encode_shard(std::span<const std::byte> payload, const IndexWriterO
       std::copy(piece.begin(), piece.end(), padded.begin());
       piece = padded;
     }
-    detail::encode_chunk(piece, encoded);
+    if (options.compression == ChunkCompression::none)
+      detail::encode_chunk_uncompressed(piece, std::min<std::uint64_t>(chunk_bytes, payload.size() - k * chunk_bytes),
+                                        encoded);
+    else
+      detail::encode_chunk(piece, encoded);
     shard.chunks.push_back(encoded.bytes);
     shard.filter_masks.push_back(encoded.filter_mask);
   }

@@ -659,12 +659,13 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   summary.output = output;
   summary.memory_budget_bytes = options.memory_bytes;
   summary.precision = std::string(to_string(options.precision));
+  summary.compression = std::string(to_string(options.compression));
   const std::filesystem::path spill_folder =
       !options.spill_folder.empty() ? options.spill_folder
                                     : std::filesystem::absolute(output).parent_path();
 
   // The writer's temporary file is removed if anything below throws.
-  IndexWriter writer(output);
+  IndexWriter writer(output, {.compression = options.compression});
 
   // 1. Ingest.
   Ingest in;
@@ -1049,6 +1050,7 @@ std::string PreprocessSummary::to_json() const {
   j["bytes_written"] = bytes_written;
   j["bytes_per_triangle"] = triangles_read ? double(bytes_written) / double(triangles_read) : 0.0;
   j["precision"] = precision;
+  j["compression"] = compression;
   j["max_rounding_distance"] = max_rounding_distance;
   j["query_extent"] = query_extent;
   j["memory_budget_bytes"] = memory_budget_bytes;
@@ -1080,9 +1082,10 @@ std::string PreprocessSummary::to_text() const {
                 (unsigned long long)regions, (unsigned long long)empty_regions, (unsigned long long)region_triangles,
                 (unsigned long long)grid_shards, (unsigned long long)rtree_shards, duplication_factor);
   text << line;
-  std::snprintf(line, sizeof line, "index %s: %s (%.1f B/triangle), shards decoded %s; %s coordinates, max rounding %.3g\n",
+  std::snprintf(line, sizeof line,
+                "index %s: %s (%.1f B/triangle, chunks %s), shards decoded %s; %s coordinates, max rounding %.3g\n",
                 output.string().c_str(), format_byte_size(bytes_written).c_str(),
-                triangles_read ? double(bytes_written) / double(triangles_read) : 0.0,
+                triangles_read ? double(bytes_written) / double(triangles_read) : 0.0, compression.c_str(),
                 format_byte_size(shard_payload_bytes).c_str(), precision.c_str(), max_rounding_distance);
   text << line;
   std::snprintf(line, sizeof line, "closed parts %llu; interiors %s (%llu tets inside, %llu undecided)\n",

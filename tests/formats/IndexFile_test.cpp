@@ -398,6 +398,96 @@ TEST(IndexFile, ChunkCodecAgreesWithHdf5Filters) {
   EXPECT_GE(multi_block_frames, 2u);
 }
 
+TEST(IndexFile, UncompressedChunksAgreeWithHdf5Filters) {
+  ASSERT_GT(H5Zfilter_avail(detail::kLz4FilterId), 0)
+      << "HDF5 finds no LZ4 filter plugin: install Debian's hdf5-filter-plugin";
+  const std::uint64_t seed = 4343;
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const auto folder = scratch_folder("codec_none");
+  Random random(seed);
+  // Chunks of several sizes, each with a payload of every kind of length (one byte, below and
+  // above the 1 KiB block floor, one short of the chunk, the whole chunk) and zero padding.
+  for (std::size_t size : {8, 64, 1024, 4096, 16384, 65536}) {
+    for (std::size_t payload : {std::size_t(1), std::size_t(7), std::size_t(100), std::size_t(1023),
+                                std::size_t(1025), size / 3, size - 1, size}) {
+      if (payload == 0 || payload > size) continue;
+      SCOPED_TRACE("chunk " + std::to_string(size) + ", payload " + std::to_string(payload));
+      auto data = random_bytes(random, size, false);
+      std::fill(data.begin() + std::ptrdiff_t(payload), data.end(), std::byte{0});
+      detail::EncodedChunk encoded;
+      detail::encode_chunk_uncompressed(data, payload, encoded);
+      // The payload is stored as it is (no decompression), and the padding takes little room.
+      EXPECT_NE((encoded.filter_mask & detail::kShuffleSkipped), 0u);
+      // (LZ4 takes a byte per 255 zeros, and a few bytes a block.)
+      EXPECT_LE(encoded.bytes.size(), std::max<std::size_t>(payload, (size + 15) / 16) + size / 200 + 400);
+      EXPECT_NE(std::search(encoded.bytes.begin(), encoded.bytes.end(), data.begin(),
+                            data.begin() + std::ptrdiff_t(payload)),
+                encoded.bytes.end());
+      std::vector<std::byte> decoded(size);
+      EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, decoded), "");
+      EXPECT_EQ(decoded, data);
+      // HDF5 with the plugin reads it as written: an independent decoder.
+      EXPECT_EQ(read_by_hdf5(folder / "none.h5", encoded, size), data);
+      auto corrupted = encoded.bytes;
+      corrupted[random.below(corrupted.size())] ^= std::byte{0x04};
+      EXPECT_NE(detail::decode_chunk(corrupted, encoded.filter_mask, decoded), "");
+    }
+  }
+  detail::EncodedChunk encoded;
+  std::vector<std::byte> data(64, std::byte{0});
+  data[40] = std::byte{1};
+  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 32, encoded); }, {"byte 40", "not zero"});
+  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 0, encoded); }, {"0 payload bytes"});
+  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 65, encoded); }, {"65 payload bytes"});
+}
+
+TEST(IndexFile, UncompressedIndexReadsBackThroughOurReaderAndHdf5) {
+  const std::uint64_t seed = 31;
+  SCOPED_TRACE("seed " + std::to_string(seed));
+  const auto folder = scratch_folder("index_none");
+  Random random(seed);
+  std::vector<std::vector<std::byte>> shards;
+  for (std::size_t size : edge_sizes()) shards.push_back(random_bytes(random, size, true));
+  const auto path = folder / "raw.tpi";
+  const auto compressed_path = folder / "lz4.tpi";
+  for (const auto compression : {ChunkCompression::none, ChunkCompression::lz4}) {
+    IndexWriter writer(compression == ChunkCompression::none ? path : compressed_path,
+                       {.chunk_bytes = kChunk, .compression = compression});
+    for (const auto& shard : shards) writer.append_shard(shard);
+    IndexHeader header;
+    header.shard_count = shards.size();
+    writer.commit(header);
+  }
+  const IndexReader reader(path);
+  const IndexReader compressed(compressed_path);
+  const std::string text = test::read_file(path);
+  const std::vector<std::byte> file(reinterpret_cast<const std::byte*>(text.data()),
+                                    reinterpret_cast<const std::byte*>(text.data()) + text.size());
+  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+    SCOPED_TRACE("shard " + std::to_string(s));
+    EXPECT_EQ(reader.read_shard(s), shards[s]);
+    EXPECT_EQ(reader.read_shard_through_hdf5(s), shards[s]);
+    // Each chunk's payload lies in the file as it is.
+    const auto chunks = reader.shard_chunks(s);
+    for (std::size_t k = 0; k < chunks.size(); ++k) {
+      const auto begin = shards[s].begin() + std::ptrdiff_t(k * kChunk);
+      const auto end = shards[s].begin() + std::ptrdiff_t(std::min<std::size_t>((k + 1) * kChunk, shards[s].size()));
+      const auto stored = file.begin() + std::ptrdiff_t(chunks[k].file_offset);
+      EXPECT_NE(std::search(stored, stored + std::ptrdiff_t(chunks[k].stored_bytes), begin, end),
+                stored + std::ptrdiff_t(chunks[k].stored_bytes))
+          << "chunk " << k;
+    }
+    // Compressible payloads take more room as they are, but the padding no more than a few
+    // hundred bytes a chunk.
+    EXPECT_GE(reader.stored_shard_size(s), compressed.stored_shard_size(s));
+    EXPECT_LE(reader.stored_shard_size(s),
+              shards[s].size() + reader.shard_chunks(s).size() * 400 + 1024);
+  }
+  EXPECT_EQ(reader.validate(), std::vector<std::string>{});
+  expect_error<InputError>([] { parse_chunk_compression("zstd"); }, {"'zstd'", "lz4 or none"});
+  EXPECT_EQ(parse_chunk_compression(to_string(ChunkCompression::none)), ChunkCompression::none);
+}
+
 /// HDF5's Fletcher-32 word by word, as its H5_checksum_fletcher32 states it: the reference
 /// for our blockwise one.
 std::uint32_t fletcher32_word_by_word(std::span<const std::byte> data) {

@@ -226,6 +226,33 @@ TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
   }
 }
 
+TEST(Preprocess, UncompressedChunksHoldTheSameShards) {
+  const fs::path folder = test_folder("compression");
+  const fs::path input = make_scene(folder, 20000, 5);
+  PreprocessOptions options;
+  options.region_triangles = 1000;
+  const PreprocessSummary lz4 = preprocess({input}, folder / "lz4.tpi", options);
+  options.compression = ChunkCompression::none;
+  const PreprocessSummary none = preprocess({input}, folder / "none.tpi", options);
+  EXPECT_EQ(lz4.compression, "lz4");
+  EXPECT_EQ(none.compression, "none");
+  EXPECT_NE(none.to_json().find("\"compression\": \"none\""), std::string::npos);
+  const IndexReader a(folder / "lz4.tpi"), b(folder / "none.tpi");
+  ASSERT_EQ(a.shard_count(), b.shard_count());
+  std::uint64_t stored_lz4 = 0, stored_none = 0, payload = 0;
+  for (std::uint32_t s = 0; s < a.shard_count(); ++s) {
+    ASSERT_EQ(a.read_shard(s), b.read_shard(s)) << "shard " << s;
+    stored_lz4 += a.stored_shard_size(s);
+    stored_none += b.stored_shard_size(s);
+    payload += b.shard_size(s);
+  }
+  // As they are, the shards take about their payload (not whole padded chunks), and more than
+  // compressed.
+  EXPECT_GT(stored_none, stored_lz4);
+  EXPECT_LT(stored_none, payload + 1024 * std::uint64_t(b.shard_count()));
+  EXPECT_EQ(b.validate(), std::vector<std::string>{});
+}
+
 TEST(Preprocess, DeterministicBytes) {
   // A single file, and an assembly of many part files (the ingest parses several at once).
   const fs::path folder = test_folder("deterministic");

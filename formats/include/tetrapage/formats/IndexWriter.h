@@ -17,12 +17,29 @@
 
 namespace tetrapage {
 
+/// How /shards/data chunks are stored. Either way every chunk carries its Fletcher-32 checksum
+/// and any HDF5 reader with the LZ4 plugin reads the file (docs/FORMAT.md).
+enum class ChunkCompression : std::uint8_t {
+  /// Shuffled and LZ4-compressed (kept as they are where that does not shrink them): the
+  /// smaller file, for indexes read from a slow disk or a network.
+  lz4,
+  /// The payload as it is (only a shard's zero padding compressed): about 30 % more bytes on
+  /// disk, but a page-in from the page cache or an SSD skips LZ4 and the unshuffle, most of
+  /// its read time (docs/BENCHMARKS.md, twenty-first stop).
+  none,
+};
+
+/// "lz4" or "none". @throw InputError for another name (naming it).
+ChunkCompression parse_chunk_compression(std::string_view name);
+std::string_view to_string(ChunkCompression compression);
+
 struct IndexWriterOptions {
   /// Chunk size of /shards/data in bytes, a multiple of 8 in 1 KiB .. 64 MiB. Every shard
   /// starts on a chunk boundary, and its last chunk is padded. On the 10M scene's shards (15 KB
   /// on average), shuffled 16 KiB chunks decompress with LZ4 2.4x as fast per payload byte as
   /// 64 KiB ones and are 1 % smaller (tetrapage_bench_chunks; docs/FORMAT.md).
   std::uint32_t chunk_bytes = 16384;
+  ChunkCompression compression = ChunkCompression::lz4;
 };
 
 /// A shard's payload cut into chunks, each compressed and checksummed as the index stores it.

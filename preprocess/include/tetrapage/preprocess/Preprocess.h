@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/runtime/ShardKind.h"
 
 namespace tetrapage {
@@ -40,6 +41,8 @@ struct PreprocessOptions {
   unsigned threads = 0;
   ShardChoice shard = ShardChoice::automatic;
   StoredPrecision precision = StoredPrecision::float32;
+  /// How shard chunks are stored: LZ4 (the smaller file) or as they are (the faster page-in).
+  ChunkCompression compression = ChunkCompression::lz4;
   /// The side of the query boxes the cost model plans for; 0: 5 % of the model's largest side
   /// (the study's flying objects fit a cube of 0.05 in a unit-cube scene).
   double query_extent = 0;
@@ -85,6 +88,7 @@ struct PreprocessSummary {
   std::uint64_t bytes_written = 0;         ///< the index file
   double max_rounding_distance = 0;
   std::string precision;
+  std::string compression;                 ///< of the shard chunks: "lz4" or "none"
   double query_extent = 0;
   std::uint64_t memory_budget_bytes = 0;
   std::uint64_t closed_parts = 0;          ///< parts whose every edge is used an even number of times
