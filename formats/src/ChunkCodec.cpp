@@ -260,16 +260,18 @@ void encode_chunk_uncompressed(std::span<const std::byte> chunk, std::size_t pay
 
 namespace {
 
-/// Decodes an LZ4 filter frame into `out` (exactly out.size() bytes); "" or what is wrong.
-std::string decode_lz4_frame(std::span<const std::byte> frame, std::span<std::byte> out) {
+/// Decodes the first out.size() bytes of an LZ4 filter frame of `decoded_size` bytes into
+/// `out`; "" or what is wrong. Blocks past out.size() are walked, not decompressed.
+std::string decode_lz4_frame(std::span<const std::byte> frame, std::span<std::byte> out, std::uint64_t expected_size) {
   if (frame.size() < kFrameHeaderBytes)
     return "LZ4 frame of " + std::to_string(frame.size()) + " bytes is too short for its header";
   const std::uint64_t decoded_size = load_be(frame.data(), 8);
   std::uint64_t block_size = load_be(frame.data() + 8, 4);
-  if (decoded_size != out.size())
-    return "LZ4 frame decodes to " + std::to_string(decoded_size) + " bytes, expected " + std::to_string(out.size());
+  if (decoded_size != expected_size)
+    return "LZ4 frame decodes to " + std::to_string(decoded_size) + " bytes, expected " + std::to_string(expected_size);
   if (block_size == 0) return "LZ4 frame has blocks of 0 bytes";
   block_size = std::min(block_size, decoded_size);
+  const std::uint64_t wanted = out.size();
   std::size_t at = kFrameHeaderBytes;
   for (std::uint64_t done = 0; done < decoded_size;) {
     const std::uint64_t expected = std::min(block_size, decoded_size - done);
@@ -277,14 +279,22 @@ std::string decode_lz4_frame(std::span<const std::byte> frame, std::span<std::by
     const std::uint64_t stored = load_be(frame.data() + at, 4);
     at += kBlockHeaderBytes;
     if (stored > frame.size() - at) return "LZ4 block of " + std::to_string(stored) + " bytes runs past the frame";
-    if (stored == expected) {
-      std::memcpy(out.data() + done, frame.data() + at, stored);  // stored as it is
-    } else {
-      const int decoded = LZ4_decompress_safe(reinterpret_cast<const char*>(frame.data() + at),
+    if (done < wanted) {
+      const std::uint64_t take = std::min(expected, wanted - done);  // of this block, into out
+      if (stored == expected) {
+        std::memcpy(out.data() + done, frame.data() + at, take);  // stored as it is
+      } else {
+        const int decoded =
+            take == expected
+                ? LZ4_decompress_safe(reinterpret_cast<const char*>(frame.data() + at),
+                                      reinterpret_cast<char*>(out.data() + done), static_cast<int>(stored),
+                                      static_cast<int>(expected))
+                : LZ4_decompress_safe_partial(reinterpret_cast<const char*>(frame.data() + at),
                                               reinterpret_cast<char*>(out.data() + done), static_cast<int>(stored),
-                                              static_cast<int>(expected));
-      if (decoded < 0 || std::uint64_t(decoded) != expected)
-        return "cannot decompress an LZ4 block (corrupt or incomplete data)";
+                                              static_cast<int>(take), static_cast<int>(take));
+        if (decoded < 0 || std::uint64_t(decoded) != take)
+          return "cannot decompress an LZ4 block (corrupt or incomplete data)";
+      }
     }
     at += stored;
     done += expected;
@@ -296,7 +306,8 @@ std::string decode_lz4_frame(std::span<const std::byte> frame, std::span<std::by
 }  // namespace
 
 std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter_mask,
-                         std::span<std::byte> out) {
+                         std::span<std::byte> out, std::size_t chunk_bytes) {
+  if (chunk_bytes == 0) chunk_bytes = out.size();
   if ((filter_mask & kChecksumSkipped) != 0)
     return "stored without its Fletcher-32 checksum (filter mask " +
            std::to_string(filter_mask) + ")";
@@ -312,24 +323,35 @@ std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter
                   expected, actual);
     return text;
   }
-  if (out.size() % kShuffleElementBytes != 0)
-    return "chunk of " + std::to_string(out.size()) + " bytes is not whole 8-byte elements";
+  if (chunk_bytes % kShuffleElementBytes != 0)
+    return "chunk of " + std::to_string(chunk_bytes) + " bytes is not whole 8-byte elements";
+  if (out.size() > chunk_bytes)
+    return "asked for " + std::to_string(out.size()) + " bytes of a " + std::to_string(chunk_bytes) + "-byte chunk";
   const bool shuffled = (filter_mask & kShuffleSkipped) == 0;
-  thread_local std::vector<std::byte> planes;
+  // A shuffled chunk is decoded whole (its byte planes span it), then unshuffled.
+  thread_local std::vector<std::byte> planes, whole;
   std::span<std::byte> target = out;  // where the filtered bytes go before unshuffling
   if (shuffled) {
-    planes.resize(out.size());
+    planes.resize(chunk_bytes);
     target = planes;
   }
   if ((filter_mask & kCompressionSkipped) != 0) {
-    if (filtered.size() != out.size())
+    if (filtered.size() != chunk_bytes)
       return "uncompressed chunk holds " + std::to_string(filtered.size()) + " bytes, expected " +
-             std::to_string(out.size());
-    std::memcpy(target.data(), filtered.data(), out.size());
-  } else if (std::string problem = decode_lz4_frame(filtered, target); !problem.empty()) {
+             std::to_string(chunk_bytes);
+    std::memcpy(target.data(), filtered.data(), target.size());
+  } else if (std::string problem = decode_lz4_frame(filtered, target, chunk_bytes); !problem.empty()) {
     return problem;
   }
-  if (shuffled) unshuffle_bytes(target, out);
+  if (shuffled) {
+    if (out.size() == chunk_bytes) {
+      unshuffle_bytes(target, out);
+    } else {
+      whole.resize(chunk_bytes);
+      unshuffle_bytes(target, whole);
+      std::memcpy(out.data(), whole.data(), out.size());
+    }
+  }
   return {};
 }
 

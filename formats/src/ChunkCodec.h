@@ -54,11 +54,13 @@ void encode_chunk(std::span<const std::byte> chunk, EncodedChunk& out);
 ///        past payload_bytes is not zero.
 void encode_chunk_uncompressed(std::span<const std::byte> chunk, std::size_t payload_bytes, EncodedChunk& out);
 
-/// Checks the checksum of `stored` and decodes it into `out`, which must receive exactly
-/// out.size() bytes (the chunk size). Returns "" on success, else what is wrong (the caller
-/// names the file, shard and chunk).
+/// Checks the checksum of `stored` and decodes the first out.size() bytes of its chunk of
+/// `chunk_bytes` bytes (0: out.size(), the whole chunk) into `out`: a shard's last chunk is
+/// decoded straight into the payload. Blocks of an unshuffled frame past out.size() are
+/// checked by the checksum only, not decompressed. Returns "" on success, else what is wrong
+/// (the caller names the file, shard and chunk).
 std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter_mask,
-                         std::span<std::byte> out);
+                         std::span<std::byte> out, std::size_t chunk_bytes = 0);
 
 /// HDF5's shuffle filter of whole 8-byte elements: byte k of element i goes to k * n + i (n
 /// elements), and its inverse. `in` and `out` have the same size, a multiple of 8.

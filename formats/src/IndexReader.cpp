@@ -427,20 +427,22 @@ struct IndexReader::Impl {
       hdf5_format_error("cannot read " + chunk_name(shard, k));
   }
 
-  /// Checks and decompresses stored chunk k of a shard into its place in `payload`.
+  /// Checks and decompresses stored chunk k of a shard into its place in `payload`. A page-in
+  /// decodes the last chunk's payload only; with `whole_chunk` (validate) every block of it is
+  /// decoded, there.
   void decode_into(std::uint32_t shard, std::uint64_t k, std::span<const std::byte> stored,
                    std::uint32_t filter_mask, std::vector<std::byte>& payload,
-                   std::vector<std::byte>& scratch) const {
+                   std::vector<std::byte>* whole_chunk = nullptr) const {
     const std::uint64_t begin = k * chunk_bytes;
     const std::uint64_t bytes = std::min<std::uint64_t>(chunk_bytes, payload.size() - begin);
     std::span<std::byte> target(payload.data() + begin, bytes);
-    if (bytes < chunk_bytes) {
-      scratch.resize(chunk_bytes);
-      target = scratch;
+    if (whole_chunk != nullptr && bytes < chunk_bytes) {
+      whole_chunk->resize(chunk_bytes);
+      target = *whole_chunk;
     }
-    const std::string problem = detail::decode_chunk(stored, filter_mask, target);
+    const std::string problem = detail::decode_chunk(stored, filter_mask, target, chunk_bytes);
     if (!problem.empty()) format_error(chunk_name(shard, k) + ": " + problem);
-    if (bytes < chunk_bytes) std::memcpy(payload.data() + begin, scratch.data(), bytes);
+    if (target.data() != payload.data() + begin) std::memcpy(payload.data() + begin, target.data(), bytes);
   }
 
   void read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const {
@@ -452,7 +454,6 @@ struct IndexReader::Impl {
     // Buffers kept by the thread: fresh ones made every page-in fault new pages in (a tenth
     // of a paged flight's main thread in perf).
     constexpr std::size_t kKeptBufferBytes = std::size_t(1) << 20;
-    thread_local std::vector<std::byte> scratch;
     thread_local std::vector<std::vector<std::byte>> stored;
     thread_local std::vector<std::uint32_t> masks;
 
@@ -480,7 +481,7 @@ struct IndexReader::Impl {
         decode_into(shard, k,
                     std::span<const std::byte>(stored[0]).subspan(location.address - low,
                                                                   location.stored_bytes),
-                    location.filter_mask, payload, scratch);
+                    location.filter_mask, payload);
       }
       if (stored[0].capacity() > kKeptBufferBytes) std::vector<std::byte>().swap(stored[0]);  // a rare large shard
       return;
@@ -495,7 +496,7 @@ struct IndexReader::Impl {
       const std::unique_lock lock = lock_spinning_first(chunk_read_mutex(), spin_before_sleep);
       for (std::uint64_t k = 0; k < count; ++k) read_stored_chunk(shard, k, masks[k], stored[k]);
     }
-    for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload, scratch);
+    for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload);
     constexpr std::size_t kKeptChunks = kKeptBufferBytes / 16384;
     if (stored.size() > kKeptChunks) {  // a rare large shard: keep a megabyte's worth
       stored.resize(kKeptChunks);
@@ -783,7 +784,7 @@ std::vector<std::string> IndexReader::validate(
         try {
           std::uint32_t mask = 0;
           r.read_stored_chunk(s, k, mask, stored);
-          r.decode_into(s, k, stored, mask, payload, scratch);
+          r.decode_into(s, k, stored, mask, payload, &scratch);
         } catch (const FormatError& error) {
           problems.push_back(error.what());
           intact = false;

@@ -348,6 +348,20 @@ std::vector<std::byte> read_by_hdf5(const std::filesystem::path& path,
   return back;
 }
 
+/// A prefix of a chunk (a shard's last chunk, without its padding) decodes to the chunk's
+/// first bytes: the empty one, one byte, a random length, and all but one byte.
+void expect_prefixes_decode(const detail::EncodedChunk& encoded, const std::vector<std::byte>& data,
+                            Random& random) {
+  for (const std::size_t length : {std::size_t(0), std::size_t(1), std::size_t(random.below(data.size())),
+                                   data.size() - 1}) {
+    std::vector<std::byte> prefix(length, std::byte{0x5a});
+    EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, prefix, data.size()), "") << length;
+    EXPECT_TRUE(std::equal(prefix.begin(), prefix.end(), data.begin())) << "prefix of " << length;
+  }
+  std::vector<std::byte> too_long(data.size() + 8);
+  EXPECT_NE(detail::decode_chunk(encoded.bytes, encoded.filter_mask, too_long, data.size()), "");
+}
+
 TEST(IndexFile, ChunkCodecAgreesWithHdf5Filters) {
   // The oracle is HDF5's own pipeline with the LZ4 plugin: without it there is nothing to
   // compare with, and the test fails rather than passing vacuously.
@@ -377,6 +391,7 @@ TEST(IndexFile, ChunkCodecAgreesWithHdf5Filters) {
         const auto compressed = stored_by_hdf5(folder / "lz4.h5", data, true, blocks, mask);
         EXPECT_EQ(detail::decode_chunk(compressed, mask, decoded), "");
         EXPECT_EQ(decoded, data);
+        expect_prefixes_decode({compressed, mask}, data, random);
         multi_block_frames += blocks < size && (mask & detail::kCompressionSkipped) == 0;
       }
 
@@ -387,6 +402,7 @@ TEST(IndexFile, ChunkCodecAgreesWithHdf5Filters) {
       EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, decoded), "");
       EXPECT_EQ(decoded, data);
       EXPECT_EQ(read_by_hdf5(folder / "ours.h5", encoded, size), data);
+      expect_prefixes_decode(encoded, data, random);
       // Any single flipped byte is caught.
       auto corrupted = encoded.bytes;
       corrupted[random.below(corrupted.size())] ^= std::byte{0x20};
@@ -428,6 +444,7 @@ TEST(IndexFile, UncompressedChunksAgreeWithHdf5Filters) {
       EXPECT_EQ(decoded, data);
       // HDF5 with the plugin reads it as written: an independent decoder.
       EXPECT_EQ(read_by_hdf5(folder / "none.h5", encoded, size), data);
+      expect_prefixes_decode(encoded, data, random);
       auto corrupted = encoded.bytes;
       corrupted[random.below(corrupted.size())] ^= std::byte{0x04};
       EXPECT_NE(detail::decode_chunk(corrupted, encoded.filter_mask, decoded), "");
