@@ -13,6 +13,7 @@
 #include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/runtime/geometry/SegmentTriangle.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
+#include "tetrapage/runtime/geometry/TriangleDistance.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 
 namespace tetrapage {
@@ -472,6 +473,21 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     }
     return false;
   };
+  // For a round object, a box in its frame wholly outside the ball that holds it misses it
+  // and its hull (the box is grown by the reach and margins already; the ball by far more
+  // than the roundings of this test).
+  const bool ball_prunes = own_frame && model_->ball_prunes;
+  const double ball_reach = model_->ball_radius * (1 + 0x1p-30);
+  auto outside_ball = [&](const geometry::Box& b) {
+    if (!ball_prunes) return false;
+    double squared = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double below = b.lo[a] - model_->ball_centre[a], above = model_->ball_centre[a] - b.hi[a];
+      const double gap = std::max({below, above, 0.0});
+      squared += gap * gap;
+    }
+    return squared > ball_reach * ball_reach;
+  };
   auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
     Vec3 c, h;
@@ -489,7 +505,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       in_frame.lo[a] = x - e - reach - margin;
       in_frame.hi[a] = x + e + reach + margin;
     }
-    if (beyond_hull(in_frame)) return false;
+    if (beyond_hull(in_frame) || outside_ball(in_frame)) return false;
     if (!near_surface_only || triangles < kSurfaceTestTriangles || std::max({h[0], h[1], h[2]}) > surface_test_extent)
       return true;
     bool near_surface = false;
@@ -523,6 +539,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
       if ((own_frame && (!geometry::boxes_overlap(query, model_->box) || beyond_hull(query))) ||
+          (ball_prunes && geometry::triangle_outside_ball(framed, model_->ball_centre, model_->ball_radius + grow)) ||
           !geometry::triangle_intersects_box(environment, box))
         return;
       ++counters.candidates;

@@ -86,6 +86,19 @@ ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mes
     radius = std::max(radius, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
     box.extend(v);
   }
+  if (!mesh.vertices.empty()) {
+    double farthest = 0;
+    for (int a = 0; a < 3; ++a) ball_centre[a] = 0.5 * (box.lo[a] + box.hi[a]);
+    for (const auto& v : mesh.vertices) {
+      const double dx = v[0] - ball_centre[0], dy = v[1] - ball_centre[1], dz = v[2] - ball_centre[2];
+      farthest = std::max(farthest, dx * dx + dy * dy + dz * dz);
+    }
+    // Up by far more than the roundings of the squares and the root.
+    ball_radius = std::sqrt(farthest) * (1 + 0x1p-40);
+    const double ball_volume = 4.0 / 3.0 * 3.14159265358979 * ball_radius * ball_radius * ball_radius;
+    const double box_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
+    ball_prunes = ball_volume < 0.7 * box_volume;
+  }
   // The interior grid and the hull are independent: build them side by side (opening an
   // index and placing a large object must take milliseconds).
   tbb::parallel_invoke(

@@ -181,4 +181,49 @@ bool within_distance(const Triangle& a, const Triangle& b, double d) {
   return triangle_distance(a, b).lower_bound <= d;
 }
 
+bool triangle_outside_ball(const Triangle& triangle, const Point& centre, double radius) {
+  const auto sub = [](const Point& x, const Point& y) { return Point{x[0] - y[0], x[1] - y[1], x[2] - y[2]}; };
+  const auto dot = [](const Point& x, const Point& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+  const Point& a = triangle[0];
+  const Point& b = triangle[1];
+  const Point& c = triangle[2];
+  const Point ab = sub(b, a), ac = sub(c, a), ap = sub(centre, a);
+  const double ab2 = dot(ab, ab), ac2 = dot(ac, ac), ap2 = dot(ap, ap);
+  const double size = std::sqrt(ab2) + std::sqrt(ac2) + std::sqrt(ap2);
+  // Rounding errors below are a few ulps of size^2 over the sine of the triangle's shape: far
+  // inside the margin for a triangle whose largest angle's sine is at least 2^-10.
+  const Point n{ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
+  const Point bc = sub(c, b);
+  const double longest2 = std::max({ab2, ac2, dot(bc, bc)});
+  const double n2 = dot(n, n);
+  // |n| = |ab||ac| sin A; the largest angle's sine is at least |n| / (longest side)^2.
+  if (!(n2 >= 0x1p-20 * longest2 * longest2) || !(n2 > 0)) return false;
+  const double reach = radius + 0x1p-20 * (size + radius);
+  if (!(reach >= 0) || !std::isfinite(reach)) return false;
+  const double limit = reach * reach;
+  // The closest point's region: a vertex, an edge, or the face.
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return ap2 > limit;
+  const Point bp = sub(centre, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return dot(bp, bp) > limit;
+  const double vc = d1 * d4 - d3 * d2;
+  const auto squared_to = [&](const Point& from, const Point& along, double t) {
+    const Point d{from[0] - t * along[0], from[1] - t * along[1], from[2] - t * along[2]};
+    return dot(d, d);
+  };
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return squared_to(ap, ab, d1 / (d1 - d3)) > limit;
+  const Point cp = sub(centre, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return dot(cp, cp) > limit;
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return squared_to(ap, ac, d2 / (d2 - d6)) > limit;
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)
+    return squared_to(bp, bc, (d4 - d3) / ((d4 - d3) + (d5 - d6))) > limit;
+  // Inside the face's prism: the distance to the plane.
+  const double plane = dot(n, ap);
+  return plane * plane > limit * n2;
+}
+
 }  // namespace tetrapage::geometry

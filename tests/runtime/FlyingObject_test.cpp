@@ -112,6 +112,9 @@ TEST(FlyingObject, ExactAnswersEqualTheOracleOnScenesTetrasAndTerrains) {
   const World scene = make_world(Kind::scene, 30000, 500, 1500, 1);
   expect_same_answers(fly(scene, {}), scene, "scene");
   const World tetras = make_world(Kind::tetras, 4000, 116, 1500, 2, 200);
+  // The study's sphere is pruned by the ball around it in phase I: these flights check it.
+  EXPECT_TRUE(ObjectModel(tetras.object).ball_prunes);
+  EXPECT_FALSE(ObjectModel(scene.object).ball_prunes);
   expect_same_answers(fly(tetras, {}), tetras, "tetras");
   const World terrain = make_world(Kind::terrain, 8000, 116, 1500, 3);
   expect_same_answers(fly(terrain, {}), terrain, "terrain");

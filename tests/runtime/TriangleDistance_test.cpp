@@ -109,5 +109,68 @@ TEST(TriangleDistance, WithinDistanceRejectsClearlyFartherPairs) {
   EXPECT_EQ(accepted, 0u);
 }
 
+// triangle_outside_ball prunes phase I's candidates for round objects: it must never call a
+// triangle outside a ball that it reaches (CGAL's exact squared distance), and must prune
+// what lies clearly outside, or it is useless.
+TEST(TriangleOutsideBall, NeverPrunesATriangleThatReachesTheBall) {
+  constexpr std::uint64_t kCases = 30000;
+  Disagreements disagreements("triangle_outside_ball");
+  std::uint64_t tested = 0, clearly_outside = 0, pruned_clearly_outside = 0;
+  for (std::uint64_t c = 0; c < kCases; ++c) {
+    Generator g(c);
+    const int family = int(c % 4);
+    const Triangle t = distance_case(g, family).a;
+    // The centre: near the triangle's plane, on it (a vertex, an edge, inside), or anywhere.
+    Point centre;
+    switch (int(g.integer(0, 3))) {
+      case 0: centre = dyadic_point_on(g, t, int(g.integer(0, 3))); break;
+      case 1: centre = nudge(g, dyadic_point_on(g, t, int(g.integer(0, 3)))); break;
+      case 2: centre = distance_case(g, family).b[0]; break;
+      default: {
+        const Point p = dyadic_point_on(g, t, 3);
+        const double away = g.log_uniform(-9, 9);
+        centre = {p[0] + away * g.uniform(-1, 1), p[1] + away * g.uniform(-1, 1), p[2] + away * g.uniform(-1, 1)};
+      }
+    }
+    if (epeck_degenerate(t)) {
+      // Segments and points are never pruned (no plane to take the distance from).
+      if (triangle_outside_ball(t, centre, 0.0)) disagreements.add(c, "degenerate " + hex(t) + " pruned");
+      continue;
+    }
+    const Epeck::FT exact = CGAL::squared_distance(to_epeck(centre), to_epeck(t));
+    const double distance = std::sqrt(CGAL::to_double(exact));
+    ++tested;
+    // Radii at the exact distance (rounded either way), just inside and outside it.
+    for (const double radius : {std::nextafter(distance, 0.0), distance, std::nextafter(distance, INFINITY),
+                                distance * (1 - 1e-12), distance * (1 + 1e-12), 0.5 * distance, 0.99 * distance,
+                                2 * distance}) {
+      const bool outside = triangle_outside_ball(t, centre, radius);
+      if (outside && !(Epeck::FT(radius) * Epeck::FT(radius) < exact))
+        disagreements.add(c, "t " + hex(t) + " centre " + hex(centre) + " radius " + std::to_string(radius) +
+                                 " pruned, exact distance^2 " + std::to_string(CGAL::to_double(exact)));
+    }
+    // Well-shaped triangles outside a ball, by more than the margin (a millionth of the sizes),
+    // are pruned.
+    double longest = 0;
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, std::sqrt(CGAL::to_double(CGAL::squared_distance(to_epeck(t[k]), to_epeck(t[(k + 1) % 3])))));
+    if (family == 0 && distance > 1e-3 * longest) {
+      ++clearly_outside;
+      pruned_clearly_outside += triangle_outside_ball(t, centre, 0.99 * distance);
+    }
+  }
+  disagreements.expect_none(tested);
+  EXPECT_GT(clearly_outside, kCases / 8);
+  EXPECT_GT(pruned_clearly_outside, clearly_outside * 9 / 10)
+      << pruned_clearly_outside << " of " << clearly_outside << " triangles outside 0.99 of their distance pruned";
+  // Non-finite input is never pruned.
+  const Triangle unit{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}};
+  EXPECT_FALSE(triangle_outside_ball(unit, {NAN, 5, 5}, 1.0));
+  EXPECT_FALSE(triangle_outside_ball(unit, {5, 5, 5}, NAN));
+  EXPECT_FALSE(triangle_outside_ball({{{0, 0, 0}, {1, 0, 0}, {INFINITY, 1, 0}}}, {5, 5, 5}, 1.0));
+  EXPECT_TRUE(triangle_outside_ball(unit, {5, 5, 5}, 1.0));
+  EXPECT_FALSE(triangle_outside_ball(unit, {0.25, 0.25, 0.5}, 0.5));
+}
+
 }  // namespace
 }  // namespace tetrapage::geometry

@@ -27,6 +27,13 @@ class ObjectModel {
   const geometry::ObjectBVH bvh;
   double radius = 0;  ///< largest |x| over the vertices (object frame)
   BoundingBox box;    ///< of the vertices (object frame)
+  /// A ball holding every vertex (object frame): centred on the box, its radius the largest
+  /// distance to the centre, rounded up.
+  Vec3 ball_centre{};
+  double ball_radius = 0;
+  /// The ball is much tighter than the box (a round object: under 0.7 of its volume), so
+  /// phase I asks it of leaves and candidates before the object's BVH.
+  bool ball_prunes = false;
   /// Every edge is used an even number of times (EdgeParity): only then can an obstacle lie
   /// inside the object.
   bool closed = false;

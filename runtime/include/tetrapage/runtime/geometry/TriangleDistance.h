@@ -32,4 +32,11 @@ TriangleDistance triangle_distance(const Triangle& a, const Triangle& b);
 /// Precondition: d >= 0 and finite.
 bool within_distance(const Triangle& a, const Triangle& b, double d);
 
+/// True only when every point of the closed triangle lies farther than `radius` from
+/// `centre`: a pruning test, conservative whatever the rounding. The closest point is found in
+/// double (the triangle's Voronoi regions) and the test is taken with a margin of 2^-20 of the
+/// sizes involved; a needle or sliver (sine of its largest angle under 2^-10, where the
+/// barycentric division loses its accuracy) and any non-finite input answer false.
+bool triangle_outside_ball(const Triangle& triangle, const Point& centre, double radius);
+
 }  // namespace tetrapage::geometry
