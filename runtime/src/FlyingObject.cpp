@@ -478,18 +478,33 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // than the roundings of this test).
   const bool ball_prunes = own_frame && model_->ball_prunes;
   const double ball_reach = model_->ball_radius * (1 + 0x1p-30);
-  auto outside_ball = [&](const geometry::Box& b) {
-    if (!ball_prunes) return false;
+  auto box_outside_ball = [&](const geometry::Box& b, const Vec3& centre, double radius) {
     double squared = 0;
     for (int a = 0; a < 3; ++a) {
-      const double below = b.lo[a] - model_->ball_centre[a], above = model_->ball_centre[a] - b.hi[a];
-      const double gap = std::max({below, above, 0.0});
+      const double gap = std::max({b.lo[a] - centre[a], centre[a] - b.hi[a], 0.0});
       squared += gap * gap;
     }
-    return squared > ball_reach * ball_reach;
+    return squared > radius * radius;
+  };
+  auto outside_ball = [&](const geometry::Box& b) {
+    return ball_prunes && box_outside_ball(b, model_->ball_centre, ball_reach);
+  };
+  // The ball placed in the world (its centre by apply_pose's arithmetic): a world box that
+  // misses it misses the object, with no turn into the object's frame. Its radius is grown by
+  // the reach and far beyond the placement's rounding.
+  Vec3 world_ball_centre{};
+  double world_ball_reach = 0;
+  if (ball_prunes) {
+    world_ball_centre = apply_pose(rotation_, translation_, model_->ball_centre);
+    world_ball_reach = ball_reach + reach +
+                       (model_->radius + model_->ball_radius + translation_magnitude) * 0x1p-40;
+  }
+  auto world_box_outside_ball = [&](const geometry::Box& b) {
+    return ball_prunes && box_outside_ball(b, world_ball_centre, world_ball_reach);
   };
   auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
+    if (world_box_outside_ball(b)) return false;
     Vec3 c, h;
     for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
     const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
@@ -602,7 +617,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // Before a page-in also the tet itself, by its face planes: the coarse tets are slivers
   // whose boxes reach far beyond them.
   auto needs = [&](std::size_t k) {
-    return geometry::boxes_overlap(box, shard_reach_[k]) &&
+    return geometry::boxes_overlap(box, shard_reach_[k]) && !world_box_outside_ball(shard_reach_[k]) &&
            ((keep_pins_ && pins_[k]) ||
             (meets_own_box(shard_reach_[k], 0) && index.tet_filter().planes_may_meet(shard_tet_[k], box)));
   };

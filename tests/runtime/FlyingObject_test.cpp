@@ -195,6 +195,45 @@ TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
   check_all_contacts(make_world(Kind::scene, 30000, 2000, 300, 12, 200));
 }
 
+TEST(FlyingObject, ClearanceContactsOfARoundObjectEqualBruteForce) {
+  // The sphere is pruned by its ball (in the world and in its frame): within a clearance d,
+  // every pair the brute force finds within d (the same triangle test) is reported, no other.
+  const World world = make_world(Kind::scene, 10000, 116, 1500, 5, 200);
+  ASSERT_TRUE(ObjectModel(world.object).ball_prunes);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+  FlyingObject object(index, world.object);
+  QueryOptions options;
+  options.mode = QueryMode::all_contacts;
+  std::size_t near_steps = 0;
+  for (const double d : {1e-3, 5e-3}) {
+    options.accuracy = geometry::Accuracy::within(d);
+    for (std::size_t i = 0; i < world.flight.poses.size(); ++i) {
+      const Pose& pose = world.flight.poses[i];
+      const QueryResult result = object.query(pose, options);
+      std::vector<geometry::Triangle> placed(world.object.triangle_count());
+      geometry::Box box;
+      for (std::uint32_t k = 0; k < world.object.triangle_count(); ++k) {
+        const auto o = world.object.triangles[k];
+        placed[k] = {apply_pose(pose, world.object.vertices[o[0]]), apply_pose(pose, world.object.vertices[o[1]]),
+                     apply_pose(pose, world.object.vertices[o[2]])};
+        for (const auto& p : placed[k]) box.extend(p);
+      }
+      box = geometry::inflated(box, 2 * d);
+      std::set<std::pair<std::uint64_t, std::uint32_t>> expected, got;
+      for (std::size_t t = 0; t < world.environment.triangle_count(); ++t) {
+        const auto e = world.environment.corners(t);
+        if (!geometry::boxes_overlap(geometry::box_of(e), box)) continue;
+        for (std::uint32_t k = 0; k < placed.size(); ++k)
+          if (geometry::triangles_collide(e, placed[k], options.accuracy)) expected.insert({t, k});
+      }
+      for (const Contact& c : result.contacts) got.insert({c.environment_triangle, c.object_triangle});
+      EXPECT_EQ(got, expected) << "step " << i << ", clearance " << d;
+      near_steps += !expected.empty();
+    }
+  }
+  EXPECT_GT(near_steps, 20u) << "the flight must come within the clearance of obstacles";
+}
+
 // Real shards decoded into an arena: the same shards, their large arrays in the arena, and
 // their bytes counted as the arena's blocks (at least what they hold, at most an eighth more).
 TEST(FlyingObject, ShardsDecodeIntoTheArenaAlike) {
