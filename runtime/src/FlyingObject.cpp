@@ -502,9 +502,37 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   auto world_box_outside_ball = [&](const geometry::Box& b) {
     return ball_prunes && box_outside_ball(b, world_ball_centre, world_ball_reach);
   };
+  // The hull's planes placed in the world, likewise: a world box wholly beyond one misses the
+  // object (the tetrahedron's world box is up to five times its volume). Offsets grown by the
+  // reach, and by far more than the placement's and this test's roundings over any box of the
+  // model.
+  const std::size_t world_planes = own_frame ? model_->hull_planes.size() : 0;
+  std::array<std::array<double, 4>, 24> world_plane{};
+  if (world_planes > 0) {
+    const geometry::Box& model_box = index.mesh_bounds();
+    const double magnitude = model_->radius + translation_magnitude +
+                             std::max({std::fabs(model_box.lo[0]), std::fabs(model_box.lo[1]), std::fabs(model_box.lo[2]),
+                                       std::fabs(model_box.hi[0]), std::fabs(model_box.hi[1]), std::fabs(model_box.hi[2])});
+    for (std::size_t k = 0; k < world_planes && k < world_plane.size(); ++k) {
+      const auto& [n, offset] = model_->hull_planes[k];
+      auto& w = world_plane[k];
+      for (int a = 0; a < 3; ++a) w[a] = rotation_[3 * a] * n[0] + rotation_[3 * a + 1] * n[1] + rotation_[3 * a + 2] * n[2];
+      w[3] = offset + w[0] * translation_[0] + w[1] * translation_[1] + w[2] * translation_[2] + reach + plane_margin +
+             magnitude * 0x1p-40;
+    }
+  }
+  auto world_box_beyond_hull = [&](const geometry::Box& b) {
+    for (std::size_t k = 0; k < world_planes; ++k) {
+      const auto& w = world_plane[k];
+      double lowest = 0;
+      for (int a = 0; a < 3; ++a) lowest += w[a] * (w[a] > 0 ? b.lo[a] : b.hi[a]);
+      if (lowest > w[3]) return true;
+    }
+    return false;
+  };
   auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
-    if (world_box_outside_ball(b)) return false;
+    if (world_box_outside_ball(b) || world_box_beyond_hull(b)) return false;
     Vec3 c, h;
     for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
     const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
@@ -618,6 +646,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // whose boxes reach far beyond them.
   auto needs = [&](std::size_t k) {
     return geometry::boxes_overlap(box, shard_reach_[k]) && !world_box_outside_ball(shard_reach_[k]) &&
+           !world_box_beyond_hull(shard_reach_[k]) &&
            ((keep_pins_ && pins_[k]) ||
             (meets_own_box(shard_reach_[k], 0) && index.tet_filter().planes_may_meet(shard_tet_[k], box)));
   };

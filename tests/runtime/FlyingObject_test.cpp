@@ -195,11 +195,9 @@ TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
   check_all_contacts(make_world(Kind::scene, 30000, 2000, 300, 12, 200));
 }
 
-TEST(FlyingObject, ClearanceContactsOfARoundObjectEqualBruteForce) {
-  // The sphere is pruned by its ball (in the world and in its frame): within a clearance d,
-  // every pair the brute force finds within d (the same triangle test) is reported, no other.
-  const World world = make_world(Kind::scene, 10000, 116, 1500, 5, 200);
-  ASSERT_TRUE(ObjectModel(world.object).ball_prunes);
+// Within a clearance d, every pair the brute force finds within d (the same triangle test) is
+// reported, and no other.
+void expect_clearance_contacts_equal_brute_force(const World& world) {
   auto index = std::make_shared<const CollisionIndex>(world.index_path);
   FlyingObject object(index, world.object);
   QueryOptions options;
@@ -232,6 +230,17 @@ TEST(FlyingObject, ClearanceContactsOfARoundObjectEqualBruteForce) {
     }
   }
   EXPECT_GT(near_steps, 20u) << "the flight must come within the clearance of obstacles";
+}
+
+TEST(FlyingObject, ClearanceContactsOfPrunedObjectsEqualBruteForce) {
+  // The sphere is pruned by its ball, the tetrahedron by its hull's planes, both placed in the
+  // world and in the object's frame.
+  const World sphere = make_world(Kind::scene, 10000, 116, 1500, 5, 200);
+  ASSERT_TRUE(ObjectModel(sphere.object).ball_prunes);
+  expect_clearance_contacts_equal_brute_force(sphere);
+  const World tetrahedron = make_world(Kind::scene, 30000, 4, 1500, 6, 200);
+  ASSERT_FALSE(ObjectModel(tetrahedron.object).hull_planes.empty());
+  expect_clearance_contacts_equal_brute_force(tetrahedron);
 }
 
 // Real shards decoded into an arena: the same shards, their large arrays in the arena, and
