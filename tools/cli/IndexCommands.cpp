@@ -352,8 +352,8 @@ void add_index_commands(CLI::App& app) {
       ->check(CLI::IsMember({"float", "double"}));
   command->add_option("--compression", pre->compression,
                       "Shard chunks: lz4 (shuffled and compressed: the smaller file) or none (stored as they\n"
-                      "are: about 30% larger, but a page-in from the page cache or an SSD skips the\n"
-                      "decompression, most of its read time)")
+                      "are: about a third larger, but a page-in read from the page cache skips the\n"
+                      "decompression, a third of its time)")
       ->capture_default_str()
       ->check(CLI::IsMember({"lz4", "none"}));
   command->add_option("--query-extent", pre->query_extent,

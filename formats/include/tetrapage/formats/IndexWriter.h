@@ -21,11 +21,11 @@ namespace tetrapage {
 /// and any HDF5 reader with the LZ4 plugin reads the file (docs/FORMAT.md).
 enum class ChunkCompression : std::uint8_t {
   /// Shuffled and LZ4-compressed (kept as they are where that does not shrink them): the
-  /// smaller file, for indexes read from a slow disk or a network.
+  /// smaller file (from this machine's disk a page-in is as fast either way).
   lz4,
-  /// The payload as it is (only a shard's zero padding compressed): about 30 % more bytes on
-  /// disk, but a page-in from the page cache or an SSD skips LZ4 and the unshuffle, most of
-  /// its read time (docs/BENCHMARKS.md, twenty-first stop).
+  /// The payload as it is (only a shard's zero padding compressed): about a third more bytes
+  /// on disk, but a page-in's read from the page cache skips LZ4 and the unshuffle, a third of
+  /// its time (docs/BENCHMARKS.md, twenty-first stop).
   none,
 };
 
