@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <tuple>
 
 #include "ConvexHull.h"
@@ -173,7 +174,15 @@ void FlyingObject::place(const Pose& pose) {
                   pose.rotation[1], pose.rotation[2], pose.rotation[3]);
     throw InputError(text);
   }
-  rotation_ = rotation_matrix(pose.rotation);
+  // A quaternion off unit norm by more than rounding is normalised, as read_poses does: its
+  // matrix would stretch the object by up to 1e-6, beyond every pruning margin here (they
+  // hold for an orthogonal matrix up to rounding).
+  std::array<double, 4> q = pose.rotation;
+  if (std::fabs(n - 1) > 8 * std::numeric_limits<double>::epsilon()) {
+    const double norm = std::sqrt(n);
+    for (double& component : q) component /= norm;
+  }
+  rotation_ = rotation_matrix(q);
   translation_ = pose.translation;
   ++step_;
 }

@@ -195,6 +195,31 @@ TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
   check_all_contacts(make_world(Kind::scene, 30000, 2000, 300, 12, 200));
 }
 
+TEST(FlyingObject, ANearlyUnitQuaternionAnswersAsItsNormalisedPose) {
+  // A caller's quaternion may be off unit norm by up to 1e-6 in its square (a float's
+  // rounding): its matrix would stretch the object beyond the pruning margins, so the step
+  // normalises it, and answers as the oracle does for the unit pose.
+  const World world = make_world(Kind::tetras, 4000, 500, 1500, 21, 200);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+  FlyingObject object(index, world.object);
+  std::vector<std::uint8_t> answers;
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i) {
+    Pose stretched = world.flight.poses[i];
+    const double scale = i % 2 == 0 ? 1 + 4e-7 : 1 - 4e-7;
+    for (double& component : stretched.rotation) component *= scale;
+    const QueryResult result = object.query(stretched);
+    answers.push_back(result.collides ? 1 : 0);
+    for (const auto& v : world.object.vertices) {
+      const Vec3 placed = apply_pose(world.flight.poses[i], v);
+      for (int a = 0; a < 3; ++a) {
+        ASSERT_LE(result.world_box.lo[a], placed[a]) << "step " << i;
+        ASSERT_GE(result.world_box.hi[a], placed[a]) << "step " << i;
+      }
+    }
+  }
+  expect_same_answers(answers, world, "stretched quaternions");
+}
+
 // Within a clearance d, every pair the brute force finds within d (the same triangle test) is
 // reported, and no other.
 void expect_clearance_contacts_equal_brute_force(const World& world) {

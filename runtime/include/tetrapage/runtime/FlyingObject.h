@@ -134,7 +134,8 @@ class FlyingObject {
   FlyingObject(FlyingObject&&) noexcept;
   FlyingObject& operator=(FlyingObject&&) noexcept;
 
-  /// One step at `pose`. Reuses `result`'s buffers.
+  /// One step at `pose`. Reuses `result`'s buffers. A quaternion within 1e-6 of unit squared
+  /// norm is normalised first, as read_poses does (one unit up to rounding is used as it is).
   /// @throw InputError for a non-finite or non-unit pose; what the shard cache throws (a
   ///        budget smaller than one shard, I/O and checksum errors naming the index).
   void query(const Pose& pose, const QueryOptions& options, QueryResult& result);
