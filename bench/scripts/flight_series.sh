@@ -5,6 +5,9 @@
 #
 #   bench/scripts/flight_series.sh [TRIANGLES] [OUT_DIR] [BUDGET_FRACTION]
 #
+# PREPROCESS_FLAGS adds flags to the preprocess (e.g. "--compression none", whose page-ins
+# decompress nothing: docs/BENCHMARKS.md, twenty-first stop).
+#
 # Writes OUT_DIR/series.md (a Markdown table) and the JSON reports it was made from.
 set -euo pipefail
 TRIANGLES=${1:-10000000}
@@ -18,7 +21,7 @@ if [ ! -f "$OUT/scene.ply" ]; then
   "$TETRAPAGE" generate scene --triangles "$TRIANGLES" --seed 1 -o "$OUT/scene.ply"
 fi
 if [ ! -f "$OUT/scene.tpi" ]; then
-  /usr/bin/time -v "$TETRAPAGE" preprocess "$OUT/scene.ply" -o "$OUT/scene.tpi" --precision double \
+  /usr/bin/time -v "$TETRAPAGE" preprocess "$OUT/scene.ply" -o "$OUT/scene.tpi" --precision double ${PREPROCESS_FLAGS:-} \
     --report "$OUT/preprocess.json" 2> "$OUT/preprocess.time"
 fi
 "$TETRAPAGE" inspect "$OUT/scene.tpi" --report "$OUT/inspect.json"
