@@ -144,6 +144,19 @@ TEST(FlyingObject, StepsInFreeBoxesAgreeWithTheOracle) {
   EXPECT_GT(found_free_box, scene.flight.poses.size() / 20) << "steps that found a free box";
 }
 
+/// The object's triangles placed at `pose` (apply_pose, as the oracle places them), and
+/// their box.
+std::vector<geometry::Triangle> placed_triangles(const TriangleSoup& object, const Pose& pose, geometry::Box& box) {
+  std::vector<geometry::Triangle> placed(object.triangle_count());
+  for (std::uint32_t k = 0; k < object.triangle_count(); ++k) {
+    const auto o = object.triangles[k];
+    placed[k] = {apply_pose(pose, object.vertices[o[0]]), apply_pose(pose, object.vertices[o[1]]),
+                 apply_pose(pose, object.vertices[o[2]])};
+    for (const auto& p : placed[k]) box.extend(p);
+  }
+  return placed;
+}
+
 void check_all_contacts(const World& world) {
   auto index = std::make_shared<const CollisionIndex>(world.index_path);
   FlyingObject object(index, world.object);
@@ -170,14 +183,8 @@ void check_all_contacts(const World& world) {
     }
     // Brute force over every environment triangle near the placed object (its box from its
     // own placed vertices, not the runtime's): the same number of pairs.
-    std::vector<geometry::Triangle> placed(world.object.triangle_count());
     geometry::Box box;
-    for (std::uint32_t k = 0; k < world.object.triangle_count(); ++k) {
-      const auto o = world.object.triangles[k];
-      placed[k] = {apply_pose(pose, world.object.vertices[o[0]]), apply_pose(pose, world.object.vertices[o[1]]),
-                   apply_pose(pose, world.object.vertices[o[2]])};
-      for (const auto& p : placed[k]) box.extend(p);
-    }
+    const std::vector<geometry::Triangle> placed = placed_triangles(world.object, pose, box);
     std::size_t expected = 0;
     for (std::size_t t = 0; t < world.environment.triangle_count(); ++t) {
       const auto e = world.environment.corners(t);
@@ -233,14 +240,8 @@ void expect_clearance_contacts_equal_brute_force(const World& world) {
     for (std::size_t i = 0; i < world.flight.poses.size(); ++i) {
       const Pose& pose = world.flight.poses[i];
       const QueryResult result = object.query(pose, options);
-      std::vector<geometry::Triangle> placed(world.object.triangle_count());
       geometry::Box box;
-      for (std::uint32_t k = 0; k < world.object.triangle_count(); ++k) {
-        const auto o = world.object.triangles[k];
-        placed[k] = {apply_pose(pose, world.object.vertices[o[0]]), apply_pose(pose, world.object.vertices[o[1]]),
-                     apply_pose(pose, world.object.vertices[o[2]])};
-        for (const auto& p : placed[k]) box.extend(p);
-      }
+      const std::vector<geometry::Triangle> placed = placed_triangles(world.object, pose, box);
       box = geometry::inflated(box, 2 * d);
       std::set<std::pair<std::uint64_t, std::uint32_t>> expected, got;
       for (std::size_t t = 0; t < world.environment.triangle_count(); ++t) {
