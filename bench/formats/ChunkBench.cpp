@@ -5,8 +5,9 @@
 //     libdeflate at levels 1 and 4 and with LZ4, one thread: the stored/decoded ratio and
 //     compress and decompress MB/s per payload byte (padding excluded), which is what chose
 //     the format's chunks (format 2) and codec (format 3);
-//  2. IndexReader::read_shard (pread, Fletcher-32, LZ4, unshuffle) and Shard::decode,
-//     microseconds a shard, from the page cache (a first pass warms it);
+//  2. IndexReader::read_shard (pread, Fletcher-32, LZ4 and unshuffle unless the index was
+//     preprocessed with --compression none) and Shard::decode, microseconds a shard, from the
+//     page cache (a first pass warms it), and the bytes a shard is stored in;
 //  3. with --same-shards OTHER: how many shards' payloads differ between the two indexes (the
 //     check that a preprocess change wrote the same shards).
 //
@@ -146,11 +147,14 @@ int main(int argc, char** argv) {
     }
     for (std::uint32_t s = 0; s < reader.shard_count(); s += every) payloads.push_back(reader.read_shard(s));
     if (payloads.empty()) throw tetrapage::InputError(index.string() + " holds no shard");
-    std::uint64_t bytes = 0;
+    std::uint64_t bytes = 0, stored = 0;
     for (const auto& p : payloads) bytes += p.size();
+    for (std::uint32_t s = 0; s < reader.shard_count(); s += every) stored += reader.stored_shard_size(s);
     const double n = double(payloads.size());
-    std::printf("%zu of %u shards, mean payload %.0f B: read_shard %.1f us, Shard::decode %.1f us a shard\n\n",
-                payloads.size(), reader.shard_count(), double(bytes) / n, 1e6 * read_seconds / n,
+    // (Stored: as the index keeps them, LZ4 or, from `preprocess --compression none`, as they are.)
+    std::printf("%zu of %u shards, mean payload %.0f B, stored %.0f B: read_shard %.2f us, Shard::decode %.2f us a "
+                "shard\n\n",
+                payloads.size(), reader.shard_count(), double(bytes) / n, double(stored) / n, 1e6 * read_seconds / n,
                 1e6 * decode_seconds / n);
     chunk_table(payloads);
     if (!other.empty()) {

@@ -2,7 +2,8 @@
 #   cmake -DCLI=tetrapage -DBENCH=tetrapage_bench_chunks -DWORK=folder -P ChunkBenchTest.cmake
 # The scene is preprocessed on one thread and on all: the two indexes must hold the same shards
 # (the comparison the benchmark makes for preprocess changes), and a third index from another
-# scene must not; the table must have every row.
+# scene must not; the table must have every row. With --compression none the shards are the
+# same, stored larger.
 
 cmake_minimum_required(VERSION 3.22)
 
@@ -32,4 +33,17 @@ execute_process(COMMAND ${BENCH} ${WORK}/one.tpi --same-shards ${WORK}/other.tpi
                 RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(result EQUAL 0)
   message(FATAL_ERROR "another scene's index was reported the same:\n${out}")
+endif()
+
+run_checked(${CLI} preprocess ${WORK}/scene.ply -o ${WORK}/none.tpi --region-triangles 500 --compression none)
+run_checked(${BENCH} ${WORK}/none.tpi --every 1 --same-shards ${WORK}/all.tpi)
+if(NOT last_output MATCHES "same shards: 0 of [1-9][0-9]* differ")
+  message(FATAL_ERROR "--compression none wrote other shards:\n${last_output}")
+endif()
+string(REGEX MATCH "mean payload ([0-9]+) B, stored ([0-9]+) B" sizes "${last_output}")
+set(none_stored ${CMAKE_MATCH_2})
+run_checked(${BENCH} ${WORK}/all.tpi --every 1)
+string(REGEX MATCH "mean payload ([0-9]+) B, stored ([0-9]+) B" sizes "${last_output}")
+if(NOT none_stored GREATER CMAKE_MATCH_2)
+  message(FATAL_ERROR "uncompressed shards stored in ${none_stored} B, compressed in ${CMAKE_MATCH_2} B")
 endif()

@@ -1,7 +1,8 @@
 # The step benchmark's harness on a tiny generated scene (ctest bench_steps_harness):
 #   cmake -DCLI=tetrapage -DBENCH=tetrapage_bench_steps -DWORK=folder -P StepBenchTest.cmake
 # A billiard flight through random tetrahedra with the oracle's answers, replayed twice: every
-# answer must agree, some must be collisions, and the table must have a row for every kind of step.
+# answer must agree, some must be collisions, and the tables must have a row for every kind of
+# step, and the phase table its columns.
 
 cmake_minimum_required(VERSION 3.22)
 
@@ -32,3 +33,10 @@ foreach(row "| searched |" "| no candidate |" "| phase II |" "| candidates |" "|
     message(FATAL_ERROR "the table has no row '${row}'")
   endif()
 endforeach()
+foreach(table "mean us of each phase by kind of step" "| step | locate | search | free box |")
+  string(FIND "${last_output}" "${table}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "no phase table ('${table}')")
+  endif()
+endforeach()
+

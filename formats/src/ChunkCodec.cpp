@@ -232,7 +232,7 @@ void encode_chunk_uncompressed(std::span<const std::byte> chunk, std::size_t pay
   const std::size_t block = std::max(payload_bytes, (chunk.size() + 15) / 16);
   const std::size_t blocks = (chunk.size() + block - 1) / block;
   out.bytes.resize(kFrameHeaderBytes + blocks * (kBlockHeaderBytes + std::size_t(LZ4_compressBound(int(block)))) +
-                   block + kChecksumBytes);
+                   kChecksumBytes);
   std::byte* frame = out.bytes.data();
   store_be64(frame, chunk.size());
   store_be32(frame + 8, static_cast<std::uint32_t>(block));

@@ -15,7 +15,17 @@
 
 namespace tetrapage {
 
-std::array<double, 9> rotation_matrix(const std::array<double, 4>& q) {
+std::array<double, 4> unit_quaternion(const std::array<double, 4>& q) {
+  const double norm2 = q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3];
+  // Unit up to rounding: kept, so that writing poses and reading them back is exact.
+  if (!(norm2 > 0) || !std::isfinite(norm2) || std::abs(norm2 - 1.0) <= 8 * std::numeric_limits<double>::epsilon())
+    return q;
+  const double norm = std::sqrt(norm2);
+  return {q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm};
+}
+
+std::array<double, 9> rotation_matrix(const std::array<double, 4>& unnormalised) {
+  const auto q = unit_quaternion(unnormalised);
   const double w = q[0], x = q[1], y = q[2], z = q[3];
   return {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
           2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
@@ -104,12 +114,7 @@ std::vector<Pose> read_poses(const std::filesystem::path& path) {
                        std::string(fields[4]) + ", " + std::string(fields[5]) + ", " +
                        std::string(fields[6]) + ") cannot be normalised");
     }
-    // A quaternion that is unit up to rounding is kept as written, so that writing the poses
-    // back and reading them again gives the same bits.
-    if (std::abs(norm2 - 1.0) > 8 * std::numeric_limits<double>::epsilon()) {
-      const double norm = std::sqrt(norm2);
-      for (double& component : pose.rotation) component /= norm;
-    }
+    pose.rotation = unit_quaternion(pose.rotation);
     poses.push_back(pose);
   }
   return poses;

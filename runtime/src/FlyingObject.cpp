@@ -4,7 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <span>
 #include <tuple>
 
 #include "ConvexHull.h"
@@ -174,15 +174,9 @@ void FlyingObject::place(const Pose& pose) {
                   pose.rotation[1], pose.rotation[2], pose.rotation[3]);
     throw InputError(text);
   }
-  // A quaternion off unit norm by more than rounding is normalised, as read_poses does: its
-  // matrix would stretch the object by up to 1e-6, beyond every pruning margin here (they
-  // hold for an orthogonal matrix up to rounding).
-  std::array<double, 4> q = pose.rotation;
-  if (std::fabs(n - 1) > 8 * std::numeric_limits<double>::epsilon()) {
-    const double norm = std::sqrt(n);
-    for (double& component : q) component /= norm;
-  }
-  rotation_ = rotation_matrix(q);
+  // rotation_matrix normalises a q off unit norm: every prune here assumes an orthogonal
+  // matrix up to rounding.
+  rotation_ = rotation_matrix(pose.rotation);
   translation_ = pose.translation;
   ++step_;
 }
@@ -474,14 +468,16 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // A box in the object's frame wholly beyond one of the hull's planes misses the object and
   // its hull (the margin covers the planes' rounding, far beyond it).
   const double plane_margin = model_->radius * 0x1p-30;
-  auto beyond_hull = [&](const geometry::Box& b) {
-    for (const auto& [n, offset] : model_->hull_planes) {
+  using Plane = std::pair<Vec3, double>;  // n.x <= offset holds the object
+  auto box_beyond_planes = [](std::span<const Plane> planes, double margin, const geometry::Box& b) {
+    for (const auto& [n, offset] : planes) {
       double lowest = 0;
       for (int a = 0; a < 3; ++a) lowest += n[a] * (n[a] > 0 ? b.lo[a] : b.hi[a]);
-      if (lowest > offset + plane_margin) return true;
+      if (lowest > offset + margin) return true;
     }
     return false;
   };
+  auto beyond_hull = [&](const geometry::Box& b) { return box_beyond_planes(model_->hull_planes, plane_margin, b); };
   // For a round object, a box in its frame wholly outside the ball that holds it misses it
   // and its hull (the box is grown by the reach and margins already; the ball by far more
   // than the roundings of this test).
@@ -515,33 +511,28 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // object (the tetrahedron's world box is up to five times its volume). Offsets grown by the
   // reach, and by far more than the placement's and this test's roundings over any box of the
   // model.
-  const std::size_t world_planes = own_frame ? model_->hull_planes.size() : 0;
-  std::array<std::array<double, 4>, 24> world_plane{};
-  if (world_planes > 0) {
+  world_planes_.clear();
+  if (own_frame && !model_->hull_planes.empty()) {
+    world_planes_.resize(model_->hull_planes.size());
     const geometry::Box& model_box = index.mesh_bounds();
     const double magnitude = model_->radius + translation_magnitude +
                              std::max({std::fabs(model_box.lo[0]), std::fabs(model_box.lo[1]), std::fabs(model_box.lo[2]),
                                        std::fabs(model_box.hi[0]), std::fabs(model_box.hi[1]), std::fabs(model_box.hi[2])});
-    for (std::size_t k = 0; k < world_planes && k < world_plane.size(); ++k) {
+    for (std::size_t k = 0; k < model_->hull_planes.size(); ++k) {
       const auto& [n, offset] = model_->hull_planes[k];
-      auto& w = world_plane[k];
+      auto& [w, world_offset] = world_planes_[k];
       for (int a = 0; a < 3; ++a) w[a] = rotation_[3 * a] * n[0] + rotation_[3 * a + 1] * n[1] + rotation_[3 * a + 2] * n[2];
-      w[3] = offset + w[0] * translation_[0] + w[1] * translation_[1] + w[2] * translation_[2] + reach + plane_margin +
-             magnitude * 0x1p-40;
+      world_offset = offset + w[0] * translation_[0] + w[1] * translation_[1] + w[2] * translation_[2] + reach +
+                     plane_margin + magnitude * 0x1p-40;
     }
   }
-  auto world_box_beyond_hull = [&](const geometry::Box& b) {
-    for (std::size_t k = 0; k < world_planes; ++k) {
-      const auto& w = world_plane[k];
-      double lowest = 0;
-      for (int a = 0; a < 3; ++a) lowest += w[a] * (w[a] > 0 ? b.lo[a] : b.hi[a]);
-      if (lowest > w[3]) return true;
-    }
-    return false;
+  // Either shape placed in the world: a world box it rules out misses the object.
+  auto world_shapes_miss = [&](const geometry::Box& b) {
+    return world_box_outside_ball(b) || box_beyond_planes(world_planes_, 0.0, b);
   };
   auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     if (!own_frame) return true;
-    if (world_box_outside_ball(b) || world_box_beyond_hull(b)) return false;
+    if (world_shapes_miss(b)) return false;
     Vec3 c, h;
     for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
     const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
@@ -654,10 +645,11 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // Before a page-in also the tet itself, by its face planes: the coarse tets are slivers
   // whose boxes reach far beyond them.
   auto needs = [&](std::size_t k) {
-    return geometry::boxes_overlap(box, shard_reach_[k]) && !world_box_outside_ball(shard_reach_[k]) &&
-           !world_box_beyond_hull(shard_reach_[k]) &&
-           ((keep_pins_ && pins_[k]) ||
-            (meets_own_box(shard_reach_[k], 0) && index.tet_filter().planes_may_meet(shard_tet_[k], box)));
+    // (meets_own_box asks the world shapes first.)
+    return geometry::boxes_overlap(box, shard_reach_[k]) &&
+           ((keep_pins_ && pins_[k]) ? !world_shapes_miss(shard_reach_[k])
+                                     : meets_own_box(shard_reach_[k], 0) &&
+                                           index.tet_filter().planes_may_meet(shard_tet_[k], box));
   };
   if (index.options().prefetch) {
     // Several shards to page in: the prefetch thread loads them from the last while this

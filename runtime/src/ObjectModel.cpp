@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 
 #include "ConvexHull.h"
 #include "tetrapage/formats/EdgeParity.h"
@@ -95,7 +96,7 @@ ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mes
     }
     // Up by far more than the roundings of the squares and the root.
     ball_radius = std::sqrt(farthest) * (1 + 0x1p-40);
-    const double ball_volume = 4.0 / 3.0 * 3.14159265358979 * ball_radius * ball_radius * ball_radius;
+    const double ball_volume = 4.0 / 3.0 * std::numbers::pi * ball_radius * ball_radius * ball_radius;
     const double box_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
     ball_prunes = ball_volume < 0.7 * box_volume;
   }

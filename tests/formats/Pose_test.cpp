@@ -42,6 +42,24 @@ TEST(Pose, RotationMatrixMatchesEigenAndIsOrthonormal) {
   }
 }
 
+TEST(Pose, ANearlyUnitQuaternionGivesTheUnitOnesMatrix) {
+  // A caller's q may be off unit norm (a float's rounding, up to 1e-6 in its square): its
+  // matrix is the unit q's, orthonormal, not a stretched one; a unit q is kept bit for bit.
+  Random random(777);
+  for (int trial = 0; trial < 1000; ++trial) {
+    const auto q = random_unit_quaternion(random);
+    EXPECT_EQ(unit_quaternion(q), q);
+    auto stretched = q;
+    const double scale = trial % 2 == 0 ? 1 + 4e-7 : 1 - 4e-7;
+    for (double& c : stretched) c *= scale;
+    const auto r = rotation_matrix(stretched);
+    const auto expected = rotation_matrix(q);
+    for (int k = 0; k < 9; ++k) ASSERT_NEAR(r[k], expected[k], 4e-15) << "seed 777 trial " << trial;
+    const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> m(r.data());
+    ASSERT_TRUE((m * m.transpose()).isApprox(Eigen::Matrix3d::Identity(), 1e-14)) << "trial " << trial;
+  }
+}
+
 TEST(Pose, ApplyPoseIsRotationThenTranslation) {
   Random random(99);
   for (int trial = 0; trial < 1000; ++trial) {

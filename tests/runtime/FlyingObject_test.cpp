@@ -204,8 +204,8 @@ TEST(FlyingObject, AllContactsAgreeWithBruteForceAndFirstHit) {
 
 TEST(FlyingObject, ANearlyUnitQuaternionAnswersAsItsNormalisedPose) {
   // A caller's quaternion may be off unit norm by up to 1e-6 in its square (a float's
-  // rounding): its matrix would stretch the object beyond the pruning margins, so the step
-  // normalises it, and answers as the oracle does for the unit pose.
+  // rounding): its matrix would stretch the object beyond the pruning margins, so
+  // rotation_matrix normalises it, and the step answers as the oracle does for the unit pose.
   const World world = make_world(Kind::tetras, 4000, 500, 1500, 21, 200);
   auto index = std::make_shared<const CollisionIndex>(world.index_path);
   FlyingObject object(index, world.object);

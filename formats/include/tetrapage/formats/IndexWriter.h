@@ -21,7 +21,7 @@ namespace tetrapage {
 /// and any HDF5 reader with the LZ4 plugin reads the file (docs/FORMAT.md).
 enum class ChunkCompression : std::uint8_t {
   /// Shuffled and LZ4-compressed (kept as they are where that does not shrink them): the
-  /// smaller file (from this machine's disk a page-in is as fast either way).
+  /// smaller file.
   lz4,
   /// The payload as it is (only a shard's zero padding compressed): about a third more bytes
   /// on disk, but a page-in's read from the page cache skips LZ4 and the unshuffle, a third of

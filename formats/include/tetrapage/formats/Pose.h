@@ -17,8 +17,14 @@ struct Pose {
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion qw, qx, qy, qz
 };
 
-/// Row-major 3x3 rotation matrix of a unit quaternion (not normalised here: pass a unit q,
-/// as read_poses returns them). The identity quaternion gives exactly the identity.
+/// q as the unit quaternion of its rotation: one unit up to rounding (its squared norm within
+/// 8 epsilon of 1) bit for bit, any other divided by its norm (a zero or non-finite one is
+/// returned as it is: callers reject it).
+std::array<double, 4> unit_quaternion(const std::array<double, 4>& q);
+
+/// Row-major 3x3 rotation matrix of unit_quaternion(q): every placement (the runtime, the
+/// oracle, the peers) turns a slightly non-unit q into the same orthogonal matrix, whose
+/// product does not stretch the object. The identity quaternion gives exactly the identity.
 std::array<double, 9> rotation_matrix(const std::array<double, 4>& q);
 
 /// R(q) x + t, computed in double the one canonical way: every component of the product

@@ -135,7 +135,7 @@ class FlyingObject {
   FlyingObject& operator=(FlyingObject&&) noexcept;
 
   /// One step at `pose`. Reuses `result`'s buffers. A quaternion within 1e-6 of unit squared
-  /// norm is normalised first, as read_poses does (one unit up to rounding is used as it is).
+  /// norm stands for its rotation (rotation_matrix normalises it).
   /// @throw InputError for a non-finite or non-unit pose; what the shard cache throws (a
   ///        budget smaller than one shard, I/O and checksum errors naming the index).
   void query(const Pose& pose, const QueryOptions& options, QueryResult& result);
@@ -207,6 +207,8 @@ class FlyingObject {
   geometry::Box previous_box_;
   geometry::Box current_box_;  ///< this query's world box, before the accuracy's growth
   std::unique_ptr<Solid> solid_;  ///< per-step scratch
+  /// Per step: the hull's pruning planes placed in the world (n.x <= offset holds the object).
+  std::vector<std::pair<Vec3, double>> world_planes_;
 
   // Per-step state.
   std::array<double, 9> rotation_{};
