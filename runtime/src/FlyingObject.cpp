@@ -567,9 +567,15 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
                             (model_->box.hi[2] - model_->box.lo[2] + 2 * reach);
   const double world_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
   const bool prune_inner = own_frame && world_volume > kLoose * own_volume;
+  // A triangle stored in several of the step's shards is tested once: double-precision copies
+  // are the input's coordinates, the same in every shard (float copies each round to their
+  // own shard's frame, so each is tested).
+  met_triangles_.clear();
   auto test_shard = [&](const Shard& shard) {
+    const bool same_copies = shard.precision() == StoredPrecision::float64;
     auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
+      if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) return;
       // The environment triangle in the object's frame (rounded: it only prunes).
       const std::array<Vec3, 3> framed{to_object_frame(environment[0]), to_object_frame(environment[1]),
                                        to_object_frame(environment[2])};

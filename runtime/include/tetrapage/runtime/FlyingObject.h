@@ -23,6 +23,7 @@
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/runtime/TriangleIdSet.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
 
@@ -84,7 +85,8 @@ struct StepCounters {
   std::uint32_t shards_touched = 0; ///< shards whose bounds met the object's box
   std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
   /// phase I: shard triangles that meet the object's world box (exactly) and whose boxes, in
-  /// the object's frame, meet its own box
+  /// the object's frame, meet its own box (a triangle stored in several of the step's shards
+  /// counts once in a double-precision index)
   std::uint64_t candidates = 0;
   std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
   /// The object's box, and the walk when it searched. While the object holds a free box, the
@@ -209,6 +211,7 @@ class FlyingObject {
   std::unique_ptr<Solid> solid_;  ///< per-step scratch
   /// Per step: the hull's pruning planes placed in the world (n.x <= offset holds the object).
   std::vector<std::pair<Vec3, double>> world_planes_;
+  TriangleIdSet met_triangles_;  ///< the triangles phase I has met this step
 
   // Per-step state.
   std::array<double, 9> rotation_{};
