@@ -5,6 +5,7 @@
 /// with generation stamps, so that clearing between steps costs nothing.
 #include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace tetrapage {
@@ -46,15 +47,15 @@ class TriangleIdSet {
   }
 
   void grow() {
-    std::vector<std::uint64_t> old_ids(stamps_.size() < 256 ? 512 : 2 * stamps_.size());
-    std::vector<std::uint32_t> old_stamps(old_ids.size(), 0u);
-    old_ids.swap(ids_);
-    old_stamps.swap(stamps_);
-    const std::uint32_t old_generation = generation_;
-    generation_ = 1;
+    const std::size_t slots = stamps_.size() < 256 ? 512 : 2 * stamps_.size();
+    const std::vector<std::uint64_t> previous_ids =
+        std::exchange(ids_, std::vector<std::uint64_t>(slots));
+    const std::vector<std::uint32_t> previous_stamps =
+        std::exchange(stamps_, std::vector<std::uint32_t>(slots, 0u));
+    const std::uint32_t previous_generation = std::exchange(generation_, 1u);
     size_ = 0;
-    for (std::size_t slot = 0; slot < old_stamps.size(); ++slot)
-      if (old_stamps[slot] == old_generation) insert(old_ids[slot]);
+    for (std::size_t slot = 0; slot < previous_stamps.size(); ++slot)
+      if (previous_stamps[slot] == previous_generation) insert(previous_ids[slot]);
   }
 
   std::vector<std::uint64_t> ids_;
