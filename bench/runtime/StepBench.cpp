@@ -86,7 +86,7 @@ int main(int argc, char** argv) {
     constexpr std::array<const char*, phase_count> kPhaseNames{"locate", "search", "free box", "shards",
                                                                "phase I+II", "containment"};
     std::array<std::array<double, phase_count>, kind_count> phase_seconds{};
-    std::array<std::uint64_t, kind_count> shards_touched{}, candidates{}, triangle_tests{}, free_box_found{},
+    std::array<std::uint64_t, kind_count> shards_touched{}, candidates{}, repeats{}, triangle_tests{}, free_box_found{},
         in_free_box{};
     std::vector<double> all;
     all.reserve(poses.size() * repeat);
@@ -107,6 +107,7 @@ int main(int argc, char** argv) {
         for (std::size_t p = 0; p < phase_count; ++p) phase_seconds[kind][p] += phases[p];
         shards_touched[kind] += c.shards_touched;
         candidates[kind] += c.candidates;
+        repeats[kind] += c.repeats;
         triangle_tests[kind] += c.triangle_tests;
         free_box_found[kind] += c.found_free_box;
         in_free_box[kind] += c.in_free_box;
@@ -132,17 +133,17 @@ int main(int argc, char** argv) {
     // The phases' clocks leave out what runs between them (and a step in the free box reads none).
     std::printf("\nmean us of each phase by kind of step (the runtime's own clocks), and counters per step:\n\n| step |");
     for (const char* name : kPhaseNames) std::printf(" %s |", name);
-    std::printf(" shards | candidates | triangle tests | found free box | in free box |\n|---|");
-    for (std::size_t p = 0; p < phase_count + 5; ++p) std::printf("---:|");
+    std::printf(" shards | candidates | repeats | triangle tests | found free box | in free box |\n|---|");
+    for (std::size_t p = 0; p < phase_count + 6; ++p) std::printf("---:|");
     std::printf("\n");
     for (std::size_t k = 0; k < kind_count; ++k) {
       if (steps[k] == 0) continue;
       const double n = double(steps[k]);
       std::printf("| %s |", kKindNames[k]);
       for (std::size_t p = 0; p < phase_count; ++p) std::printf(" %.3f |", 1e6 * phase_seconds[k][p] / n);
-      std::printf(" %.1f | %.1f | %.1f | %.1f %% | %.1f %% |\n", double(shards_touched[k]) / n, double(candidates[k]) / n,
-                  double(triangle_tests[k]) / n, 100.0 * double(free_box_found[k]) / n,
-                  100.0 * double(in_free_box[k]) / n);
+      std::printf(" %.1f | %.1f | %.1f | %.1f | %.1f %% | %.1f %% |\n", double(shards_touched[k]) / n,
+                  double(candidates[k]) / n, double(repeats[k]) / n, double(triangle_tests[k]) / n,
+                  100.0 * double(free_box_found[k]) / n, 100.0 * double(in_free_box[k]) / n);
     }
     const double per_search = double(std::max<std::uint64_t>(1, searches));
     std::printf("\nper search: %.1f tets crossed by the walk, %.1f visited, %.1f kept, %.2f us for the box search "

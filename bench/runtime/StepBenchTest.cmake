@@ -33,7 +33,7 @@ foreach(row "| searched |" "| no candidate |" "| phase II |" "| candidates |" "|
     message(FATAL_ERROR "the table has no row '${row}'")
   endif()
 endforeach()
-foreach(table "mean us of each phase by kind of step" "| step | locate | search | free box |")
+foreach(table "mean us of each phase by kind of step" "| step | locate | search | free box |" "| candidates | repeats |")
   string(FIND "${last_output}" "${table}" at)
   if(at EQUAL -1)
     message(FATAL_ERROR "no phase table ('${table}')")

@@ -575,7 +575,10 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     const bool same_copies = shard.precision() == StoredPrecision::float64;
     auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
-      if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) return;
+      if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
+        ++counters.repeats;
+        return;
+      }
       // The environment triangle in the object's frame (rounded: it only prunes).
       const std::array<Vec3, 3> framed{to_object_frame(environment[0]), to_object_frame(environment[1]),
                                        to_object_frame(environment[2])};
@@ -692,7 +695,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     test_shard(keep_pins_ ? *pins_[k] : *local_pin);
   }
   if (all && result.contacts.size() > 1) {
-    // A triangle that crosses regions is stored in each of their shards: report a pair once.
+    // A triangle that crosses regions is stored in each of their shards, and float copies are
+    // each tested (above): report a pair once.
     auto key = [](const Contact& c) { return std::tie(c.environment_triangle, c.object_triangle); };
     std::sort(result.contacts.begin(), result.contacts.end(),
               [&](const Contact& a, const Contact& b) { return key(a) < key(b); });

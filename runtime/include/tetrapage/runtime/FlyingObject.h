@@ -88,6 +88,9 @@ struct StepCounters {
   /// the object's frame, meet its own box (a triangle stored in several of the step's shards
   /// counts once in a double-precision index)
   std::uint64_t candidates = 0;
+  /// phase I: shard triangles skipped because another of the step's shards held them already
+  /// (a triangle crossing regions; double-precision indexes, whose copies are identical)
+  std::uint64_t repeats = 0;
   std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
   /// The object's box, and the walk when it searched. While the object holds a free box, the
   /// box is not timed: a step that ends inside the free box reads no clock at all.
