@@ -8,12 +8,33 @@
 /// vertices are placed in world space by apply_pose() (formats/Pose.h), in double; the pose
 /// collides when some placed object triangle and some environment triangle intersect as
 /// closed sets (touching counts), decided exactly on those doubles; or, when no surfaces
-/// touch, when one body lies inside the other: the object's first vertex has odd crossing
-/// parity with some closed part of the environment (a part whose every edge is used an even
-/// number of times; open parts such as terrains have no inside), or a vertex of an
-/// environment triangle has odd parity with the closed object. Each parity is the majority
-/// of three rays in fixed generic directions.
+/// touch, when one body lies inside the other, component by component:
+///  - a component is a maximal set of triangles of one part (TriangleSoup::part_of; an empty
+///    part_of is one part) connected through shared vertices, where vertices at identical
+///    coordinates are shared whatever their indices (-0.0 equals 0.0);
+///  - a component is closed when its triangles form a closed surface (in the runtime's words,
+///    every edge is used an even number of times); open components (terrains, sheets) have no
+///    inside. A point is inside the environment when it is strictly inside ANY closed
+///    component, each judged by its own ray parity: nested solids work (inside the inner one
+///    is inside both), and a self-intersecting closed component holds the points of odd
+///    parity (where two of its lobes overlap is outside it);
+///  - (a) object inside: some object component has a placed vertex inside a closed
+///    environment component; (b) obstacle inside: some environment component, closed or
+///    open, has a vertex inside a closed component of the placed object. With no surface
+///    contact one vertex decides for its whole (connected) component.
+///
+/// Independence from the runtime (which hashes vertex positions and calls a component closed
+/// when every edge is used an even number of times): components come from CGAL's exact
+/// merge_duplicate_points_in_polygon_soup and a union-find over the merged points;
+/// closedness from orient_polygon_soup, polygon_soup_to_polygon_mesh and CGAL::is_closed on
+/// a Surface_mesh that must be a triangle mesh; insideness from Side_of_triangle_mesh.
+/// Where the two definitions may differ, the tests avoid the input: an edge shared by four or
+/// more triangles (orient_polygon_soup cuts the soup there, so CGAL may read it open or as
+/// several sheets where parity reads it closed), and a triangle with two corners at one
+/// position (read here as open). A vertex shared by several cones of triangles (two solids
+/// touching at a corner) is fine: CGAL duplicates it and each piece stays closed.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -25,14 +46,17 @@ namespace tetrapage {
 class ReferenceCollider {
  public:
   struct Answer {
-    bool collides = false;        ///< surfaces_touch || object_inside || obstacle_inside
-    bool surfaces_touch = false;  ///< some triangle pair intersects
-    bool object_inside = false;   ///< no touch, but the object is inside a closed part
-    bool obstacle_inside = false; ///< no touch, but an environment triangle is inside the object
-    std::uint64_t candidates = 0; ///< environment triangles meeting the object's box
+    bool collides = false;         ///< surfaces_touch || object_inside || obstacle_inside
+    bool surfaces_touch = false;   ///< some triangle pair intersects
+    bool object_inside = false;    ///< no touch, but an object component is inside a closed one
+    bool obstacle_inside = false;  ///< no touch, not object_inside, but an environment component
+                                   ///< is inside a closed object component
+    std::uint64_t candidates = 0;  ///< environment triangles meeting the object's box
   };
 
-  /// Builds AABB trees over the environment and the object (object in its own frame).
+  /// Builds AABB trees over the environment and the object (object in its own frame), both
+  /// soups' components, and a Side_of_triangle_mesh (with its tree) per closed environment
+  /// component, all eagerly: queries mutate nothing.
   /// @throw InputError if either soup has no triangle.
   ReferenceCollider(const TriangleSoup& environment, const TriangleSoup& object);
   ~ReferenceCollider();
@@ -47,7 +71,8 @@ class ReferenceCollider {
   /// mesh/mesh collider such as FCL answers, decided exactly. Thread-safe.
   bool surfaces_touch(const Pose& pose) const;
 
-  /// Whether p is inside a closed part of the environment (crossing parity, see above).
+  /// Whether p is strictly inside some closed component of the environment (see above; a
+  /// point on a component's surface is not inside that component). Thread-safe.
   bool inside_environment(const Vec3& p) const;
 
   /// Bounding box of the object placed at `pose` (from all its placed vertices).
@@ -55,6 +80,12 @@ class ReferenceCollider {
   const BoundingBox& environment_bounds() const;
   /// Radius of the object's bounding sphere around its own origin.
   double object_radius() const;
+
+  /// Component counts (see the definition above), for tests and logs.
+  std::size_t environment_components() const;
+  std::size_t environment_closed_components() const;
+  std::size_t object_components() const;
+  std::size_t object_closed_components() const;
 
   class Impl;
 
