@@ -1,6 +1,8 @@
 // The study's generators (random BSP, scenes, tetras, terrains, flying objects) against
 // brute-force checks: tiling by point sampling and pairwise overlap tests, closedness by edge
 // pairing, orientation by CGAL's exact orientation predicate, and byte-for-byte determinism.
+// Open and closed scene copies are told apart in the written file, by components of shared
+// vertex positions and edge parity, independently of the generator's summary.
 
 #include <gtest/gtest.h>
 
@@ -13,6 +15,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <numeric>
 #include <string>
 
@@ -26,6 +29,8 @@
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/TerrainGenerator.h"
 #include "tetrapage/tools/TetrasGenerator.h"
+
+#include "RunCli.h"
 
 namespace tetrapage {
 namespace {
@@ -109,6 +114,44 @@ std::vector<std::vector<std::size_t>> components(const TriangleSoup& soup) {
   std::vector<std::vector<std::size_t>> result;
   for (auto& [root, list] : by_root) result.push_back(std::move(list));
   return result;
+}
+
+struct ComponentCount {
+  std::size_t closed = 0, open = 0;
+};
+
+// Connected components of a soup by shared vertex POSITION (whatever the reader does with
+// equal vertices), each closed when every undirected edge in it is used an even number of
+// times, open otherwise.
+ComponentCount closed_and_open_components(const TriangleSoup& soup) {
+  std::map<Vec3, std::uint32_t> position_ids;
+  std::vector<std::uint32_t> id(soup.vertices.size());
+  for (std::size_t v = 0; v < soup.vertices.size(); ++v) {
+    const auto next = static_cast<std::uint32_t>(position_ids.size());
+    id[v] = position_ids.emplace(soup.vertices[v], next).first->second;
+  }
+  std::vector<std::uint32_t> parent(position_ids.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  const auto find = [&](std::uint32_t p) {
+    while (parent[p] != p) p = parent[p] = parent[parent[p]];
+    return p;
+  };
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edge_uses;
+  for (const auto& t : soup.triangles) {
+    parent[find(id[t[1]])] = find(id[t[0]]);
+    parent[find(id[t[2]])] = find(id[t[0]]);
+    for (int i = 0; i < 3; ++i) {
+      const auto [a, b] = std::minmax(id[t[i]], id[t[(i + 1) % 3]]);
+      ++edge_uses[{a, b}];
+    }
+  }
+  std::map<std::uint32_t, bool> open_by_root;  // every component holding a triangle
+  for (const auto& t : soup.triangles) open_by_root.emplace(find(id[t[0]]), false);
+  for (const auto& [edge, uses] : edge_uses)
+    if (uses % 2 != 0) open_by_root[find(edge.first)] = true;
+  ComponentCount count;
+  for (const auto& [root, open] : open_by_root) ++(open ? count.open : count.closed);
+  return count;
 }
 
 TriangleSoup box_soup(const Vec3& lo, const Vec3& hi) {
@@ -322,9 +365,13 @@ TEST(SceneGenerator, PlanReachesTheTarget) {
   const MeshLibrary library = small_library();
   for (std::uint64_t target : {1u, 3u, 4u, 5u, 11u, 100u, 12345u}) {
     Random random(target);
-    const auto plan = plan_scene_copies(library, target, random);
+    const auto plan = plan_scene_copies(library, target, 0.0, random);
     std::uint64_t total = 0;
-    for (auto m : plan) total += library[m].triangle_count();
+    for (const auto& copy : plan) {
+      EXPECT_FALSE(copy.open);
+      EXPECT_EQ(copy.triangles, library[copy.mesh].triangle_count());
+      total += copy.triangles;
+    }
     ASSERT_FALSE(plan.empty());
     // Within half the smallest mesh (4 triangles), or one smallest mesh for a tiny target.
     EXPECT_LE(std::llabs(std::int64_t(total) - std::int64_t(target)), target < 4 ? 3 : 2)
@@ -346,6 +393,9 @@ TEST(SceneGenerator, CopiesSitInDisjointLeavesInsideTheUnitCube) {
   }
   EXPECT_LE(std::llabs(std::int64_t(summary.triangles) - 3000), 2);
   EXPECT_EQ(summary.leaves, 2 * summary.copies.size());
+  // SceneOptions opens no copy unless asked (library callers keep closed obstacles).
+  EXPECT_EQ(summary.open_copies, 0u);
+  EXPECT_EQ(summary.closed_copies, summary.copies.size());
   const BoundingBox unit{{0, 0, 0}, {1, 1, 1}};
   std::uint64_t triangles = 0;
   for (std::size_t i = 0; i < summary.copies.size(); ++i) {
@@ -419,6 +469,174 @@ TEST(SceneGenerator, RealMeshesReachTheTarget) {
   EXPECT_EQ(soup.triangle_count(), summary.triangles);
   const BoundingBox bounds = soup.bounds();
   EXPECT_TRUE(contains(BoundingBox{{0, 0, 0}, {1, 1, 1}}, bounds));
+}
+
+// Curated meshes are one connected piece each; with another library a closed copy may be
+// several closed components.
+bool every_mesh_is_one_piece(const MeshLibrary& library) {
+  for (const auto& mesh : library.meshes())
+    if (components(mesh.soup).size() != 1) return false;
+  return true;
+}
+
+// A real-mesh scene of about 20,000 triangles in one PLY file, as a CAD export would hold it.
+SceneSummary write_real_scene(const MeshLibrary& library, const std::filesystem::path& path,
+                              double open_fraction, std::uint64_t seed) {
+  SceneOptions options;
+  options.triangles = 20000;
+  options.seed = seed;
+  options.open_fraction = open_fraction;
+  MeshWriter writer(path);
+  SceneSummary summary = generate_scene(library, options, writer);
+  writer.commit();
+  return summary;
+}
+
+TEST(SceneGenerator, PlanCountsTheTrianglesOpenedCopiesKeep) {
+  const MeshLibrary library = MeshLibrary::load_default();
+  const double half_smallest = 0.5 * double(library.smallest_triangle_count());
+  for (double fraction : {default_scene_open_fraction, 1.0}) {
+    for (std::uint64_t target : {5000u, 40000u, 200000u}) {
+      SCOPED_TRACE("fraction " + std::to_string(fraction) + ", target " + std::to_string(target));
+      Random random(target);
+      const auto plan = plan_scene_copies(library, target, fraction, random);
+      std::uint64_t total = 0;
+      std::size_t open = 0;
+      for (const auto& copy : plan) {
+        total += copy.triangles;
+        open += copy.open ? 1 : 0;
+        const std::uint64_t whole = library[copy.mesh].triangle_count();
+        if (copy.open) {
+          EXPECT_LT(copy.triangles, whole);
+          EXPECT_GT(copy.triangles, 0u);
+          EXPECT_GE(copy.cut.height, 0.6);
+          EXPECT_LE(copy.cut.height, 0.9);
+        } else {
+          EXPECT_EQ(copy.triangles, whole);
+        }
+      }
+      EXPECT_LE(std::abs(double(total) - double(target)), half_smallest) << plan.size();
+      // Stratified: never more than the fraction rounded up; a cut that misses every triangle
+      // leaves a copy closed, which is rare with real meshes.
+      const double expected = fraction * double(plan.size());
+      EXPECT_LE(double(open), std::ceil(expected));
+      EXPECT_GE(double(open), std::floor(expected) - 0.1 * double(plan.size()) - 1.0);
+    }
+  }
+}
+
+TEST(SceneGenerator, DefaultMixesOpenAndClosedCopiesInOneFile) {
+  const MeshLibrary library = MeshLibrary::load_default();
+  const auto folder = test_folder("scene_open");
+  // Seed 11: eight copies, two of them opened (any plan of four copies or more opens some).
+  const SceneSummary summary =
+      write_real_scene(library, folder / "a.ply", default_scene_open_fraction, 11);
+  EXPECT_LE(std::abs(double(summary.triangles) - 20000.0), 2000.0);
+  EXPECT_EQ(summary.open_copies + summary.closed_copies, summary.copies.size());
+  ASSERT_GE(summary.open_copies, 1u);
+  ASSERT_GE(summary.closed_copies, 1u);
+  std::uint64_t triangles = 0;
+  for (const SceneCopy& copy : summary.copies) {
+    triangles += copy.triangles;
+    if (copy.open) {
+      EXPECT_LT(copy.triangles, library[copy.mesh].triangle_count());
+    } else {
+      EXPECT_EQ(copy.triangles, library[copy.mesh].triangle_count());
+    }
+    // Opened copies are placed as whole ones: inside their leaf, fitted along one axis.
+    EXPECT_TRUE(contains(copy.leaf, copy.placed));
+    double tightest = 0.0;
+    for (int a = 0; a < 3; ++a)
+      tightest = std::max(tightest, copy.placed.size()[a] / copy.leaf.size()[a]);
+    EXPECT_NEAR(tightest, 0.9, 1e-9);
+  }
+  EXPECT_EQ(triangles, summary.triangles);
+
+  // Independently of the summary: the file read back, split into components.
+  const TriangleSoup soup = read_mesh(folder / "a.ply");
+  ASSERT_EQ(soup.triangle_count(), summary.triangles);
+  const ComponentCount found = closed_and_open_components(soup);
+  EXPECT_GE(found.open, 1u);
+  EXPECT_GE(found.closed, 1u);
+  // An opened copy keeps one connected piece of its mesh: one open component each.
+  EXPECT_EQ(found.open, summary.open_copies);
+  // A closed copy is as many closed components as its mesh has pieces: one for the curated set.
+  EXPECT_GE(found.closed, summary.closed_copies);
+  if (every_mesh_is_one_piece(library)) {
+    EXPECT_EQ(found.closed, summary.closed_copies);
+  }
+
+  // Same seed, same bytes; the opening changes them.
+  write_real_scene(library, folder / "b.ply", default_scene_open_fraction, 11);
+  write_real_scene(library, folder / "c.ply", 0.0, 11);
+  const std::string a = file_bytes(folder / "a.ply");
+  EXPECT_EQ(a, file_bytes(folder / "b.ply"));
+  EXPECT_NE(a, file_bytes(folder / "c.ply"));
+}
+
+TEST(SceneGenerator, OpenFractionZeroKeepsEveryCopyClosed) {
+  const MeshLibrary library = MeshLibrary::load_default();
+  const auto folder = test_folder("scene_closed");
+  const SceneSummary summary = write_real_scene(library, folder / "scene.ply", 0.0, 11);
+  EXPECT_EQ(summary.open_copies, 0u);
+  EXPECT_EQ(summary.closed_copies, summary.copies.size());
+  const ComponentCount found = closed_and_open_components(read_mesh(folder / "scene.ply"));
+  EXPECT_EQ(found.open, 0u);
+  EXPECT_GE(found.closed, summary.copies.size());
+}
+
+TEST(SceneGenerator, OpenFractionOutOfRangeIsAnInputError) {
+  const MeshLibrary library = small_library();
+  const auto folder = test_folder("scene_bad_fraction");
+  for (double fraction : {-0.1, 1.5, std::nan("")}) {
+    SceneOptions options;
+    options.open_fraction = fraction;
+    MeshWriter writer(folder / "scene.ply");
+    try {
+      generate_scene(library, options, writer);
+      FAIL() << "expected InputError for " << fraction;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("--open-fraction"), std::string::npos) << e.what();
+    }
+    Random random(1);
+    EXPECT_THROW(plan_scene_copies(library, 100, fraction, random), InputError);
+  }
+  for (double fraction : {0.0, 1.0}) {  // the bounds are accepted
+    SceneOptions options;
+    options.triangles = 200;
+    options.open_fraction = fraction;
+    MeshWriter writer(folder / "scene.ply");
+    EXPECT_FALSE(generate_scene(library, options, writer).copies.empty());
+  }
+}
+
+TEST(SceneGenerator, CommandDefaultsToAMixAndReportsIt) {
+  const auto folder = test_folder("scene_command");
+  const auto scene = folder / "scene.ply", report = folder / "scene.json";
+  std::string out;
+  ASSERT_EQ(test::run_cli("generate scene --triangles 20000 --seed 11 -o " + scene.string() +
+                              " --report " + report.string(),
+                          out),
+            0)
+      << out;
+  EXPECT_NE(out.find(" open, "), std::string::npos) << out;
+  std::ifstream in(report);
+  const auto json = nlohmann::json::parse(in);
+  EXPECT_EQ(json.at("open_fraction").get<double>(), default_scene_open_fraction);
+  const auto open = json.at("open_copies").get<std::size_t>();
+  const auto closed = json.at("closed_copies").get<std::size_t>();
+  EXPECT_EQ(open + closed, json.at("copies").get<std::size_t>());
+  const ComponentCount found = closed_and_open_components(read_mesh(scene));
+  EXPECT_GE(found.open, 1u);
+  EXPECT_EQ(found.open, open);
+
+  EXPECT_NE(
+      test::run_cli("generate scene --open-fraction 1.5 -o " + (folder / "bad.ply").string(), out),
+      0);
+  EXPECT_FALSE(std::filesystem::exists(folder / "bad.ply"));
+  ASSERT_EQ(test::run_cli("generate scene --help", out), 0);
+  EXPECT_NE(out.find("--open-fraction"), std::string::npos) << out;
+  EXPECT_NE(out.find("0.25"), std::string::npos) << out;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -102,17 +102,29 @@ void add_scene(CLI::App& generate) {
       "no side shorter than alpha = 0.4 (1/leaves)^(1/3)); a random half of the boxes each get\n"
       "one randomly rotated copy of a real mesh, scaled to fill 90% of its box along the\n"
       "tightest axis and centred. Meshes are drawn until the total is about --triangles.\n"
+      "As in real CAD exports, closed solids and open shells share the file: a fraction of\n"
+      "the copies (--open-fraction) lose their triangles above a random plane, leaving one\n"
+      "connected shell with a hole; the others stay closed.\n"
       "Each copy is streamed to the file as its own part: memory stays small for any size.\n"
       "The same seed and meshes give the same file.");
   command->add_option("--triangles", options->triangles, "Target number of triangles")
       ->capture_default_str()
       ->check(CLI::Range(std::uint64_t{1}, max_scene_triangles));
+  options->open_fraction = default_scene_open_fraction;
+  command
+      ->add_option("--open-fraction", options->open_fraction,
+                   "Fraction of the copies opened, in [0, 1]: the triangles whose corners all lie "
+                   "above a plane at a random 60-90% of the copy's extent along a random direction "
+                   "are dropped (of what remains, the largest connected piece is kept). The "
+                   "triangle target counts the kept triangles. 0: every copy closed")
+      ->capture_default_str();
   add_common_options(*command, *common, true);
   add_meshes_option(*command, *common);
   command->callback([common, options] {
     const auto start = std::chrono::steady_clock::now();
     options->seed = common->seed;
-    MeshWriter writer(common->output);  // first: a bad output name fails before any work
+    check_scene_options(*options);      // first: a bad option or output name fails before
+    MeshWriter writer(common->output);  // any work
     const MeshLibrary library = load_library(common->meshes);
     Progress progress("generating scene (triangles)", 0);  // the plan decides the total
     const SceneSummary summary = generate_scene(library, *options, writer, progress);
@@ -124,7 +136,9 @@ void add_scene(CLI::App& generate) {
                     summary.copies.size(),
                     summary.bounds,
                     " (copies of real meshes in " + std::to_string(summary.copies.size()) + " of " +
-                        std::to_string(summary.leaves) + " BSP leaves)",
+                        std::to_string(summary.leaves) +
+                        " BSP leaves: " + std::to_string(summary.open_copies) + " open, " +
+                        std::to_string(summary.closed_copies) + " closed)",
                     {}};
     nlohmann::json used = nlohmann::json::object();
     for (const auto& copy : summary.copies) {
@@ -133,6 +147,9 @@ void add_scene(CLI::App& generate) {
     }
     outcome.details = {{"target_triangles", options->triangles},
                        {"copies", summary.copies.size()},
+                       {"open_fraction", options->open_fraction},
+                       {"open_copies", summary.open_copies},
+                       {"closed_copies", summary.closed_copies},
                        {"leaves", summary.leaves},
                        {"alpha", summary.alpha},
                        {"meshes_folder", library.folder().string()},
