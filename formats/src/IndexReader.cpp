@@ -558,9 +558,9 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
   IndexHeader& h = r.header;
   h.version = static_cast<std::uint32_t>(version);
   h.precision = r.read_string_attribute(g, "precision");
-  if (h.precision != "float" && h.precision != "double")
+  if (h.precision != "float" && h.precision != "double" && h.precision != "exact")
     r.format_error("root attribute 'precision' is '" + h.precision +
-                   "', expected 'float' or 'double'");
+                   "', expected 'exact', 'float' or 'double'");
   h.input_triangles = r.read_number_attribute<std::uint64_t>(g, "input_triangles", 1)[0];
   h.stored_triangles = r.read_number_attribute<std::uint64_t>(g, "stored_triangles", 1)[0];
   h.region_count = r.read_number_attribute<std::uint64_t>(g, "region_count", 1)[0];

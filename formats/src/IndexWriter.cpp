@@ -412,9 +412,9 @@ std::uint64_t IndexWriter::commit(const IndexHeader& header) {
   if (header.version != kIndexVersion)
     throw InputError(where + ": header version " + std::to_string(header.version) +
                      ", but this writer writes version " + std::to_string(kIndexVersion));
-  if (header.precision != "float" && header.precision != "double")
+  if (header.precision != "float" && header.precision != "double" && header.precision != "exact")
     throw InputError(where + ": header precision '" + header.precision +
-                     "' is neither 'float' nor 'double'");
+                     "' is not 'exact', 'float' or 'double'");
   if (header.shard_count != 0 && header.shard_count != w.offsets.size())
     throw InputError(where + ": header says " + std::to_string(header.shard_count) +
                      " shards, but " + std::to_string(w.offsets.size()) + " were appended");

@@ -25,8 +25,9 @@
 #include <sstream>
 
 #include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/EdgeParity.h"
+#include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MemoryUsage.h"
@@ -311,6 +312,9 @@ class CopyBucket {
   std::vector<CopyPair> pairs_;
 };
 
+// The marker of an undecided tet in the interiors' component lists (so never a component id).
+constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
+
 // Ingest: every part file read once, instances placed, soups kept compactly (SoupSpill); a
 // reservoir sample of centroids (Algorithm R, fixed seed) bounded by the memory budget.
 struct Ingest {
@@ -319,21 +323,19 @@ struct Ingest {
   std::uint64_t seen = 0;
   BoundingBox bounds;
   std::vector<std::string> part_names;
-  // Per part: whether its surface is closed, and its triangle count.
-  std::vector<EdgeParity> part_parity;
-  std::vector<BoundingBox> part_bounds;
+  // The surfaces' connected components, model-wide (the ids the records and shards carry).
+  std::vector<SurfaceComponent> components;
 };
 
 // One input soup (a manifest's part, or a mesh file) with what can be computed off the
-// ingest's serial path: centroids, and per soup part edge parity and bounds.
+// ingest's serial path: centroids, and its surfaces' connected components (its part_of then
+// holds each triangle's component, numbered within the soup).
 struct LoadedSoup {
   std::uint64_t degenerate_dropped = 0;
   std::uint64_t files_read = 0;
   TriangleSoup soup;
   std::vector<Vec3> centroids;  // per triangle
-  // Per soup part.
-  std::vector<EdgeParity> parity;
-  std::vector<BoundingBox> bounds;
+  std::vector<SurfaceComponent> components;
 };
 
 LoadedSoup load_soup(const InputPiece& piece) {
@@ -344,22 +346,12 @@ LoadedSoup load_soup(const InputPiece& piece) {
     loaded.degenerate_dropped += report.degenerate_dropped;
     ++loaded.files_read;
   }
-  const TriangleSoup& soup = loaded.soup;
-  const std::size_t parts = std::max<std::size_t>(soup.part_names.size(), 1);
-  loaded.parity.resize(parts);
-  loaded.bounds.resize(parts);
+  TriangleSoup& soup = loaded.soup;
+  SurfaceComponents found = find_surface_components(soup);
+  soup.part_of = std::move(found.component_of);
+  loaded.components = std::move(found.components);
   loaded.centroids.resize(soup.triangle_count());
-  // Each vertex hashed once, not once per edge end (six times for a vertex of six triangles).
-  std::vector<EdgeParity::VertexHash> vertex_hashes(soup.vertices.size());
-  for (std::size_t v = 0; v < soup.vertices.size(); ++v) vertex_hashes[v] = EdgeParity::hash_vertex(soup.vertices[v]);
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
-    const auto part = std::uint32_t(soup.part_of.empty() ? 0 : soup.part_of[t]);
-    const auto corners = soup.corners(t);
-    const auto& c = soup.triangles[t];
-    loaded.parity[part].add_hashed_triangle(vertex_hashes[c[0]], vertex_hashes[c[1]], vertex_hashes[c[2]]);
-    for (const auto& p : corners) loaded.bounds[part].extend(p);
-    loaded.centroids[t] = centroid(corners);
-  }
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) loaded.centroids[t] = centroid(soup.corners(t));
   return loaded;
 }
 
@@ -406,10 +398,15 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
     const auto part_offset = std::uint32_t(in.part_names.size());
     for (const auto& name : loaded.soup.part_names) in.part_names.push_back(name);
     if (loaded.soup.part_names.empty()) in.part_names.push_back("part" + std::to_string(part_offset));
-    in.part_parity.insert(in.part_parity.end(), loaded.parity.begin(), loaded.parity.end());
-    in.part_bounds.insert(in.part_bounds.end(), loaded.bounds.begin(), loaded.bounds.end());
-    for (const BoundingBox& b : loaded.bounds) in.bounds.extend(b);
-    in.soups.append(loaded.soup, part_offset);
+    if (in.components.size() + loaded.components.size() >= kInteriorUndecided)
+      throw InputError("the inputs hold more than 2^32 - 2 connected components");
+    const auto component_offset = std::uint32_t(in.components.size());
+    for (SurfaceComponent& c : loaded.components) {
+      c.part += part_offset;
+      in.bounds.extend(c.bounds);
+      in.components.push_back(c);
+    }
+    in.soups.append(loaded.soup, component_offset);
     if (!in.soups.spilled() && (in.soups.held_bytes() > held_limit || options.force_spill))
       in.soups.spill_to(spill_path(spill_folder, "triangles"));
     for (std::size_t t = 0; t < loaded.centroids.size(); ++t, ++in.seen) {
@@ -438,6 +435,7 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   progress.finish();
   summary.triangles_read = in.seen;
   summary.parts = in.part_names.size();
+  summary.components = in.components.size();
   if (in.seen == 0) throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
 }
 
@@ -456,31 +454,27 @@ std::vector<InMemoryTask> in_memory_tasks(const SoupSpill<TriangleRecord>& soups
   return tasks;
 }
 
-// The interiors: each tet's reference point classified against the closed parts, as CSR
+// The interiors: each tet's reference point classified against the closed components, as CSR
 // tables by tet (see docs/FORMAT.md), exactly, by vertical ray parity (RayParity.h) over one
 // stream of the records per pass.
 struct Interiors {
-  std::vector<std::uint8_t> part_closed;
   std::vector<double> reference_points;  // 3 per tet; NaN for a tet without one
   std::vector<std::uint64_t> offsets;    // tet_count + 1
-  std::vector<std::uint32_t> parts;      // kInteriorUndecided marks an undecided tet
+  std::vector<std::uint32_t> components; // kInteriorUndecided marks an undecided tet
   bool stored = false;
 };
-
-constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
 
 Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOptions& options,
                              PreprocessSummary& summary) {
   Interiors result;
-  const std::size_t parts = in.part_names.size();
-  result.part_closed.assign(parts, 0);
-  std::vector<bool> closed(parts);
-  for (std::size_t p = 0; p < parts; ++p) {
-    closed[p] = in.part_parity[p].closed();
-    summary.closed_parts += closed[p];
+  const std::size_t components = in.components.size();
+  std::vector<bool> closed(components);
+  for (std::size_t c = 0; c < components; ++c) {
+    closed[c] = in.components[c].closed;
+    summary.closed_components += closed[c];
   }
   if (!options.interiors) return result;
-  if (summary.closed_parts == 0) {
+  if (summary.closed_components == 0) {
     summary.interiors = "none closed";
     return result;
   }
@@ -497,7 +491,7 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       result.reference_points[3 * t + a] =
           reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
   });
-  // A pass classifies against as many parts as its (point, part) pairs allow: a quarter of the
+  // A pass classifies against as many components as its (point, component) pairs allow: a quarter of the
   // budget (RayParity holds 29 bytes per pair, the plan as much again).
   const std::uint64_t pairs_per_pass =
       options.interior_pairs_per_pass != 0
@@ -506,41 +500,41 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   std::vector<std::vector<std::uint32_t>> inside(tet_count);
   std::vector<std::uint8_t> undecided(tet_count, 0);
   std::uint64_t passes = 0;
-  // Classifies the given tets' reference points against every closed part whose box holds them
-  // (outside a part's box is outside the part).
+  // Classifies the given tets' reference points against every closed component whose box holds
+  // them (outside a component's box is outside the component).
   auto classify = [&](std::vector<std::uint32_t> tets, bool show_progress) {
     std::sort(tets.begin(), tets.end(),
               [&](std::uint32_t a, std::uint32_t b) { return points[a][0] < points[b][0]; });
     for (const std::uint32_t t : tets) inside[t].clear(), undecided[t] = 0;
-    std::vector<std::vector<std::uint32_t>> of_part(parts);
-    std::vector<std::vector<std::uint32_t>> pass_parts(1);
+    std::vector<std::vector<std::uint32_t>> of_component(components);
+    std::vector<std::vector<std::uint32_t>> pass_components(1);
     std::uint64_t pass_pairs = 0;
-    for (std::size_t p = 0; p < parts; ++p) {
+    for (std::size_t p = 0; p < components; ++p) {
       if (!closed[p]) continue;
-      const BoundingBox& b = in.part_bounds[p];
+      const BoundingBox& b = in.components[p].bounds;
       auto it = std::lower_bound(tets.begin(), tets.end(), b.lo[0],
                                  [&](std::uint32_t t, double x) { return points[t][0] < x; });
       for (; it != tets.end() && points[*it][0] <= b.hi[0]; ++it)
-        if (geometry::box_contains(b, points[*it])) of_part[p].push_back(*it);
-      if (of_part[p].empty()) continue;
-      if (pass_pairs > 0 && pass_pairs + of_part[p].size() > pairs_per_pass) {
-        pass_parts.emplace_back();
+        if (geometry::box_contains(b, points[*it])) of_component[p].push_back(*it);
+      if (of_component[p].empty()) continue;
+      if (pass_pairs > 0 && pass_pairs + of_component[p].size() > pairs_per_pass) {
+        pass_components.emplace_back();
         pass_pairs = 0;
       }
-      pass_parts.back().push_back(std::uint32_t(p));
-      pass_pairs += of_part[p].size();
+      pass_components.back().push_back(std::uint32_t(p));
+      pass_pairs += of_component[p].size();
     }
-    if (pass_parts.back().empty()) pass_parts.pop_back();
-    Progress progress("classifying interiors", in.seen * pass_parts.size(),
+    if (pass_components.back().empty()) pass_components.pop_back();
+    Progress progress("classifying interiors", in.seen * pass_components.size(),
                       options.progress && show_progress);
-    for (const auto& pass : pass_parts) {
+    for (const auto& pass : pass_components) {
       ++passes;
-      std::vector<std::vector<std::uint32_t>> asked(parts);
-      for (const std::uint32_t p : pass) asked[p] = std::move(of_part[p]);
+      std::vector<std::vector<std::uint32_t>> asked(components);
+      for (const std::uint32_t p : pass) asked[p] = std::move(of_component[p]);
       RayParity parity(points, asked);
       asked.clear();
       if (!in.soups.spilled()) {
-        // In memory: the soups cut into tasks, the triangles of parts not asked about skipped
+        // In memory: the soups cut into tasks, the triangles of components not asked about skipped
         // before their records are made (blocks of every record, made on one thread, were a
         // third of this stage).
         std::vector<InMemoryTask> tasks = in_memory_tasks(in.soups);
@@ -550,9 +544,9 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
                             for (std::size_t k = range.begin(); k < range.end(); ++k) {
                               const InMemoryTask& task = tasks[k];
                               for (std::size_t t = task.first; t < task.first + task.count; ++t) {
-                                const std::uint32_t part = in.soups.piece_part(task.piece, t);
-                                if (parity.wanted(part))
-                                  parity.add_triangle(part, in.soups.piece_record(task.piece, t).triangle);
+                                const std::uint32_t component = in.soups.piece_part(task.piece, t);
+                                if (parity.wanted(component))
+                                  parity.add_triangle(component, in.soups.piece_record(task.piece, t).triangle);
                               }
                               const std::lock_guard lock(progress_mutex);
                               progress.advance(task.count);
@@ -582,9 +576,9 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   for (std::size_t t = 0; t < tet_count; ++t) all[t] = std::uint32_t(t);
   classify(std::move(all), true);
   const std::uint64_t first_passes = passes;
-  // A reference point on a closed part's surface is replaced by another point strictly inside
+  // A reference point on a closed component's surface is replaced by another point strictly inside
   // its tet and classified again, in passes of its own (a tet's point must be the same for
-  // every part).
+  // every component).
   constexpr std::array<std::array<double, 4>, 3> kOtherPoints{
       {{0.31, 0.23, 0.27, 0.19}, {0.17, 0.37, 0.21, 0.25}, {0.29, 0.13, 0.39, 0.19}}};
   std::uint64_t moved = 0;
@@ -607,19 +601,18 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     classify(std::move(retry), false);
   }
 
-  for (std::size_t p = 0; p < parts; ++p) result.part_closed[p] = closed[p] ? 1 : 0;
   result.offsets.reserve(tet_count + 1);
   result.offsets.push_back(0);
   for (std::size_t t = 0; t < tet_count; ++t) {
     if (!has_point[t] || undecided[t] != 0) {
-      result.parts.push_back(kInteriorUndecided);
+      result.components.push_back(kInteriorUndecided);
       ++summary.interior_undecided;
     } else {
       std::sort(inside[t].begin(), inside[t].end());
-      result.parts.insert(result.parts.end(), inside[t].begin(), inside[t].end());
+      result.components.insert(result.components.end(), inside[t].begin(), inside[t].end());
       if (!inside[t].empty()) ++summary.interior_tets;
     }
-    result.offsets.push_back(result.parts.size());
+    result.offsets.push_back(result.components.size());
   }
   result.stored = true;
   summary.interiors =
@@ -628,6 +621,25 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
     summary.interiors +=
         "; " + std::to_string(moved) + " reference points on a surface moved and classified again";
   return result;
+}
+
+// The components table (docs/FORMAT.md): each component's part, closedness and box.
+void write_components(IndexWriter& writer, const std::vector<SurfaceComponent>& components) {
+  std::vector<std::uint32_t> part;
+  std::vector<std::uint8_t> closed;
+  std::vector<double> bounds;
+  part.reserve(components.size());
+  closed.reserve(components.size());
+  bounds.reserve(6 * components.size());
+  for (const SurfaceComponent& c : components) {
+    part.push_back(c.part);
+    closed.push_back(c.closed ? 1 : 0);
+    bounds.insert(bounds.end(), c.bounds.lo.begin(), c.bounds.lo.end());
+    bounds.insert(bounds.end(), c.bounds.hi.begin(), c.bounds.hi.end());
+  }
+  writer.write_table("component_part", std::span<const std::uint32_t>(part));
+  writer.write_table("component_closed", std::span<const std::uint8_t>(closed));
+  writer.write_table("component_bounds", std::span<const double>(bounds));
 }
 
 }  // namespace
@@ -983,6 +995,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                     summary.shard_payload_bytes += ready->payload_bytes;
                     summary.max_rounding_distance = std::max(summary.max_rounding_distance, built.max_rounding_distance);
                     (built.kind == ShardKind::grid ? summary.grid_shards : summary.rtree_shards) += 1;
+                    summary.float_shards += built.precision == StoredPrecision::float32;
                     progress.advance();
                   });
     }
@@ -1000,11 +1013,11 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     writer.write_table("shard_kind", std::span<const std::uint8_t>(shard_kind));
     writer.write_table("shard_triangles", std::span<const std::uint32_t>(shard_triangles));
     writer.write_table("shard_bounds", std::span<const double>(shard_bounds));
+    write_components(writer, in.components);
     if (interiors.stored) {
-      writer.write_table("part_closed", std::span<const std::uint8_t>(interiors.part_closed));
       writer.write_table("reference_points", std::span<const double>(interiors.reference_points));
       writer.write_table("interior_offsets", std::span<const std::uint64_t>(interiors.offsets));
-      writer.write_table("interior_parts", std::span<const std::uint32_t>(interiors.parts));
+      writer.write_table("interior_components", std::span<const std::uint32_t>(interiors.components));
     }
     IndexHeader header;
     header.precision = summary.precision;
@@ -1052,9 +1065,11 @@ std::string PreprocessSummary::to_json() const {
   j["precision"] = precision;
   j["compression"] = compression;
   j["max_rounding_distance"] = max_rounding_distance;
+  j["float_shards"] = float_shards;
   j["query_extent"] = query_extent;
   j["memory_budget_bytes"] = memory_budget_bytes;
-  j["closed_parts"] = closed_parts;
+  j["components"] = components;
+  j["closed_components"] = closed_components;
   j["interiors"] = interiors;
   j["interior_tets"] = interior_tets;
   j["interior_undecided"] = interior_undecided;
@@ -1082,14 +1097,16 @@ std::string PreprocessSummary::to_text() const {
                 (unsigned long long)regions, (unsigned long long)empty_regions, (unsigned long long)region_triangles,
                 (unsigned long long)grid_shards, (unsigned long long)rtree_shards, duplication_factor);
   text << line;
-  std::snprintf(line, sizeof line,
-                "index %s: %s (%.1f B/triangle, chunks %s), shards decoded %s; %s coordinates, max rounding %.3g\n",
+  std::snprintf(line, sizeof line, "index %s: %s (%.1f B/triangle, chunks %s), shards decoded %s\n",
                 output.string().c_str(), format_byte_size(bytes_written).c_str(),
                 triangles_read ? double(bytes_written) / double(triangles_read) : 0.0, compression.c_str(),
-                format_byte_size(shard_payload_bytes).c_str(), precision.c_str(), max_rounding_distance);
-  text << line;
-  std::snprintf(line, sizeof line, "closed parts %llu; interiors %s (%llu tets inside, %llu undecided)\n",
-                (unsigned long long)closed_parts, interiors.c_str(), (unsigned long long)interior_tets,
+                format_byte_size(shard_payload_bytes).c_str());
+  text << line << storage_statement(precision, max_rounding_distance) << "; "
+       << float_shards << " of " << (grid_shards + rtree_shards) << " shards in 4-byte floats\n";
+  std::snprintf(line, sizeof line,
+                "components %llu (closed %llu, open %llu); interiors %s (%llu tets inside, %llu undecided)\n",
+                (unsigned long long)components, (unsigned long long)closed_components,
+                (unsigned long long)(components - closed_components), interiors.c_str(), (unsigned long long)interior_tets,
                 (unsigned long long)interior_undecided);
   text << line;
   for (const auto& stage : stages) {

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <string>
 
 #include "tetrapage/formats/Error.h"
@@ -76,6 +77,30 @@ Frame double_frame(const Box& box, std::span<const Triangle> triangles) {
   return frame;
 }
 
+// exact: float32 at an origin where every vertex decodes, as o + double(float(v - o)) in
+// binary64 (the format's definition of a stored vertex), to exactly v; the float frame's origin
+// is tried first, then 0 (which suits input that was float already). Nothing when neither does.
+std::optional<Frame> lossless_float_frame(const Box& box, std::span<const Triangle> triangles) {
+  const auto decodes = [&](const Point& o) {
+    for (const Triangle& t : triangles)
+      for (const Point& v : t)
+        for (int k = 0; k < 3; ++k) {
+          const float r = float(v[k] - o[k]);
+          if (!std::isfinite(r) || o[k] + double(r) != v[k]) return false;
+        }
+    return true;
+  };
+  std::optional<Frame> frame;
+  try {
+    frame = float_frame(box);
+  } catch (const InputError&) {
+    frame.reset();  // beyond float's range around any origin near the region
+  }
+  if (frame && decodes(frame->origin)) return frame;
+  if (decodes(Point{})) return Frame{};
+  return std::nullopt;
+}
+
 struct VertexKey {
   std::array<std::uint64_t, 3> bits;
   bool operator==(const VertexKey&) const = default;
@@ -91,6 +116,8 @@ struct VertexKeyHash {
 /// The triangles as stored: relative coordinates (exactly representable in the stored type),
 /// deduplicated vertices, and the absolute stored triangles.
 struct StoredGeometry {
+  StoredPrecision precision = StoredPrecision::float64;  ///< float32 or float64
+  bool rounds = false;  ///< float32 on a fixed-point step (--precision float), not lossless
   Frame frame;
   std::vector<Point> relative;                      ///< per distinct vertex, first-seen order
   std::vector<std::array<std::uint32_t, 3>> corners;  ///< per triangle
@@ -103,7 +130,15 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
   for (const Triangle& t : input)
     for (const Point& v : t) box.extend(v);
   StoredGeometry g;
-  g.frame = precision == StoredPrecision::float32 ? float_frame(box) : double_frame(box, input);
+  g.precision = precision;
+  if (precision == StoredPrecision::exact) {
+    const std::optional<Frame> lossless = lossless_float_frame(box, input);
+    g.precision = lossless ? StoredPrecision::float32 : StoredPrecision::float64;
+    g.frame = lossless ? *lossless : double_frame(box, input);
+  } else {
+    g.rounds = precision == StoredPrecision::float32;
+    g.frame = g.rounds ? float_frame(box) : double_frame(box, input);
+  }
   const Point& o = g.frame.origin;
   // Open addressing over a power-of-two table at most a third full: no allocation per vertex
   // (a node-based map's allocations were a tenth of the shard stage).
@@ -121,8 +156,10 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
       Point r;
       for (int k = 0; k < 3; ++k) {
         r[k] = v[k] - o[k];
-        if (precision == StoredPrecision::float32)
+        if (g.rounds)
           r[k] = double(float(std::nearbyint(r[k] / g.frame.step) * g.frame.step));
+        else if (g.precision == StoredPrecision::float32)
+          r[k] = double(float(r[k]));  // exact: the frame was checked to be lossless
         r[k] += 0.0;  // one key for 0 and -0
       }
       Point stored;
@@ -469,8 +506,8 @@ StoredRegion::StoredRegion(const ShardTriangles& region, StoredPrecision precisi
   auto tables = std::make_unique<Tables>();
   Tables& d = *tables;
   d.region = region;
-  d.precision = precision;
   d.g = store(region.triangles, precision);
+  d.precision = d.g.precision;
   const auto n = std::uint32_t(region.triangles.size());
   for (const Triangle& t : d.g.triangles) d.bounds.extend(geometry::box_of(t));
   d.boxes.resize(n);

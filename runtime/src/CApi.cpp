@@ -295,7 +295,8 @@ tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
     const auto& found = object->result.contacts;
     const std::size_t n = std::min(capacity, found.size());
     for (std::size_t i = 0; i < n; ++i)
-      contacts[i] = {found[i].environment_triangle, found[i].environment_part, found[i].object_triangle};
+      contacts[i] = {found[i].environment_triangle, found[i].environment_part, found[i].object_triangle,
+                     found[i].environment_component};
     *written = n;
   });
 }
@@ -325,6 +326,7 @@ tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
                     counters.test_seconds + counters.interior_seconds;
     info->containment = int(result.containment);
     info->containing_part = result.containing_part;
+    info->containing_component = result.containing_component;
   });
 }
 

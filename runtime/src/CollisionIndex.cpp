@@ -43,6 +43,8 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
     shard_bytes_[s] = reader_.shard_size(s) + 4096;
     total_shard_bytes_ += shard_bytes_[s];
   }
+  read_components(where);
+  stores_input_coordinates_ = header().precision != "float";
   read_interiors(where);
   ShardCacheOptions cache_options;
   cache_options.prefetch_threads = options_.prefetch ? std::max<std::size_t>(1, options_.prefetch_threads) : 0;
@@ -72,30 +74,48 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
 
 CollisionIndex::~CollisionIndex() = default;
 
+void CollisionIndex::read_components(const std::string& where) {
+  component_part_ = reader_.read_table_uint32("component_part");
+  component_closed_ = reader_.read_table_uint8("component_closed");
+  const auto bounds = reader_.read_table_double("component_bounds");
+  const std::size_t count = component_part_.size();
+  if (component_closed_.size() != count || bounds.size() != 6 * count)
+    throw FormatError(where + "/tables/component_closed and component_bounds hold " +
+                      std::to_string(component_closed_.size()) + " and " + std::to_string(bounds.size()) +
+                      " values for " + std::to_string(count) + " components (1 and 6 each)");
+  component_bounds_.resize(count);
+  for (std::size_t c = 0; c < count; ++c) {
+    geometry::Box& box = component_bounds_[c];
+    for (int a = 0; a < 3; ++a) box.lo[a] = bounds[6 * c + a], box.hi[a] = bounds[6 * c + 3 + a];
+    if (!(box.lo[0] <= box.hi[0] && box.lo[1] <= box.hi[1] && box.lo[2] <= box.hi[2]))
+      throw FormatError(where + "/tables/component_bounds holds an empty or non-finite box for component " +
+                        std::to_string(c));
+  }
+}
+
 void CollisionIndex::read_interiors(const std::string& where) {
   const auto names = reader_.table_names();
   const auto has = [&](const char* name) { return std::find(names.begin(), names.end(), name) != names.end(); };
   if (!has("interior_offsets")) return;  // written without interiors: surfaces only
   const std::size_t tets = mesh_.tet_count();
-  part_closed_ = reader_.read_table_uint8("part_closed");
   const auto points = reader_.read_table_double("reference_points");
   auto offsets = reader_.read_table_uint64("interior_offsets");
-  interior_parts_ = reader_.read_table_uint32("interior_parts");
+  interior_components_ = reader_.read_table_uint32("interior_components");
   if (points.size() != 3 * tets)
     throw FormatError(where + "/tables/reference_points has " + std::to_string(points.size()) + " values for " +
                       std::to_string(tets) + " tets (3 each)");
-  if (offsets.size() != tets + 1 || offsets.front() != 0 || offsets.back() != interior_parts_.size())
-    throw FormatError(where + "/tables/interior_offsets does not delimit /tables/interior_parts for " +
+  if (offsets.size() != tets + 1 || offsets.front() != 0 || offsets.back() != interior_components_.size())
+    throw FormatError(where + "/tables/interior_offsets does not delimit /tables/interior_components for " +
                       std::to_string(tets) + " tets");
   for (std::size_t t = 0; t < tets; ++t) {
     if (offsets[t + 1] < offsets[t])
       throw FormatError(where + "/tables/interior_offsets decreases at tet " + std::to_string(t));
     for (std::uint64_t i = offsets[t]; i < offsets[t + 1]; ++i) {
-      const std::uint32_t part = interior_parts_[i];
-      const bool undecided = part == kInteriorUndecided && offsets[t + 1] - offsets[t] == 1;
-      if (!undecided && !part_closed(part))
-        throw FormatError(where + "/tables/interior_parts names part " + std::to_string(part) + " for tet " +
-                          std::to_string(t) + ", which is not a closed part");
+      const std::uint32_t component = interior_components_[i];
+      const bool undecided = component == kInteriorUndecided && offsets[t + 1] - offsets[t] == 1;
+      if (!undecided && !component_closed(component))
+        throw FormatError(where + "/tables/interior_components names component " + std::to_string(component) +
+                          " for tet " + std::to_string(t) + ", which is not a closed component");
     }
   }
   reference_points_.resize(tets);
@@ -103,7 +123,7 @@ void CollisionIndex::read_interiors(const std::string& where) {
     reference_points_[t] = {points[3 * t], points[3 * t + 1], points[3 * t + 2]};
     // A NaN point is stored for an undecided tet only; any other must lie in its tet.
     const bool finite = std::isfinite(points[3 * t]) && std::isfinite(points[3 * t + 1]) && std::isfinite(points[3 * t + 2]);
-    if (!finite && !(offsets[t + 1] - offsets[t] == 1 && interior_parts_[offsets[t]] == kInteriorUndecided))
+    if (!finite && !(offsets[t + 1] - offsets[t] == 1 && interior_components_[offsets[t]] == kInteriorUndecided))
       throw FormatError(where + "/tables/reference_points holds a non-finite point for tet " + std::to_string(t));
   }
   interior_offsets_ = std::move(offsets);

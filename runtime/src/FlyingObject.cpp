@@ -21,6 +21,12 @@ namespace tetrapage {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+Contact contact_with(const CollisionIndex& index, const Shard& shard, std::uint32_t local,
+                     std::uint32_t object_triangle) {
+  const std::uint32_t component = shard.component_id(local);
+  return {index.component_part(component), shard.triangle_id(local), object_triangle, component};
+}
 using hull::Kernel;
 using hull::hull_of;
 using hull::to_point;
@@ -367,6 +373,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   result.collides = false;
   result.containment = Containment::none;
   result.containing_part = 0;
+  result.containing_component = 0;
   result.contacts.clear();
   enclosed_.clear();
   result.outside_model = false;
@@ -567,12 +574,12 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
                             (model_->box.hi[2] - model_->box.lo[2] + 2 * reach);
   const double world_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
   const bool prune_inner = own_frame && world_volume > kLoose * own_volume;
-  // A triangle stored in several of the step's shards is tested once: double-precision copies
-  // are the input's coordinates, the same in every shard (float copies each round to their
-  // own shard's frame, so each is tested).
+  // A triangle stored in several of the step's shards is tested once: exact and double copies
+  // are the input's coordinates, the same in every shard (rounded float copies each round to
+  // their own shard's frame, so each is tested).
   met_triangles_.clear();
   auto test_shard = [&](const Shard& shard) {
-    const bool same_copies = shard.precision() == StoredPrecision::float64;
+    const bool same_copies = index.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
     auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
@@ -601,14 +608,16 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         if (!solid_collides(*solid_, environment, options.accuracy, reach)) return;
         result.collides = true;
         if (all || result.contacts.empty())
-          result.contacts.push_back({shard.part_id(local), shard.triangle_id(local), Contact::kNoObjectTriangle});
+          result.contacts.push_back(contact_with(index, shard, local, Contact::kNoObjectTriangle));
         if (!all) stop = true;
         return;
       }
-      if (model_->closed && !result.collides && geometry::box_contains(box, environment[0]) &&
-          geometry::box_contains(box, environment[1]) && geometry::box_contains(box, environment[2]) &&
-          in_object_box(environment[0]))
-        enclosed_.emplace_back(environment[0], shard.part_id(local));
+      if (model_->closed && !result.collides) {
+        const std::uint32_t component = shard.component_id(local);
+        if (index.component_part(component) != CollisionIndex::kNoPart &&
+            geometry::box_contains(box, index.component_bounds(component)) && in_object_box(environment[0]))
+          enclosed_.emplace_back(component, environment[0]);
+      }
       // Object triangles that can meet the environment triangle lie within `grow` of its
       // plane, in the object's frame (its corners taken there round by less than `grow`).
       const Vec3& p0 = framed[0];
@@ -634,7 +643,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;
         result.collides = true;
         if (all || result.contacts.empty())
-          result.contacts.push_back({shard.part_id(local), shard.triangle_id(local), object_triangle});
+          result.contacts.push_back(contact_with(index, shard, local, object_triangle));
         if (!all) stop = true;
         return all;
       });
@@ -829,44 +838,56 @@ bool FlyingObject::find_free_box(const geometry::Box& box) {
 
 void FlyingObject::check_containment(const geometry::Box& box, QueryResult& result,
                                      std::chrono::steady_clock::time_point start) {
-  // The object inside an obstacle: with no surface contact, one vertex decides for all.
-  if (index_->has_interiors()) {
-    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tet_, world_vertex(model_->mesh.triangles[0][0]),
-                                                      interior_memo_, std::span<const ShardPin>(pins_));
+  check_object_inside_obstacle(result);
+  if (!result.collides) check_obstacle_inside_object(box, result);
+  result.counters.interior_seconds = seconds_since(start);
+}
+
+void FlyingObject::check_object_inside_obstacle(QueryResult& result) {
+  // With no surface contact, one vertex of each of the object's components decides for the
+  // whole component (it is connected and crosses no surface).
+  if (!index_->has_interiors()) return;
+  const std::size_t components = model_->component_vertices.size();
+  if (interior_memos_.size() != components) interior_memos_.assign(components, {}), interior_tets_.assign(components, 0);
+  for (std::size_t c = 0; c < components && !result.collides; ++c) {
+    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tets_[c], world_vertex(model_->component_vertices[c]),
+                                                      interior_memos_[c], std::span<const ShardPin>(pins_));
     if (inside.containment == ObstacleContainment::inside) {
       result.collides = true;
       result.containment = Containment::object_inside_obstacle;
-      result.containing_part = inside.part;
+      result.containing_component = inside.component;
+      result.containing_part = index_->component_part(inside.component);
     }
   }
-  // An obstacle inside the object: each enclosed candidate triangle lies wholly inside or
-  // wholly outside (its surface does not cross the object's), so one vertex decides. Most
-  // vertices are far from the object's surface, where the interior grid answers at once; the
-  // rest need a parity count, once per vertex (neighbouring triangles share vertices).
+}
+
+void FlyingObject::check_obstacle_inside_object(const geometry::Box& box, QueryResult& result) {
+  // An environment component whose box lies in the object's box, touching no object surface,
+  // lies wholly inside or wholly outside every closed component of the object: one vertex
+  // decides. Most vertices are far from the object's surface, where the interior grid answers
+  // at once; the rest need a parity count.
+  std::sort(enclosed_.begin(), enclosed_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  enclosed_.erase(std::unique(enclosed_.begin(), enclosed_.end(),
+                              [](const auto& a, const auto& b) { return a.first == b.first; }),
+                  enclosed_.end());
+  const auto inside = [&](std::uint32_t component) {
+    result.collides = true;
+    result.containment = Containment::obstacle_inside_object;
+    result.containing_component = component;
+    result.containing_part = index_->component_part(component);
+  };
   std::size_t undecided = 0;
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
-    const geometry::Point& p = enclosed_[i].first;
+    const geometry::Point& p = enclosed_[i].second;
     switch (model_->interior_grid.classify(to_object_frame(p), frame_margin(p))) {
-      case ObjectInteriorGrid::Side::inside:
-        result.collides = true;
-        result.containment = Containment::obstacle_inside_object;
-        result.containing_part = enclosed_[i].second;
-        break;
+      case ObjectInteriorGrid::Side::inside: inside(enclosed_[i].first); break;
       case ObjectInteriorGrid::Side::outside: break;
       case ObjectInteriorGrid::Side::unknown: enclosed_[undecided++] = enclosed_[i]; break;
     }
   }
   enclosed_.resize(undecided);
-  std::sort(enclosed_.begin(), enclosed_.end());
-  for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
-    if (i > 0 && enclosed_[i].first == enclosed_[i - 1].first) continue;
-    if (crossing_parity_holds(enclosed_[i].first, box)) {
-      result.collides = true;
-      result.containment = Containment::obstacle_inside_object;
-      result.containing_part = enclosed_[i].second;
-    }
-  }
-  result.counters.interior_seconds = seconds_since(start);
+  for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i)
+    if (crossing_parity_holds(enclosed_[i].second, box)) inside(enclosed_[i].first);
 }
 
 Vec3 FlyingObject::to_object_frame(const geometry::Point& p) const {
@@ -923,7 +944,7 @@ bool FlyingObject::crossing_parity_holds(const geometry::Point& p, const geometr
     }
     const double grow = magnitude * 0x1p-40;
     for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-    if (const auto odd = crossing_parity(model_->bvh, segment, query, [&](std::uint32_t t) { return world_triangle(t); }))
+    if (const auto odd = crossing_parity(model_->bvh, model_->closed_components, segment, query, [&](std::uint32_t t) { return world_triangle(t); }))
       return *odd;
   }
   return false;  // every direction grazed the object: taken as outside

@@ -11,7 +11,7 @@
 #include <numbers>
 
 #include "ConvexHull.h"
-#include "tetrapage/formats/EdgeParity.h"
+#include "tetrapage/formats/SurfaceComponents.h"
 
 namespace tetrapage {
 namespace {
@@ -104,11 +104,18 @@ ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mes
   // index and placing a large object must take milliseconds).
   tbb::parallel_invoke(
       [&] {
-        EdgeParity parity;
+        const SurfaceComponents components = find_surface_components(mesh);
+        std::vector<std::uint32_t> closed_index(components.components.size(), ClosedComponentOf::kOpen);
+        for (std::size_t c = 0; c < components.components.size(); ++c) {
+          const SurfaceComponent& component = components.components[c];
+          component_vertices.push_back(mesh.triangles[component.first_triangle][0]);
+          if (component.closed) closed_index[c] = closed_components.count++;
+        }
+        closed_components.of_triangle.resize(mesh.triangle_count());
         for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
-          parity.add_triangle(mesh.corners(t));
-        closed = parity.closed();
-        if (closed) interior_grid = ObjectInteriorGrid(bvh);
+          closed_components.of_triangle[t] = closed_index[components.component_of[t]];
+        closed = closed_components.count > 0;
+        if (closed) interior_grid = ObjectInteriorGrid(bvh, closed_components);
       },
       [&] { build_hull_graph(*this, mesh); });
 }

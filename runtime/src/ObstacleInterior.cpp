@@ -22,18 +22,18 @@ constexpr std::array<std::array<double, 4>, 8> kBendWeights{{{0.31, 0.23, 0.27, 
                                                              {0.36, 0.26, 0.15, 0.23},
                                                              {0.2, 0.16, 0.31, 0.33}}};
 
-void toggle(std::vector<std::uint32_t>& parts, std::uint32_t part) {
-  const auto at = std::find(parts.begin(), parts.end(), part);
-  if (at == parts.end())
-    parts.push_back(part);
+void toggle(std::vector<std::uint32_t>& components, std::uint32_t component) {
+  const auto at = std::find(components.begin(), components.end(), component);
+  if (at == components.end())
+    components.push_back(component);
   else
-    parts.erase(at);
+    components.erase(at);
 }
 
-// Toggles the closed parts the open segment crosses; false when some closed-part triangle
+// Toggles the closed components the open segment crosses; false when some closed component's triangle
 // meets it other than in one interior point away from its ends (the path is degenerate).
 bool count_crossings(const CollisionIndex& index, const Shard& shard,
-                     const geometry::Segment& segment, std::vector<std::uint32_t>& parts,
+                     const geometry::Segment& segment, std::vector<std::uint32_t>& components,
                      std::uint64_t& tests) {
   geometry::Box box;
   box.extend(segment[0]);
@@ -45,13 +45,13 @@ bool count_crossings(const CollisionIndex& index, const Shard& shard,
       box, [](const geometry::Box&, std::uint32_t) { return true; },
       [&](std::uint32_t local, const geometry::Triangle& triangle) {
         if (!generic) return;
-        const std::uint32_t part = shard.part_id(local);
-        if (!index.part_closed(part)) return;
+        const std::uint32_t component = shard.component_id(local);
+        if (!index.component_closed(component)) return;
         ++tests;
         const auto hit = geometry::classify_segment_triangle(segment, triangle);
         if (!hit) return;
         if (hit.contact == geometry::SegmentTriangleContact::interior && !hit.at_endpoint)
-          toggle(parts, part);
+          toggle(components, component);
         else
           generic = false;
       });
@@ -64,7 +64,7 @@ bool on_closed_surface(const CollisionIndex& index, const Shard& shard, const ge
   box.extend(p);
   bool on = false;
   shard.for_each_candidate(box, [&](std::uint32_t local) {
-    if (on || !index.part_closed(shard.part_id(local))) return;
+    if (on || !index.component_closed(shard.component_id(local))) return;
     ++tests;
     on = geometry::segment_intersects_triangle({p, p}, shard.triangle(local));
   });
@@ -81,29 +81,29 @@ const Shard& shard_for(const CollisionIndex& index, std::uint32_t shard_id,
   return *own;
 }
 
-// The answer of a decided point from the closed parts holding it.
-ObstacleQuery decided(ObstacleQuery answer, const std::vector<std::uint32_t>& parts) {
-  if (parts.empty()) {
+// The answer of a decided point from the closed components holding it.
+ObstacleQuery decided(ObstacleQuery answer, const std::vector<std::uint32_t>& components) {
+  if (components.empty()) {
     answer.containment = ObstacleContainment::outside;
   } else {
     answer.containment = ObstacleContainment::inside;
-    answer.part = *std::min_element(parts.begin(), parts.end());
+    answer.component = *std::min_element(components.begin(), components.end());
   }
   return answer;
 }
 
-// From the tet's reference point (the tet holds p); `parts` receives the closed parts holding
+// From the tet's reference point (the tet holds p); `components` receives the closed components holding
 // p when the answer is inside or outside.
 ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet,
-                             const geometry::Point& p, std::vector<std::uint32_t>& parts,
+                             const geometry::Point& p, std::vector<std::uint32_t>& components,
                              std::span<const ShardPin> held) {
   ObstacleQuery answer;
   answer.tet = tet;
   if (!index.interior_decided(tet)) return answer;
   const TetMesh& mesh = index.mesh();
-  const auto stored = index.interior_parts(tet);
-  parts.assign(stored.begin(), stored.end());
-  const auto finish = [&] { return decided(answer, parts); };
+  const auto stored = index.interior_components(tet);
+  components.assign(stored.begin(), stored.end());
+  const auto finish = [&] { return decided(answer, components); };
   const std::uint32_t shard_id = index.shard_of_tet(tet);
   const geometry::Point& reference = index.reference_point(tet);
   geometry::Box reach;
@@ -117,7 +117,7 @@ ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet,
   ShardPin own;
   const Shard& shard = shard_for(index, shard_id, held, own);
   ++answer.paths_tried;
-  if (count_crossings(index, shard, {reference, p}, parts, answer.triangle_tests)) return finish();
+  if (count_crossings(index, shard, {reference, p}, components, answer.triangle_tests)) return finish();
   if (on_closed_surface(index, shard, p, answer.triangle_tests)) {
     answer.containment = ObstacleContainment::on_surface;
     return answer;
@@ -132,10 +132,10 @@ ObstacleQuery from_reference(const CollisionIndex& index, std::uint32_t tet,
     if (geometry::locate_in_tetrahedron(bend, corners).position !=
         geometry::TetrahedronPosition::inside)
       continue;
-    parts.assign(stored.begin(), stored.end());
+    components.assign(stored.begin(), stored.end());
     ++answer.paths_tried;
-    if (count_crossings(index, shard, {reference, bend}, parts, answer.triangle_tests) &&
-        count_crossings(index, shard, {bend, p}, parts, answer.triangle_tests))
+    if (count_crossings(index, shard, {reference, bend}, components, answer.triangle_tests) &&
+        count_crossings(index, shard, {bend, p}, components, answer.triangle_tests))
       return finish();
   }
   answer.containment = ObstacleContainment::unknown;
@@ -166,7 +166,7 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
     // Both points lie in the convex tet, so the segment between them does too, and every
     // triangle it can cross is in the tet's shard.
     answer.paths_tried = 1;
-    if (memo.point == p) return decided(answer, memo.parts);
+    if (memo.point == p) return decided(answer, memo.components);
     const std::uint32_t shard_id = index.shard_of_tet(located.tet);
     geometry::Box reach;
     reach.extend(memo.point);
@@ -174,17 +174,17 @@ ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hi
     if (shard_id == TetMesh::no_neighbour ||
         !geometry::boxes_overlap(reach, index.shard_bounds(shard_id))) {
       memo.point = p;
-      return decided(answer, memo.parts);
+      return decided(answer, memo.components);
     }
     ShardPin own;
-    if (count_crossings(index, shard_for(index, shard_id, held, own), {memo.point, p}, memo.parts,
+    if (count_crossings(index, shard_for(index, shard_id, held, own), {memo.point, p}, memo.components,
                         answer.triangle_tests)) {
       memo.point = p;
-      return decided(answer, memo.parts);
+      return decided(answer, memo.components);
     }
-    // A degenerate short path: decide from the reference point (which resets memo.parts).
+    // A degenerate short path: decide from the reference point (which resets memo.components).
   }
-  answer = from_reference(index, located.tet, p, memo.parts, held);
+  answer = from_reference(index, located.tet, p, memo.components, held);
   memo.valid = answer.containment == ObstacleContainment::inside ||
                answer.containment == ObstacleContainment::outside;
   memo.tet = located.tet;

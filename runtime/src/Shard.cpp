@@ -125,7 +125,7 @@ Shard::Marks::~Marks() {
   if (borrowed_) thread_marks().busy = false;
 }
 
-std::uint32_t Shard::part_id(std::uint32_t local) const {
+std::uint32_t Shard::component_id(std::uint32_t local) const {
   switch (part_index_bytes_) {
     case 0:
       return part_palette_[0];

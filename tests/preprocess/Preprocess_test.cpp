@@ -25,6 +25,7 @@
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/tools/IndexAudit.h"
 #include "tetrapage/tools/MeshLibrary.h"
+#include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/TetrasGenerator.h"
 #include "../FileSizeLimit.h"
@@ -87,12 +88,14 @@ void expect_tets_match_brute_force(const fs::path& input, const fs::path& index_
     ADD_FAILURE() << findings.problems[p];
 
   std::uint64_t stored = 0;
+  const auto component_part = index.read_table_uint32("component_part");
   for (std::uint32_t s = 0; s < index.shard_count(); ++s) {
     const Shard shard = Shard::decode(index.read_shard(s));
     for (std::uint32_t local = 0; local < shard.triangle_count(); ++local) {
       const std::uint64_t id = shard.triangle_id(local);
       ASSERT_LT(id, soup.triangle_count());
-      EXPECT_EQ(shard.part_id(local), soup.part_of.empty() ? 0u : soup.part_of[id]);
+      ASSERT_LT(shard.component_id(local), component_part.size());
+      EXPECT_EQ(component_part[shard.component_id(local)], soup.part_of.empty() ? 0u : soup.part_of[id]);
       // Stored vertices: the same triangle up to the recorded rounding (as a set of corners: a
       // shard may start a triangle at another corner).
       const auto input_corners = soup.corners(id);
@@ -147,6 +150,7 @@ TEST(Preprocess, TetrasWithFloatStorageAndForcedKinds) {
     PreprocessOptions options;
     options.region_triangles = 100;
     options.shard = choice;
+    options.precision = StoredPrecision::float32;
     const fs::path output = folder / (choice == ShardChoice::grid ? "grid.tpi" : "rtree.tpi");
     const PreprocessSummary summary = preprocess({input}, output, options);
     EXPECT_EQ(choice == ShardChoice::grid ? summary.rtree_shards : summary.grid_shards, 0u);
@@ -185,8 +189,49 @@ TEST(Preprocess, AModelAt1e9WithDetailAt1e3) {
   const PreprocessSummary rounded = preprocess({input}, folder / "float.tpi", options);
   EXPECT_GT(rounded.max_rounding_distance, 0.0) << "float cannot hold 1e9 + detail exactly";
   EXPECT_LT(rounded.max_rounding_distance, 1e-6) << "relative to each shard's origin, it keeps the detail";
-  EXPECT_NE(rounded.to_text().find("max rounding"), std::string::npos) << rounded.to_text();
+  EXPECT_NE(rounded.to_text().find("rounded to floats"), std::string::npos) << rounded.to_text();
   expect_tets_match_brute_force(input, folder / "float.tpi", false);
+  // The default keeps the input. These doubles lie within 0.02 of 1e9, on its grid of 2^-23:
+  // relative to an origin near them they need 18 bits, so 4-byte floats hold them exactly.
+  options.precision = PreprocessOptions{}.precision;
+  const PreprocessSummary as_read = preprocess({input}, folder / "exact.tpi", options);
+  EXPECT_EQ(as_read.precision, "exact");
+  EXPECT_EQ(as_read.max_rounding_distance, 0.0);
+  EXPECT_EQ(as_read.float_shards, as_read.grid_shards + as_read.rtree_shards);
+  expect_tets_match_brute_force(input, folder / "exact.tpi", true);
+  // Doubles with all 53 bits in use (near 0.5, where the grid is 2^-54) keep 8 bytes.
+  TriangleSoup fine = soup;
+  Random random(3);
+  for (auto& v : fine.vertices)
+    for (auto& c : v) c = (c - 1e9) + 0.5 + random.uniform(0.0, 1e-3);
+  write_mesh(folder / "fine.ply", fine);
+  const PreprocessSummary fine_read = preprocess({folder / "fine.ply"}, folder / "fine.tpi", options);
+  EXPECT_EQ(fine_read.max_rounding_distance, 0.0);
+  EXPECT_LT(fine_read.float_shards, (fine_read.grid_shards + fine_read.rtree_shards) / 10);
+  expect_tets_match_brute_force(folder / "fine.ply", folder / "fine.tpi", true);
+}
+
+// Input whose coordinates are floats (an STL, or a float PLY such as most CAD exports write):
+// the default stores 4-byte floats that decode to exactly the coordinates read, so the index
+// is as small as the rounded one and answers for the input, near the origin and far from it.
+TEST(Preprocess, FloatInputIsStoredExactlyInFloats) {
+  const fs::path folder = test_folder("float-input");
+  for (const double offset : {0.0, 1e4, -3e6}) {
+    TriangleSoup soup = read_mesh(make_tetras(folder, 300, 9));
+    for (auto& v : soup.vertices)
+      for (auto& c : v) c = double(float(offset + c));
+    const fs::path input = folder / "tetras.stl";  // binary STL: float coordinates
+    write_mesh(input, soup);
+    PreprocessOptions options;
+    options.region_triangles = 100;
+    const PreprocessSummary summary = preprocess({input}, folder / "exact.tpi", options);
+    EXPECT_EQ(summary.max_rounding_distance, 0.0) << offset;
+    EXPECT_EQ(summary.float_shards, summary.grid_shards + summary.rtree_shards) << offset;
+    expect_tets_match_brute_force(input, folder / "exact.tpi", true);
+    options.precision = StoredPrecision::float64;
+    const PreprocessSummary doubles = preprocess({input}, folder / "double.tpi", options);
+    EXPECT_LT(summary.shard_payload_bytes, doubles.shard_payload_bytes) << offset;
+  }
 }
 
 // The budget forces spill files and several buckets; the index must be the same as in memory.
@@ -277,11 +322,11 @@ TEST(Preprocess, DeterministicBytes) {
     if (input == assembly) {
       EXPECT_GT(all_threads.parts, 3u);
     }
-    EXPECT_EQ(all_threads.closed_parts, one_thread.closed_parts);
+    EXPECT_EQ(all_threads.closed_components, one_thread.closed_components);
     const IndexReader a(folder / "a.tpi"), b(folder / "b.tpi");
     ASSERT_EQ(a.shard_count(), b.shard_count()) << input;
     for (std::uint32_t s = 0; s < a.shard_count(); ++s) ASSERT_EQ(a.read_shard(s), b.read_shard(s)) << input;
-    for (const char* table : {"tet_shard", "interior_parts"})
+    for (const char* table : {"tet_shard", "interior_components"})
       EXPECT_EQ(a.read_table_uint32(table), b.read_table_uint32(table)) << input << " " << table;
     EXPECT_EQ(a.read_table_uint64("interior_offsets"), b.read_table_uint64("interior_offsets")) << input;
   }

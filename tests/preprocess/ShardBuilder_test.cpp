@@ -306,7 +306,7 @@ TEST_P(ShardBuilderTest, StoredVerticesIdsAndPartsRoundTrip) {
       inputs.emplace(std::pair{region.ids[i], region.parts[i]}, i);
     double max_distance = 0;
     for (std::uint32_t t = 0; t < shard.triangle_count(); ++t) {
-      const auto it = inputs.find({shard.triangle_id(t), shard.part_id(t)});
+      const auto it = inputs.find({shard.triangle_id(t), shard.component_id(t)});
       ASSERT_NE(it, inputs.end()) << what << " triangle " << t << " id " << shard.triangle_id(t);
       const Triangle& in = region.triangles[it->second];
       const Triangle stored = shard.triangle(t);
@@ -479,7 +479,7 @@ TEST(ShardBuilder, UsesCompactWidthsWhereTheyFit) {
   EXPECT_EQ(std::uint8_t(built.payload[10]), 0);
   EXPECT_EQ(std::uint8_t(built.payload[11]), 2);
   const Shard shard = Shard::decode(built.payload);
-  for (std::uint32_t t = 0; t < shard.triangle_count(); ++t) EXPECT_EQ(shard.part_id(t), 5u);
+  for (std::uint32_t t = 0; t < shard.triangle_count(); ++t) EXPECT_EQ(shard.component_id(t), 5u);
   EXPECT_LE(built.vertex_count, 3 * built.triangle_count);
 }
 

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
@@ -121,11 +122,14 @@ TriangleSoup tetra_object(double size) {
   return soup;
 }
 
-TEST(Interiors, PreprocessClassifiesTheClosedParts) {
+TEST(Interiors, PreprocessClassifiesTheClosedComponents) {
   const Model& m = model();
   const auto parts = std::uint32_t(m.summary.parts);
   ASSERT_GT(parts, 5u) << "the scene's copies are parts";
-  EXPECT_EQ(m.summary.closed_parts, parts - 1)
+  // Each copy is one component; boxes.obj is one part of three closed components.
+  const auto components = std::uint32_t(m.summary.components);
+  EXPECT_EQ(components, parts + 2);
+  EXPECT_EQ(m.summary.closed_components, components - 1)
       << "the sheet is open, the copies and the boxes are closed";
   EXPECT_EQ(m.summary.interiors.rfind("stored (1 pass)", 0), 0u) << m.summary.interiors;
   // Undecided points are moved and classified again: none is left.
@@ -133,8 +137,12 @@ TEST(Interiors, PreprocessClassifiesTheClosedParts) {
   EXPECT_GT(m.summary.interior_tets, 0u);
   const CollisionIndex index(m.index);
   ASSERT_TRUE(index.has_interiors());
-  for (std::uint32_t p = 0; p + 1 < parts; ++p) EXPECT_TRUE(index.part_closed(p)) << p;
-  EXPECT_FALSE(index.part_closed(parts - 1));
+  ASSERT_EQ(index.component_count(), components);
+  for (std::uint32_t c = 0; c + 1 < components; ++c) EXPECT_TRUE(index.component_closed(c)) << c;
+  EXPECT_FALSE(index.component_closed(components - 1));
+  // The three boxes of boxes.obj are the part before the sheet's.
+  for (std::uint32_t c = components - 4; c + 1 < components; ++c) EXPECT_EQ(index.component_part(c), parts - 2);
+  EXPECT_EQ(index.component_part(components - 1), parts - 1);
 }
 
 void expect_points_agree(const Model& m) {
@@ -202,10 +210,10 @@ TEST(Interiors, AMovingPointDecidedFromItsLastAnswerAgreesWithTheOracle) {
     EXPECT_EQ(answer.containment, plain.containment) << "step " << i;
     const ObstacleQuery from_held = locate_in_obstacles(index, held_hint, p, held_memo, held);
     EXPECT_EQ(from_held.containment, answer.containment) << "step " << i;
-    EXPECT_EQ(from_held.part, answer.part) << "step " << i;
+    EXPECT_EQ(from_held.component, answer.component) << "step " << i;
     if (answer.containment != ObstacleContainment::inside && answer.containment != ObstacleContainment::outside)
       continue;
-    EXPECT_EQ(answer.part, plain.part) << "step " << i;
+    EXPECT_EQ(answer.component, plain.component) << "step " << i;
     const bool oracle_inside = oracle.inside_environment(p);
     inside += oracle_inside;
     if ((answer.containment == ObstacleContainment::inside) != oracle_inside && ++wrong <= 5)
@@ -223,27 +231,30 @@ TEST(Interiors, ClassifiedInSeveralPassesTheTablesAreTheSame) {
   EXPECT_NE(m.summary.interiors.rfind("stored (1 pass)", 0), 0u) << m.summary.interiors;
   const IndexReader one(whole.index), several(m.index);
   EXPECT_EQ(one.read_table_uint64("interior_offsets"), several.read_table_uint64("interior_offsets"));
-  EXPECT_EQ(one.read_table_uint32("interior_parts"), several.read_table_uint32("interior_parts"));
+  EXPECT_EQ(one.read_table_uint32("interior_components"), several.read_table_uint32("interior_components"));
   EXPECT_EQ(one.read_table_double("reference_points"), several.read_table_double("reference_points"));
-  EXPECT_EQ(one.read_table_uint8("part_closed"), several.read_table_uint8("part_closed"));
+  EXPECT_EQ(one.read_table_uint8("component_closed"), several.read_table_uint8("component_closed"));
 }
 
 TEST(Interiors, StoredClassesAreEmbreeRayParityWhereverEmbreeDecides) {
-  // An independent engine: Embree's float rays in three directions against the closed parts
-  // (the exact classification uses one vertical ray with a symbolic perturbation).
+  // An independent engine: Embree's float rays in three directions against the closed
+  // components (the exact classification uses one vertical ray with a symbolic perturbation).
   const Model& m = model();
   const IndexReader reader(m.index);
-  const auto closed = reader.read_table_uint8("part_closed");
+  const auto closed = reader.read_table_uint8("component_closed");
   const auto references = reader.read_table_double("reference_points");
   const auto offsets = reader.read_table_uint64("interior_offsets");
-  const auto parts = reader.read_table_uint32("interior_parts");
+  const auto parts = reader.read_table_uint32("interior_components");
+  // The model's components numbered in input order, as the preprocess numbers them.
+  const SurfaceComponents split = find_surface_components(m.environment);
+  ASSERT_EQ(split.components.size(), closed.size());
   EmbreeInteriorClassifier embree;
   std::vector<std::array<Vec3, 3>> triangles;
   for (std::uint32_t p = 0; p < closed.size(); ++p) {
     if (closed[p] == 0) continue;
     triangles.clear();
     for (std::size_t t = 0; t < m.environment.triangle_count(); ++t)
-      if (m.environment.part_of[t] == p) triangles.push_back(m.environment.corners(t));
+      if (split.component_of[t] == p) triangles.push_back(m.environment.corners(t));
     embree.add_triangles(p, triangles);
   }
   std::vector<Vec3> points;

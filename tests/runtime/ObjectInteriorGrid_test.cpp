@@ -33,7 +33,11 @@ TEST_P(ObjectInteriorGridTest, AgreesWithCgalWhereverItAnswers) {
   const GeneratedObject object = generate_object(options, &library);
   ASSERT_TRUE(object.closed) << object.source;
   const geometry::ObjectBVH bvh(object.soup);
-  const ObjectInteriorGrid grid(bvh);
+  // One closed component (the generated objects are one connected closed mesh).
+  ClosedComponentOf closed;
+  closed.count = 1;
+  closed.of_triangle.assign(object.soup.triangle_count(), 0);
+  const ObjectInteriorGrid grid(bvh, closed);
   EXPECT_GT(grid.count(ObjectInteriorGrid::Side::inside), 0u) << "a closed object has inside cells";
   EXPECT_GT(grid.count(ObjectInteriorGrid::Side::outside), 0u);
 

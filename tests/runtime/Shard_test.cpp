@@ -124,8 +124,8 @@ TEST_P(ShardTest, DecodesWhatWasEncoded) {
                                          Point{101, 201, 300.5}}));
   EXPECT_EQ(shard.triangle_id(0), 7u);
   EXPECT_EQ(shard.triangle_id(1), 9u);
-  EXPECT_EQ(shard.part_id(0), 3u);
-  EXPECT_EQ(shard.part_id(1), 5u);
+  EXPECT_EQ(shard.component_id(0), 3u);
+  EXPECT_EQ(shard.component_id(1), 5u);
   EXPECT_GT(shard.memory_bytes(), 0u);
 }
 
@@ -158,7 +158,7 @@ TEST_P(ShardTest, DecodesIntoAnArenaAlike) {
   for (std::uint32_t t = 0; t < plain.triangle_count(); ++t) {
     EXPECT_EQ(in_arena.triangle(t), plain.triangle(t));
     EXPECT_EQ(in_arena.triangle_id(t), plain.triangle_id(t));
-    EXPECT_EQ(in_arena.part_id(t), plain.part_id(t));
+    EXPECT_EQ(in_arena.component_id(t), plain.component_id(t));
   }
   // A moved shard keeps its arrays (these tiny ones all go to the arena's upstream; the
   // flying tests decode real shards into an arena).

@@ -35,7 +35,7 @@ struct PreprocessArguments {
   std::string memory = "1G";
   unsigned threads = 0;
   std::string shard = "auto";
-  std::string precision = "float";
+  std::string precision = "exact";
   std::string compression = "lz4";
   double query_extent = 0;
   std::string interiors = "on";
@@ -71,25 +71,38 @@ struct InteriorFigures {
   nlohmann::json json;
 };
 
-// What the interiors tables hold (preprocess --interiors): closed parts, tets inside, undecided.
-InteriorFigures interior_figures(const IndexReader& reader, std::size_t tets) {
+// The connected components (their part and closedness) and what the interiors tables hold
+// (preprocess --interiors): tets inside a closed component, undecided tets.
+InteriorFigures component_figures(const IndexReader& reader, std::size_t tets) {
+  const auto closed = reader.read_table_uint8("component_closed");
+  const auto part = reader.read_table_uint32("component_part");
+  std::uint64_t closed_count = 0, parts = 0;
+  for (const auto c : closed) closed_count += c != 0;
+  for (const auto p : part) parts = std::max<std::uint64_t>(parts, std::uint64_t(p) + 1);
+  char line[512];
+  std::snprintf(line, sizeof line, "components: %zu in %llu parts (%llu closed, %llu open)", closed.size(),
+                (unsigned long long)parts, (unsigned long long)closed_count,
+                (unsigned long long)(closed.size() - closed_count));
+  std::string text = line;
+  nlohmann::json json{{"components", closed.size()}, {"closed_components", closed_count},
+                      {"open_components", closed.size() - closed_count}};
   const auto names = reader.table_names();
-  if (std::find(names.begin(), names.end(), "interior_offsets") == names.end())
-    return {"interiors: not stored (objects inside obstacles go unseen)", {{"stored", false}}};
-  const auto closed = reader.read_table_uint8("part_closed");
+  if (std::find(names.begin(), names.end(), "interior_offsets") == names.end()) {
+    json["interiors"] = {{"stored", false}};
+    return {text + "\ninteriors: not stored (objects inside obstacles go unseen)", json};
+  }
   const auto offsets = reader.read_table_uint64("interior_offsets");
-  const auto parts = reader.read_table_uint32("interior_parts");
-  std::uint64_t closed_parts = 0, inside = 0, undecided = 0;
-  for (const auto c : closed) closed_parts += c != 0;
+  const auto inside_of = reader.read_table_uint32("interior_components");
+  std::uint64_t inside = 0, undecided = 0;
   for (std::size_t t = 0; t + 1 < offsets.size() && t < tets; ++t) {
     if (offsets[t + 1] == offsets[t]) continue;
-    if (offsets[t + 1] - offsets[t] == 1 && offsets[t] < parts.size() && parts[offsets[t]] == 0xffffffffu) ++undecided;
+    if (offsets[t + 1] - offsets[t] == 1 && offsets[t] < inside_of.size() && inside_of[offsets[t]] == 0xffffffffu) ++undecided;
     else ++inside;
   }
-  char line[256];
-  std::snprintf(line, sizeof line, "interiors: %llu of %zu parts closed; %llu tets with their reference point inside, %llu undecided",
-                (unsigned long long)closed_parts, closed.size(), (unsigned long long)inside, (unsigned long long)undecided);
-  return {line, {{"stored", true}, {"closed_parts", closed_parts}, {"tets_inside", inside}, {"tets_undecided", undecided}}};
+  std::snprintf(line, sizeof line, "\ninteriors: %llu tets with their reference point inside a closed component, %llu undecided",
+                (unsigned long long)inside, (unsigned long long)undecided);
+  json["interiors"] = {{"stored", true}, {"tets_inside", inside}, {"tets_undecided", undecided}};
+  return {text + line, json};
 }
 
 void run_inspect(const InspectArguments& args) {
@@ -113,10 +126,10 @@ void run_inspect(const InspectArguments& args) {
   const double triangles = double(std::max<std::uint64_t>(1, header.input_triangles));
   std::printf("index %s: format version %u, %s coordinates, %s on disk\n", args.index.c_str(),
               header.version, header.precision.c_str(), format_byte_size(reader.file_bytes()).c_str());
-  std::printf("model: %llu triangles, bounds [%g %g %g]-[%g %g %g], max rounding distance %.3g\n",
-              (unsigned long long)header.input_triangles, header.bounds.lo[0], header.bounds.lo[1],
-              header.bounds.lo[2], header.bounds.hi[0], header.bounds.hi[1], header.bounds.hi[2],
-              header.max_rounding_distance);
+  std::printf("model: %llu triangles, bounds [%g %g %g]-[%g %g %g]\n", (unsigned long long)header.input_triangles,
+              header.bounds.lo[0], header.bounds.lo[1], header.bounds.lo[2], header.bounds.hi[0], header.bounds.hi[1],
+              header.bounds.hi[2]);
+  std::printf("%s\n", storage_statement(header).c_str());
   std::printf("coarse mesh: %zu vertices, %zu tets (%zu empty)\n", mesh.vertices.size(), mesh.tet_count(),
               mesh.tet_count() - reader.shard_count());
   std::printf("shards: %u (grid %llu, rtree %llu), %llu stored triangles (duplication %.3f), largest %s (%u triangles max)\n",
@@ -127,7 +140,7 @@ void run_inspect(const InspectArguments& args) {
               format_byte_size(stored).c_str(), double(stored) / triangles, format_byte_size(kind_bytes[0]).c_str(),
               format_byte_size(kind_bytes[1]).c_str(), format_byte_size(decoded).c_str(),
               double(decoded) / triangles);
-  const InteriorFigures interiors = interior_figures(reader, mesh.tet_count());
+  const InteriorFigures interiors = component_figures(reader, mesh.tet_count());
   std::printf("%s\n", interiors.text.c_str());
   std::optional<StabbingNumbers> stabbing;
   if (args.stabbing_segments > 0) {
@@ -163,7 +176,7 @@ void run_inspect(const InspectArguments& args) {
                           {"shard_stored_bytes", stored},
                           {"shard_decoded_bytes", decoded},
                           {"max_rounding_distance", header.max_rounding_distance},
-                          {"interiors", interiors.json}};
+                          {"components", interiors.json}};
     if (stabbing) {
       report["stabbing_segments"] = stabbing->segments;
       report["stabbing_number_walk"] = stabbing->walk;
@@ -347,9 +360,12 @@ void add_index_commands(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "grid", "rtree"}));
   command->add_option("--precision", pre->precision,
-                      "Stored coordinates: float or double (the largest rounding distance is reported)")
+                      "Stored coordinates: exact (each shard decodes to the coordinates read: 4-byte floats\n"
+                      "where that is lossless, as for float input, else doubles), double (8 bytes always),\n"
+                      "or float (rounded to compact floats, by up to the reported max rounding distance:\n"
+                      "answers are then exact for the rounded model, not the input)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"float", "double"}));
+      ->check(CLI::IsMember({"exact", "float", "double"}));
   command->add_option("--compression", pre->compression,
                       "Shard chunks: lz4 (shuffled and compressed: the smaller file) or none (stored as they\n"
                       "are: about a third larger, but a page-in read from the page cache skips the\n"
@@ -360,8 +376,9 @@ void add_index_commands(CLI::App& app) {
                       "Side of the query boxes the cost model plans for (0: 5% of the model's size)")
       ->capture_default_str();
   command->add_option("--interiors", pre->interiors,
-                      "Classify each region's reference point against the closed parts (exact ray parity,\n"
-                      "one pass over the triangles) so that the runtime reports an object inside an obstacle")
+                      "Classify each region's reference point against the closed components (connected\n"
+                      "surfaces whose every edge is used an even number of times; exact ray parity, one pass\n"
+                      "over the triangles) so that the runtime reports an object inside an obstacle")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
   command->add_option("--report", pre->report, "Write the summary as JSON");

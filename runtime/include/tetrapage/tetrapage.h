@@ -182,12 +182,13 @@ tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double p
                                         tetrapage_object_shape shape, tetrapage_motion motion,
                                         int all_contacts, int* collides);
 
-/* One contact: an environment triangle (its part and model-wide id) and an object triangle
-   (UINT32_MAX when the object was checked as a solid). */
+/* One contact: an environment triangle (its part, connected component and model-wide id) and
+   an object triangle (UINT32_MAX when the object was checked as a solid). */
 typedef struct tetrapage_contact {
   uint64_t environment_triangle;
   uint32_t environment_part;
   uint32_t object_triangle;
+  uint32_t environment_component;
 } tetrapage_contact;
 
 /* The number of contacts of the last successful query (first hit: 0 or 1).
@@ -217,10 +218,12 @@ typedef struct tetrapage_query_info {
   uint64_t triangle_tests; /* triangle pair tests */
   double seconds;          /* locate + search + shards + tests + containment */
   /* Why a query collides without touching surfaces: 0 it does not (or surfaces touch),
-     1 the object lies inside a closed obstacle (an index preprocessed with interiors),
-     2 an environment triangle lies inside the closed object. */
+     1 a component of the object lies inside a closed component of the environment (an
+       index preprocessed with interiors),
+     2 a component of the environment lies inside a closed component of the object. */
   int containment;
-  uint32_t containing_part; /* the environment part of a containment */
+  uint32_t containing_part;      /* the environment part of a containment */
+  uint32_t containing_component; /* the environment component of a containment */
 } tetrapage_query_info;
 
 /* Fills *info for the last successful query (all zero before the first one).

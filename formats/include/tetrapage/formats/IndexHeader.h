@@ -13,11 +13,13 @@ namespace tetrapage {
 /// Value of the root attribute "format" of every tetrapage index.
 inline constexpr std::string_view kIndexFormatName = "tetrapage-index";
 /// The only layout version this build writes and reads; any change to the layout bumps it.
-inline constexpr std::uint32_t kIndexVersion = 3;
+inline constexpr std::uint32_t kIndexVersion = 4;
 
 struct IndexHeader {
   std::uint32_t version = kIndexVersion;
-  /// Precision of the stored shard coordinates: "float" or "double".
+  /// How shard coordinates are stored: "exact" (each shard decodes to the input's
+  /// coordinates: float32 where that is lossless, else float64), "double", or "float" (rounded
+  /// to compact floats, by up to max_rounding_distance).
   std::string precision = "double";
   std::uint64_t input_triangles = 0;
   /// Triangles over all shards, duplicates (a triangle binned into several tets) included.
@@ -35,5 +37,13 @@ struct IndexHeader {
   /// Program that wrote the file; the writer fills it in, the reader reports it.
   std::string created_by;
 };
+
+/// One line saying how an index stores coordinates and what that means for its answers (for
+/// preprocess, inspect and fly): exact for the input, or for a model rounded by up to
+/// `max_rounding_distance`.
+std::string storage_statement(std::string_view precision, double max_rounding_distance);
+inline std::string storage_statement(const IndexHeader& header) {
+  return storage_statement(header.precision, header.max_rounding_distance);
+}
 
 }  // namespace tetrapage

@@ -40,7 +40,9 @@ struct PreprocessOptions {
   /// Worker threads; 0: all cores.
   unsigned threads = 0;
   ShardChoice shard = ShardChoice::automatic;
-  StoredPrecision precision = StoredPrecision::float32;
+  /// exact: every shard decodes to the input's coordinates (float32 where lossless, else
+  /// float64); float: rounded compact floats (answers exact for the rounded model); double.
+  StoredPrecision precision = StoredPrecision::exact;
   /// How shard chunks are stored: LZ4 (the smaller file) or as they are (the faster page-in).
   ChunkCompression compression = ChunkCompression::lz4;
   /// The side of the query boxes the cost model plans for; 0: 5 % of the model's largest side
@@ -54,10 +56,10 @@ struct PreprocessOptions {
   /// compare such a run with one that holds them in memory).
   bool force_spill = false;
   /// Store the interiors: each tet's reference point classified, exactly, against every
-  /// closed part (RayParity.h); false: not stored, and the runtime then reports only touching
+  /// closed component (RayParity.h); false: not stored, and the runtime then reports only touching
   /// surfaces.
   bool interiors = false;
-  /// (point, part) pairs classified per pass over the triangles; 0: as many as a quarter of
+  /// (point, component) pairs classified per pass over the triangles; 0: as many as a quarter of
   /// memory_bytes holds. Tests set it small to exercise several passes.
   std::uint64_t interior_pairs_per_pass = 0;
 };
@@ -87,14 +89,18 @@ struct PreprocessSummary {
   std::uint64_t shard_payload_bytes = 0;   ///< decoded, the bytes a resident cache holds
   std::uint64_t bytes_written = 0;         ///< the index file
   double max_rounding_distance = 0;
-  std::string precision;
+  std::string precision;                   ///< "exact", "double" or "float"
+  std::uint64_t float_shards = 0;          ///< shards stored in 4-byte floats (lossless under "exact")
   std::string compression;                 ///< of the shard chunks: "lz4" or "none"
   double query_extent = 0;
   std::uint64_t memory_budget_bytes = 0;
-  std::uint64_t closed_parts = 0;          ///< parts whose every edge is used an even number of times
+  /// Connected components of the parts' surfaces (SurfaceComponents.h), and those closed:
+  /// every edge used an even number of times.
+  std::uint64_t components = 0;
+  std::uint64_t closed_components = 0;
   /// "stored", "off" (no classifier), "none closed", or "skipped: <why>".
   std::string interiors = "off";
-  std::uint64_t interior_tets = 0;         ///< tets whose reference point is inside a closed part
+  std::uint64_t interior_tets = 0;         ///< tets whose reference point is inside a closed component
   std::uint64_t interior_undecided = 0;    ///< tets whose reference point could not be classified
   std::uint64_t buckets = 0;               ///< tet buckets processed one at a time
   bool spilled = false;                    ///< whether the stages used spill files

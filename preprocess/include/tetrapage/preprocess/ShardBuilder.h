@@ -43,6 +43,8 @@ struct ShardLayout {
 struct BuiltShard {
   std::vector<std::byte> payload;
   ShardKind kind = ShardKind::grid;
+  /// The shard's own type: float32 or float64 (for StoredPrecision::exact, whichever keeps the
+  /// input's coordinates in this shard).
   StoredPrecision precision = StoredPrecision::float32;
   /// The largest Euclidean distance between an input vertex and its stored vertex.
   double max_rounding_distance = 0;

@@ -56,6 +56,9 @@ class CollisionIndex {
 
   const std::filesystem::path& path() const { return reader_.path(); }
   const IndexHeader& header() const { return reader_.header(); }
+  /// Every shard decodes to the coordinates the preprocess read (precision "exact" or
+  /// "double"), so the copies of a triangle that crosses regions are identical.
+  bool stores_input_coordinates() const { return stores_input_coordinates_; }
   const TetMesh& mesh() const { return mesh_; }
   const CollisionIndexOptions& options() const { return options_; }
   /// The box of the coarse mesh: every stored triangle lies inside it.
@@ -80,33 +83,47 @@ class CollisionIndex {
 
   ShardCache<Shard>& cache() const { return *cache_; }
 
-  /// Whether the index stores the interiors of closed parts (preprocess --interiors on):
-  /// each tet's reference point classified against the closed parts (ObstacleInterior.h).
+  /// The connected components of the parts' surfaces (SurfaceComponents.h): the ids that
+  /// Shard::component_id returns. A component's part, whether it is closed, and its box.
+  std::uint32_t component_count() const { return std::uint32_t(component_part_.size()); }
+  /// The part of a component (kNoPart for an id the index does not list).
+  std::uint32_t component_part(std::uint32_t component) const {
+    return component < component_part_.size() ? component_part_[component] : kNoPart;
+  }
+  static constexpr std::uint32_t kNoPart = 0xffffffffu;
+  /// Whether component `component` has a closed surface (false for an unknown id).
+  bool component_closed(std::uint32_t component) const {
+    return component < component_closed_.size() && component_closed_[component] != 0;
+  }
+  const geometry::Box& component_bounds(std::uint32_t component) const { return component_bounds_[component]; }
+
+  /// Whether the index stores the interiors of closed components (preprocess --interiors on):
+  /// each tet's reference point classified against them (ObstacleInterior.h).
   bool has_interiors() const { return !interior_offsets_.empty(); }
   /// A point strictly inside the tet whose classification is stored (has_interiors()).
   const geometry::Point& reference_point(std::uint32_t tet) const { return reference_points_[tet]; }
   /// False when the preprocess could not classify the tet's reference point.
   bool interior_decided(std::uint32_t tet) const {
     return interior_offsets_[tet + 1] == interior_offsets_[tet] ||
-           interior_parts_[interior_offsets_[tet]] != kInteriorUndecided;
+           interior_components_[interior_offsets_[tet]] != kInteriorUndecided;
   }
-  /// The closed parts whose interior holds the tet's reference point (sorted; empty for an
-  /// undecided tet).
-  std::span<const std::uint32_t> interior_parts(std::uint32_t tet) const {
+  /// The closed components whose interior holds the tet's reference point (sorted; empty for
+  /// an undecided tet).
+  std::span<const std::uint32_t> interior_components(std::uint32_t tet) const {
     if (!interior_decided(tet)) return {};
-    return std::span<const std::uint32_t>(interior_parts_).subspan(
+    return std::span<const std::uint32_t>(interior_components_).subspan(
         interior_offsets_[tet], interior_offsets_[tet + 1] - interior_offsets_[tet]);
   }
-  /// Whether part `part` has a closed surface (false for unknown parts or without interiors).
-  bool part_closed(std::uint32_t part) const { return part < part_closed_.size() && part_closed_[part] != 0; }
-  /// The marker of an undecided tet in /tables/interior_parts.
+  /// The marker of an undecided tet in /tables/interior_components.
   static constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
 
  private:
+  void read_components(const std::string& where);
   void read_interiors(const std::string& where);
 
   IndexReader reader_;
   CollisionIndexOptions options_;
+  bool stores_input_coordinates_ = false;
   TetMesh mesh_;
   BoundingBox mesh_bounds_;
   TetBoxFilter tet_filter_;
@@ -114,10 +131,12 @@ class CollisionIndex {
   std::vector<std::uint64_t> shard_bytes_;
   std::vector<geometry::Box> shard_bounds_;
   std::uint64_t total_shard_bytes_ = 0;
-  std::vector<std::uint8_t> part_closed_;
+  std::vector<std::uint32_t> component_part_;
+  std::vector<std::uint8_t> component_closed_;
+  std::vector<geometry::Box> component_bounds_;
   std::vector<geometry::Point> reference_points_;
   std::vector<std::uint64_t> interior_offsets_;
-  std::vector<std::uint32_t> interior_parts_;
+  std::vector<std::uint32_t> interior_components_;
   std::unique_ptr<ShardArena> arena_;  // before the cache: its shards go first
   std::unique_ptr<ShardCache<Shard>> cache_;
 };

@@ -66,13 +66,15 @@ struct QueryOptions {
   Motion motion = Motion::discrete;
 };
 
-/// One contact: an environment triangle (its part and model-wide id) and an object triangle
-/// (kNoObjectTriangle when the object was checked as a solid: hull, box, or swept).
+/// One contact: an environment triangle (its part, connected component and model-wide id) and
+/// an object triangle (kNoObjectTriangle when the object was checked as a solid: hull, box, or
+/// swept).
 struct Contact {
   static constexpr std::uint32_t kNoObjectTriangle = 0xffffffffu;
   std::uint32_t environment_part = 0;
   std::uint64_t environment_triangle = 0;
   std::uint32_t object_triangle = 0;
+  std::uint32_t environment_component = 0;
   bool operator==(const Contact&) const = default;
 };
 
@@ -111,15 +113,18 @@ struct StepCounters {
 /// A collision without touching surfaces: one closed body holds the other.
 enum class Containment : std::uint8_t {
   none,
-  object_inside_obstacle,  ///< the object lies inside a closed part (the index's interiors)
-  obstacle_inside_object,  ///< an environment triangle lies inside the closed object
+  object_inside_obstacle,  ///< a component of the object lies inside a closed component of the
+                           ///< environment (the index's interiors)
+  obstacle_inside_object,  ///< a component of the environment lies inside a closed component of
+                           ///< the object
 };
 
 struct QueryResult {
   /// Surfaces touch (contacts), or one body contains the other (containment).
   bool collides = false;
   Containment containment = Containment::none;
-  std::uint32_t containing_part = 0;  ///< the environment part of a containment
+  std::uint32_t containing_part = 0;       ///< the environment part of a containment
+  std::uint32_t containing_component = 0;  ///< the environment component of a containment
   /// first_hit: the first contact found; all_contacts: every pair (unordered).
   std::vector<Contact> contacts;
   /// The object's box lies entirely outside the model's coarse mesh (nothing to touch).
@@ -157,8 +162,7 @@ class FlyingObject {
   const TriangleSoup& object() const { return model_->mesh; }
   const std::shared_ptr<const ObjectModel>& model() const { return model_; }
   std::size_t hull_vertex_count() const { return model_->hull_vertices.size(); }
-  /// Every edge of the object is used an even number of times (EdgeParity): only then can an
-  /// obstacle lie inside it.
+  /// Some connected component of the object is closed: only then can an obstacle lie inside it.
   bool closed() const { return model_->closed; }
 
  private:
@@ -173,6 +177,8 @@ class FlyingObject {
   // `start`: now, for its clock.
   void check_containment(const geometry::Box& box, QueryResult& result,
                          std::chrono::steady_clock::time_point start);
+  void check_object_inside_obstacle(QueryResult& result);
+  void check_obstacle_inside_object(const geometry::Box& box, QueryResult& result);
   // Does the placed object hold p? By the parity of crossings (the interior grid could not
   // tell): p must not lie on the object's surface.
   bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box);
@@ -199,11 +205,12 @@ class FlyingObject {
 
   std::shared_ptr<const CollisionIndex> index_;
   std::shared_ptr<const ObjectModel> model_;
-  // Per step: a vertex and the part of each candidate environment triangle whose box lies in
-  // the object's box (only those can lie inside the object).
-  std::vector<std::pair<geometry::Point, std::uint32_t>> enclosed_;
-  std::uint32_t interior_tet_ = 0;  ///< where the last containment walk ended
-  ObstacleMemo interior_memo_;      ///< the last containment answer, for the next step's
+  // Per step: the environment components whose boxes lie in the object's box (only those can
+  // lie inside the object), each with a vertex of a candidate triangle of theirs.
+  std::vector<std::pair<std::uint32_t, geometry::Point>> enclosed_;
+  // Per object component: where its last containment walk ended, and its last answer.
+  std::vector<std::uint32_t> interior_tets_;
+  std::vector<ObstacleMemo> interior_memos_;
   std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
   // The previous query's pose and world box (before the accuracy's growth), for swept motion.
   bool previous_valid_ = false;

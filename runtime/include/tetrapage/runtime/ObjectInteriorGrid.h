@@ -11,6 +11,7 @@
 /// group of face-adjacent surface-free cells is decided by an exact ray parity from one cell's
 /// centre (in the object's own, unrounded coordinates).
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -20,26 +21,44 @@
 
 namespace tetrapage {
 
-/// Crossing parity of `segment` with the object's triangles whose boxes meet `query` (in the
-/// BVH's frame), each triangle given by `triangle_of(t)` (its own or its placed coordinates):
-/// true for an odd number of proper crossings; nothing when the segment touches an edge, a
-/// vertex or a triangle's plane, or ends on a triangle (the caller tries another direction).
+/// Which closed component of an object each triangle belongs to: insides are counted per
+/// closed component (a multi-solid object, nested solids), and open components have none.
+struct ClosedComponentOf {
+  static constexpr std::uint32_t kOpen = 0xffffffffu;
+  std::vector<std::uint32_t> of_triangle;  ///< per object triangle: its closed component, or kOpen
+  std::uint32_t count = 0;                 ///< closed components
+};
+
+/// Whether `segment` crosses some closed component of the object an odd number of times,
+/// counting the object's triangles whose boxes meet `query` (in the BVH's frame), each given
+/// by `triangle_of(t)` (its own or its placed coordinates); nothing when the segment touches an
+/// edge, a vertex or a closed component's triangle's plane, or ends on one (the caller tries
+/// another direction).
 template <class TriangleOf>
-std::optional<bool> crossing_parity(const geometry::ObjectBVH& bvh, const geometry::Segment& segment,
-                                    const geometry::Box& query, TriangleOf&& triangle_of) {
-  bool generic = true, odd = false;
+std::optional<bool> crossing_parity(const geometry::ObjectBVH& bvh, const ClosedComponentOf& closed,
+                                    const geometry::Segment& segment, const geometry::Box& query,
+                                    TriangleOf&& triangle_of) {
+  bool generic = true;
+  // Parities by closed component: one word for up to 64 of them, bytes beyond.
+  std::uint64_t odd_bits = 0;
+  std::vector<std::uint8_t> odd_bytes(closed.count > 64 ? closed.count : 0, 0);
   bvh.for_each_in_box(query, [&](std::uint32_t t) {
+    const std::uint32_t component = closed.of_triangle[t];
+    if (component == ClosedComponentOf::kOpen) return true;
     const auto hit = geometry::classify_segment_triangle(segment, triangle_of(t));
     if (!hit) return true;
     if (hit.contact != geometry::SegmentTriangleContact::interior || hit.at_endpoint) {
       generic = false;
       return false;
     }
-    odd = !odd;
+    if (odd_bytes.empty())
+      odd_bits ^= std::uint64_t(1) << component;
+    else
+      odd_bytes[component] ^= 1;
     return true;
   });
   if (!generic) return std::nullopt;
-  return odd;
+  return odd_bits != 0 || std::find(odd_bytes.begin(), odd_bytes.end(), 1) != odd_bytes.end();
 }
 
 class ObjectInteriorGrid {
@@ -47,9 +66,10 @@ class ObjectInteriorGrid {
   enum class Side : std::uint8_t { unknown, outside, inside };
 
   ObjectInteriorGrid() = default;
-  /// Builds the grid over the closed object `bvh` (its triangles, object frame), about
-  /// 3 * cbrt(triangles) cells per axis (16 to 48).
-  explicit ObjectInteriorGrid(const geometry::ObjectBVH& bvh);
+  /// Builds the grid over the object `bvh` (its triangles, object frame) whose closed
+  /// components `closed` names (at least one), about 3 * cbrt(triangles) cells per axis (16 to
+  /// 48). A cell is inside when inside some closed component.
+  ObjectInteriorGrid(const geometry::ObjectBVH& bvh, const ClosedComponentOf& closed);
 
   /// The side of every point within `margin` (per coordinate) of `x` (object frame), or
   /// unknown when that cube reaches a cell meeting the surface, cells of both sides, or the

@@ -34,10 +34,15 @@ class ObjectModel {
   /// The ball is much tighter than the box (a round object: under 0.7 of its volume), so
   /// phase I asks it of leaves and candidates before the object's BVH.
   bool ball_prunes = false;
-  /// Every edge is used an even number of times (EdgeParity): only then can an obstacle lie
-  /// inside the object.
+  /// Some connected component of the object is closed (every edge used an even number of
+  /// times, SurfaceComponents.h): only then can an obstacle lie inside the object.
   bool closed = false;
-  ObjectInteriorGrid interior_grid;  ///< closed objects only: inside/outside by cell
+  /// The closed component of each triangle (an object may hold several solids, and open ones).
+  ClosedComponentOf closed_components;
+  /// One vertex of each connected component, closed or open: with no surface contact, each
+  /// decides whether its whole component lies inside an obstacle.
+  std::vector<std::uint32_t> component_vertices;
+  ObjectInteriorGrid interior_grid;  ///< closed objects only: inside some closed component, by cell
   /// The convex hull as a vertex graph: object vertex ids, and per hull vertex its neighbours
   /// (CSR, indices into hull_vertices). Without a usable 3D hull, every vertex and no graph.
   std::vector<std::uint32_t> hull_vertices;

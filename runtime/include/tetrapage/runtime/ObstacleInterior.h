@@ -2,7 +2,7 @@
 /// @file ObstacleInterior.h
 /// Whether a point lies inside a closed obstacle, from the interiors stored in the index (the
 /// study's footnote 3): locate the point's tet by walking, then count the crossings between
-/// the tet's own triangles and the segment from the tet's reference point (whose closed parts
+/// the tet's own triangles and the segment from the tet's reference point (whose closed components
 /// the preprocess classified) to the point. The tet is convex, so the segment never leaves it
 /// and every triangle it can cross is in the tet's shard: no ray through the whole model.
 /// Crossings are decided exactly on the stored triangles; a segment that meets a triangle's
@@ -18,15 +18,15 @@
 namespace tetrapage {
 
 enum class ObstacleContainment : std::uint8_t {
-  outside,     ///< in no closed part (or outside the coarse mesh, which encloses every obstacle)
-  inside,      ///< inside closed part `part`
-  on_surface,  ///< on a stored triangle of a closed part
+  outside,     ///< in no closed component (or outside the coarse mesh, which encloses every obstacle)
+  inside,      ///< inside closed component `component`
+  on_surface,  ///< on a stored triangle of a closed component
   unknown,  ///< the index has no interiors, or the tet is undecided, or every path was degenerate
 };
 
 struct ObstacleQuery {
   ObstacleContainment containment = ObstacleContainment::unknown;
-  std::uint32_t part = 0;            ///< when inside: one closed part holding the point
+  std::uint32_t component = 0;       ///< when inside: one closed component holding the point
   std::uint32_t tet = 0;             ///< the tet that holds the point (unless outside the mesh)
   std::uint32_t paths_tried = 0;     ///< segments from the reference point (1 unless degenerate)
   std::uint64_t triangle_tests = 0;  ///< exact segment/triangle tests
@@ -38,14 +38,14 @@ struct ObstacleQuery {
 ObstacleQuery locate_in_obstacles(const CollisionIndex& index, std::uint32_t& hint_tet,
                                   const geometry::Point& p);
 
-/// The last point decided inside or outside, with its tet and the closed parts holding it:
+/// The last point decided inside or outside, with its tet and the closed components holding it:
 /// a point of the same tet is then decided from it (parity along the short segment between
 /// them) instead of from the tet's reference point, whose segment meets far more triangles.
 struct ObstacleMemo {
   bool valid = false;
   std::uint32_t tet = 0;
   geometry::Point point{};
-  std::vector<std::uint32_t> parts;
+  std::vector<std::uint32_t> components;
 };
 
 using ShardPin = ShardCache<Shard>::Pin;

@@ -112,8 +112,9 @@ class Shard {
   std::uint64_t triangle_id(std::uint32_t local) const {
     return id_base_ + (id_offsets32_.empty() ? id_offsets64_[local] : id_offsets32_[local]);
   }
-  /// The part id of `local` (< triangle_count(), unchecked).
-  std::uint32_t part_id(std::uint32_t local) const;
+  /// The connected component of `local` (< triangle_count(), unchecked): an id of the index's
+  /// components table (CollisionIndex::component_part names its part).
+  std::uint32_t component_id(std::uint32_t local) const;
   /// The box of all stored triangles.
   const geometry::Box& bounds() const { return bounds_; }
 

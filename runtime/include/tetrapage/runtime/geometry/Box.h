@@ -43,6 +43,12 @@ inline BoxContact classify_boxes(const Box& a, const Box& b) {
   return BoxContact::overlapping;
 }
 
+/// Whether the closed box `outer` holds all of `inner` (false for an empty inner).
+inline bool box_contains(const Box& outer, const Box& inner) {
+  return !inner.empty() && outer.lo[0] <= inner.lo[0] && outer.lo[1] <= inner.lo[1] && outer.lo[2] <= inner.lo[2] &&
+         inner.hi[0] <= outer.hi[0] && inner.hi[1] <= outer.hi[1] && inner.hi[2] <= outer.hi[2];
+}
+
 inline bool box_contains(const Box& box, const Point& p) {
   return box.lo[0] <= p[0] && p[0] <= box.hi[0] && box.lo[1] <= p[1] && p[1] <= box.hi[1] &&
          box.lo[2] <= p[2] && p[2] <= box.hi[2];
