@@ -54,7 +54,7 @@ demo: build
 	  --report $(DEMO_DIR)/flight.json
 	$(TETRAPAGE) replay $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
 	  --path $(DEMO_DIR)/flight.csv --report $(DEMO_DIR)/replay.json
-	$(TETRAPAGE) preprocess $(DEMO_DIR)/scene.ply -o $(DEMO_DIR)/scene.tpi --precision double \
+	$(TETRAPAGE) preprocess $(DEMO_DIR)/scene.ply -o $(DEMO_DIR)/scene.tpi \
 	  --report $(DEMO_DIR)/preprocess.json
 	$(TETRAPAGE) validate $(DEMO_DIR)/scene.tpi
 	$(TETRAPAGE) inspect $(DEMO_DIR)/scene.tpi

@@ -21,7 +21,7 @@ if [ ! -f "$OUT/scene.ply" ]; then
   "$TETRAPAGE" generate scene --triangles "$TRIANGLES" --seed 1 -o "$OUT/scene.ply"
 fi
 if [ ! -f "$OUT/scene.tpi" ]; then
-  /usr/bin/time -v "$TETRAPAGE" preprocess "$OUT/scene.ply" -o "$OUT/scene.tpi" --precision double ${PREPROCESS_FLAGS:-} \
+  /usr/bin/time -v "$TETRAPAGE" preprocess "$OUT/scene.ply" -o "$OUT/scene.tpi" ${PREPROCESS_FLAGS:-} \
     --report "$OUT/preprocess.json" 2> "$OUT/preprocess.time"
 fi
 "$TETRAPAGE" inspect "$OUT/scene.tpi" --report "$OUT/inspect.json"

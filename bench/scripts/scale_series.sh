@@ -39,7 +39,7 @@ for model in "${models[@]}"; do
       mkdir -p "$OUT/$kind$N"
       [ -f "$input" ] || "$TETRAPAGE" generate terrain --triangles "$N" --seed 1 -o "$input"
     fi
-    /usr/bin/time -v "$TETRAPAGE" preprocess "$input" -o "$D/model.tpi" --precision double --memory "$MEMORY" \
+    /usr/bin/time -v "$TETRAPAGE" preprocess "$input" -o "$D/model.tpi" --memory "$MEMORY" \
       ${REGION:+--region-triangles "$REGION"} \
       --report "$D/preprocess.json" 2> "$D/preprocess.time"
   fi

@@ -464,6 +464,20 @@ struct Interiors {
   bool stored = false;
 };
 
+// A tet whose inside could not be decided: the runtime would answer "unknown" there, and
+// containment could be missed, so the preprocess stops unless the user accepts it.
+[[noreturn]] void throw_undecided(const Ingest& in, const TetMesh& mesh, std::uint32_t tet, std::uint32_t component) {
+  const auto c = mesh.corners(tet);
+  std::string where = "tet " + std::to_string(tet) + " (first corner " + std::to_string(c[0][0]) + ", " +
+                      std::to_string(c[0][1]) + ", " + std::to_string(c[0][2]) + ")";
+  if (component == kInteriorUndecided)
+    throw InputError("interiors: " + where + " has no point strictly inside it to classify; pass "
+                     "--accept-undecided to store it as undecided (containment there is then unknown)");
+  throw InputError("interiors: every reference point tried in " + where + " lies on the surface of closed component " +
+                   std::to_string(component) + " of part '" + in.part_names[in.components[component].part] +
+                   "'; pass --accept-undecided to store the tet as undecided (containment there is then unknown)");
+}
+
 Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOptions& options,
                              PreprocessSummary& summary) {
   Interiors result;
@@ -499,6 +513,8 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
           : std::max<std::uint64_t>(1, options.memory_bytes / 4 / 64);
   std::vector<std::vector<std::uint32_t>> inside(tet_count);
   std::vector<std::uint8_t> undecided(tet_count, 0);
+  // Per tet, a closed component whose surface its last reference point lay on (for the error).
+  std::vector<std::uint32_t> on_component(tet_count, kInteriorUndecided);
   std::uint64_t passes = 0;
   // Classifies the given tets' reference points against every closed component whose box holds
   // them (outside a component's box is outside the component).
@@ -565,7 +581,7 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
       }
       parity.for_each_answer([&](std::uint32_t t, std::uint32_t p, bool odd, bool on_surface) {
         if (on_surface)
-          undecided[t] = 1;
+          undecided[t] = 1, on_component[t] = p;
         else if (odd)
           inside[t].push_back(p);
       });
@@ -605,6 +621,7 @@ Interiors classify_interiors(Ingest& in, const TetMesh& mesh, const PreprocessOp
   result.offsets.push_back(0);
   for (std::size_t t = 0; t < tet_count; ++t) {
     if (!has_point[t] || undecided[t] != 0) {
+      if (!options.accept_undecided) throw_undecided(in, mesh, std::uint32_t(t), on_component[t]);
       result.components.push_back(kInteriorUndecided);
       ++summary.interior_undecided;
     } else {

@@ -11,6 +11,7 @@
 #include <set>
 #include <thread>
 
+#include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/MeshReader.h"
@@ -47,10 +48,11 @@ struct World {
 
 using Kind = EnvironmentKind;
 
-// Generates an environment and an object, preprocesses (double storage: the stored geometry
-// is the input's, so exact answers must equal the oracle's), and flies a billiard path.
+// Generates an environment and an object, preprocesses (the default storage: the stored
+// geometry is the input's, so exact answers must equal the oracle's), and flies a billiard
+// path. A scene opens `open_fraction` of its copies (one file of closed and open solids).
 World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triangles, std::size_t steps,
-                 std::uint64_t seed, std::size_t region_triangles = 400) {
+                 std::uint64_t seed, std::size_t region_triangles = 400, double open_fraction = 0) {
   const std::string name = to_string(kind);
   const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "flying" / (name + std::to_string(seed));
   fs::remove_all(folder);
@@ -59,7 +61,15 @@ World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triang
   world.environment_path = folder / "environment.ply";
   {
     MeshWriter writer(world.environment_path);
-    generate_environment(kind, triangles, seed, writer);
+    if (kind == Kind::scene && open_fraction > 0) {
+      SceneOptions scene;
+      scene.triangles = triangles;
+      scene.seed = seed;
+      scene.open_fraction = open_fraction;
+      generate_scene(library(), scene, writer);
+    } else {
+      generate_environment(kind, triangles, seed, writer);
+    }
     writer.commit();
   }
   world.environment = read_mesh(world.environment_path);
@@ -75,7 +85,6 @@ World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triang
   world.index_path = folder / "environment.tpi";
   PreprocessOptions options;
   options.region_triangles = region_triangles;
-  options.precision = StoredPrecision::float64;
   // Interiors too: the oracle counts an object inside a closed obstacle as a collision.
   options.interiors = true;
   preprocess({world.environment_path}, world.index_path, options);
@@ -119,6 +128,19 @@ TEST(FlyingObject, ExactAnswersEqualTheOracleOnScenesTetrasAndTerrains) {
   expect_same_answers(fly(tetras, {}), tetras, "tetras");
   const World terrain = make_world(Kind::terrain, 8000, 116, 1500, 3);
   expect_same_answers(fly(terrain, {}), terrain, "terrain");
+}
+
+// A file of closed solids and open shells (as CAD exports are), in default settings: billiard
+// flights of a closed object through it, and of the same object over a terrain (open).
+TEST(FlyingObject, ExactAnswersEqualTheOracleOnAFileOfClosedAndOpenSolids) {
+  const World mixed = make_world(Kind::scene, 30000, 500, 1500, 1, 400, 0.5);
+  const SurfaceComponents split = find_surface_components(mixed.environment);
+  const std::size_t closed = split.closed_count();
+  EXPECT_GT(closed, 0u);
+  EXPECT_LT(closed, split.components.size()) << "some copies must be open";
+  expect_same_answers(fly(mixed, {}), mixed, "mixed scene");
+  const World terrain = make_world(Kind::terrain, 8000, 2000, 1500, 5);
+  expect_same_answers(fly(terrain, {}), terrain, "closed object over a terrain");
 }
 
 TEST(FlyingObject, StepsInFreeBoxesAgreeWithTheOracle) {

@@ -5,6 +5,7 @@
 #include <future>
 
 #include "Commands.h"
+#include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MemoryUsage.h"
@@ -101,6 +102,7 @@ void run_fly(const FlyArguments& args) {
               args.accuracy.c_str(), args.no_prefetch ? "no prefetch" : "prefetch", poses.size(),
               (unsigned long long)collisions, (unsigned long long)containments,
               index->has_interiors() ? "" : "; the index has no interiors: objects inside obstacles go unseen");
+  std::printf("%s\n", storage_statement(index->header()).c_str());
   std::printf("%.0f steps/s, latency p50 %.1f us, p95 %.1f us, p99 %.1f us, max %.1f us; open to first answer %.1f ms\n",
               steps_per_second, latency.p50_us, latency.p95_us, latency.p99_us, latency.max_us,
               first_answer_seconds * 1e3);
@@ -127,6 +129,9 @@ void run_fly(const FlyArguments& args) {
                                {"collisions", collisions},
                                {"containments", containments},
                                {"index_has_interiors", index->has_interiors()},
+                               {"precision", index->header().precision},
+                               {"max_rounding_distance", index->header().max_rounding_distance},
+                               {"answers_exact_for", index->header().precision == "float" ? "rounded model" : "input"},
                                {"contacts", contacts},
                                {"steps_outside_model", outside},
                                {"steps_per_second", steps_per_second},

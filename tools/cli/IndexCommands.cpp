@@ -39,6 +39,7 @@ struct PreprocessArguments {
   std::string compression = "lz4";
   double query_extent = 0;
   std::string interiors = "on";
+  bool accept_undecided = false;
   std::filesystem::path report;
 };
 
@@ -54,6 +55,7 @@ void run_preprocess(const PreprocessArguments& args) {
   options.query_extent = args.query_extent;
   options.progress = true;
   options.interiors = args.interiors == "on";
+  options.accept_undecided = args.accept_undecided;
   const PreprocessSummary summary = preprocess(args.inputs, args.output, options);
   std::fputs(summary.to_text().c_str(), stdout);
   if (!args.report.empty()) write_report(args.report, nlohmann::json::parse(summary.to_json()));
@@ -381,6 +383,9 @@ void add_index_commands(CLI::App& app) {
                       "over the triangles) so that the runtime reports an object inside an obstacle")
       ->capture_default_str()
       ->check(CLI::IsMember({"on", "off"}));
+  command->add_flag("--accept-undecided", pre->accept_undecided,
+                   "Store a region whose inside cannot be decided (every reference point tried lies on a\n"
+                   "closed surface) as undecided, where containment is then unknown, instead of failing");
   command->add_option("--report", pre->report, "Write the summary as JSON");
   command->callback([pre] { run_preprocess(*pre); });
 

@@ -59,6 +59,10 @@ struct PreprocessOptions {
   /// closed component (RayParity.h); false: not stored, and the runtime then reports only touching
   /// surfaces.
   bool interiors = false;
+  /// A tet whose reference points all lie on a closed surface (or that has no point strictly
+  /// inside) is stored as undecided, where the runtime's containment answer is unknown, instead
+  /// of failing the preprocess with an InputError naming it.
+  bool accept_undecided = false;
   /// (point, component) pairs classified per pass over the triangles; 0: as many as a quarter of
   /// memory_bytes holds. Tests set it small to exercise several passes.
   std::uint64_t interior_pairs_per_pass = 0;
