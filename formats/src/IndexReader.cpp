@@ -515,7 +515,7 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
   detail::enter_hdf5();
   Impl& r = *impl_;
   r.path = path;
-  r.descriptor = Descriptor(::open(path.c_str(), O_RDONLY | O_CLOEXEC));
+  r.descriptor = Descriptor(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
   if (r.descriptor.get() < 0)
     throw IoError("cannot open " + r.where() + ": " + std::strerror(errno));
   struct stat status {};

@@ -16,6 +16,8 @@
 #include "ChunkCodec.h"
 #include "Hdf5Handle.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/TemporaryFiles.h"
 
 namespace tetrapage {
 
@@ -71,6 +73,7 @@ std::string created_by_text() {
 struct IndexWriter::Impl {
   std::filesystem::path path;
   std::filesystem::path temporary;
+  std::unique_ptr<TemporaryFileGuard> temporary_guard;  ///< removed by SIGINT/SIGTERM handlers
   IndexWriterOptions options;
   FileHandle file;
   GroupHandle mesh_group;
@@ -228,6 +231,7 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   w.temporary = w.path;
   w.temporary += ".tmp-" + std::to_string(::getpid());
   w.options = options;
+  check_outputs(std::span<const std::filesystem::path>(&w.path, 1), {});  // never rename over a device
   if (options.chunk_bytes < kMinChunkBytes || options.chunk_bytes > kMaxChunkBytes ||
       options.chunk_bytes % kWordBytes != 0)
     throw InputError("index '" + w.path.string() + "': chunk size " +
@@ -238,6 +242,8 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   // SEMI: closing the file fails if a handle is still open, so commit() cannot leave data
   // unwritten behind a forgotten handle.
   w.check(H5Pset_fclose_degree(access.get(), H5F_CLOSE_SEMI), "file access properties");
+  // Registered before it exists: a signal arriving as it is created still removes it.
+  w.temporary_guard = std::make_unique<TemporaryFileGuard>(w.temporary);
   hid_t file = H5Fcreate(w.temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get());
   if (file < 0)
     throw IoError("cannot create index '" + w.path.string() + "' (temporary file '" +

@@ -8,23 +8,29 @@
 #include <cerrno>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage::detail {
 
 InputFile::InputFile(const std::filesystem::path& path, std::size_t block_size)
     : path_(path), capacity_(std::max<std::size_t>(block_size, 4096)) {
-  descriptor_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  // Non-blocking: opening a FIFO would otherwise wait for a writer forever.
+  descriptor_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (descriptor_ < 0) {
     throw IoError("cannot open '" + path.string() + "': " + std::strerror(errno));
   }
   struct stat status {};
-  if (::fstat(descriptor_, &status) != 0 || !S_ISREG(status.st_mode)) {
+  if (::fstat(descriptor_, &status) != 0) {
     const int error = errno;
     ::close(descriptor_);
-    throw IoError("cannot read '" + path.string() + "': " +
-                  (S_ISDIR(status.st_mode) ? std::string("it is a folder")
-                                           : std::string(std::strerror(error))));
+    throw IoError("cannot read '" + path.string() + "': " + std::strerror(error));
   }
+  if (!S_ISREG(status.st_mode)) {
+    ::close(descriptor_);
+    require_regular_file(path);  // throws, naming what it is
+    throw IoError("cannot read '" + path.string() + "': not a regular file");
+  }
+  ::fcntl(descriptor_, F_SETFL, ::fcntl(descriptor_, F_GETFL) & ~O_NONBLOCK);
   size_ = static_cast<std::uint64_t>(status.st_size);
   // The kernel reads ahead more aggressively for a file declared sequential.
   ::posix_fadvise(descriptor_, 0, 0, POSIX_FADV_SEQUENTIAL);

@@ -17,6 +17,7 @@
 
 #include "PathSupport.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/MeshReader.h"
 
 namespace tetrapage {
@@ -188,6 +189,7 @@ bool is_manifest_path(const std::filesystem::path& path) {
 
 Manifest read_manifest(const std::filesystem::path& path) {
   const std::string file = path.string();
+  require_regular_file(path);  // a FIFO would block the read forever
   std::ifstream stream(path, std::ios::binary);
   if (!stream) throw IoError("cannot open manifest '" + file + "': " + std::strerror(errno));
   json document;

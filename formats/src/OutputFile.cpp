@@ -7,11 +7,14 @@
 #include <vector>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage::detail {
 
 OutputFile::OutputFile(std::filesystem::path path, std::filesystem::path output)
-    : path_(std::move(path)), output_(std::move(output)) {
+    : path_(std::move(path)), output_(std::move(output)), guard_(path_) {
+  // The temporary is renamed over the output at the end: never over a device, FIFO or folder.
+  check_outputs(std::span<const std::filesystem::path>(&output_, 1), {});
   descriptor_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
   if (descriptor_ < 0) fail("create", errno);
   buffer_ = std::make_unique_for_overwrite<char[]>(capacity_);

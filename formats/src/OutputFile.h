@@ -10,6 +10,8 @@
 #include <string>
 #include <string_view>
 
+#include "tetrapage/formats/TemporaryFiles.h"
+
 namespace tetrapage::detail {
 
 class OutputFile {
@@ -60,6 +62,7 @@ class OutputFile {
 
   std::filesystem::path path_;
   std::filesystem::path output_;
+  TemporaryFileGuard guard_;  ///< SIGINT/SIGTERM remove the temporary
   int descriptor_ = -1;
   bool renamed_ = false;
   std::unique_ptr<char[]> buffer_;

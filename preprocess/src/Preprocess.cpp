@@ -27,6 +27,8 @@
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/TemporaryFiles.h"
 #include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/Manifest.h"
@@ -661,6 +663,15 @@ void write_components(IndexWriter& writer, const std::vector<SurfaceComponent>& 
 
 }  // namespace
 
+std::string source_line(const std::filesystem::path& input, const std::filesystem::path& index) {
+  std::error_code error;
+  const std::filesystem::path absolute = std::filesystem::absolute(input, error);
+  std::filesystem::path from_index =
+      std::filesystem::relative(absolute, std::filesystem::absolute(index, error).parent_path(), error);
+  if (error || from_index.empty()) from_index = absolute;
+  return from_index.string() + "\t" + absolute.string();
+}
+
 ShardChoice parse_shard_choice(const std::string& text) {
   if (text == "auto") return ShardChoice::automatic;
   if (text == "grid") return ShardChoice::grid;
@@ -677,6 +688,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
                              const std::filesystem::path& output,
                              const PreprocessOptions& options) {
   if (inputs.empty()) throw InputError("no input given");
+  check_outputs(std::span<const std::filesystem::path>(&output, 1), inputs);
+  const std::size_t stale = remove_stale_temporaries(output).size();
   if (options.memory_bytes < (std::uint64_t(16) << 20))
     throw InputError("--memory " + format_byte_size(options.memory_bytes) +
                      " is below the 16 MiB the pipeline needs to work");
@@ -687,6 +700,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   PreprocessSummary summary;
   summary.output = output;
   summary.memory_budget_bytes = options.memory_bytes;
+  summary.stale_temporaries_removed = stale;
   summary.precision = std::string(to_string(options.precision));
   summary.compression = std::string(to_string(options.compression));
   const std::filesystem::path spill_folder =
@@ -1045,7 +1059,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     header.max_rounding_distance = summary.max_rounding_distance;
     header.bounds = in.bounds;
     std::string source;
-    for (const auto& input : inputs) source += (source.empty() ? "" : "\n") + input.string();
+    for (const auto& input : inputs) source += (source.empty() ? "" : "\n") + source_line(input, output);
     header.source = source;
     header.created_by = "tetrapage preprocess";
     summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -1092,6 +1106,7 @@ std::string PreprocessSummary::to_json() const {
   j["interior_undecided"] = interior_undecided;
   j["buckets"] = buckets;
   j["spilled"] = spilled;
+  j["stale_temporaries_removed"] = stale_temporaries_removed;
   j["seconds"] = seconds;
   j["triangles_per_second"] = seconds > 0 ? double(triangles_read) / seconds : 0.0;
   j["peak_rss_bytes"] = peak_resident_bytes;
@@ -1126,6 +1141,8 @@ std::string PreprocessSummary::to_text() const {
                 (unsigned long long)(components - closed_components), interiors.c_str(), (unsigned long long)interior_tets,
                 (unsigned long long)interior_undecided);
   text << line;
+  if (stale_temporaries_removed > 0)
+    text << "removed " << stale_temporaries_removed << " temporary index file(s) left beside the output by killed runs\n";
   for (const auto& stage : stages) {
     std::snprintf(line, sizeof line, "  %-12s %8.2f s  peak RSS %s\n", stage.name.c_str(), stage.seconds,
                   format_byte_size(stage.peak_resident_bytes).c_str());

@@ -5,6 +5,9 @@
 #include "tetrapage/preprocess/SoupSpill.h"
 
 #include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -98,6 +101,16 @@ TEST(SoupSpill, RecordsAreTheSameInMemoryAndSpilledMidway) {
   fs::remove_all(folder);
 }
 
+// The descriptor of this process that holds the (deleted) file `path`, or -1.
+int open_descriptor_of(const fs::path& path) {
+  for (const auto& entry : fs::directory_iterator("/proc/self/fd")) {
+    std::error_code error;
+    const std::string target = fs::read_symlink(entry.path(), error).string();
+    if (!error && target.rfind(path.string(), 0) == 0) return std::stoi(entry.path().filename().string());
+  }
+  return -1;
+}
+
 TEST(SoupSpill, ATruncatedOrDamagedFileIsAnIoError) {
   const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / ("soup-spill-bad-" + std::to_string(::getpid()));
   fs::create_directories(folder);
@@ -106,7 +119,13 @@ TEST(SoupSpill, ATruncatedOrDamagedFileIsAnIoError) {
     spill.spill_to(folder / "spill");
     spill.append(soup(50, 1, 0), 0);
     read_back(spill, 16);  // flushes
-    fs::resize_file(folder / "spill", fs::file_size(folder / "spill") - 10);
+    // The spill file is unlinked once open: truncate it through the descriptor that holds it.
+    const int descriptor = open_descriptor_of(folder / "spill");
+    ASSERT_GE(descriptor, 0);
+    struct stat status {};
+    ASSERT_EQ(::fstat(descriptor, &status), 0);
+    ASSERT_EQ(::ftruncate(descriptor, status.st_size - 10), 0);
+    EXPECT_FALSE(fs::exists(folder / "spill")) << "unlinked while open";
     EXPECT_THROW(read_back(spill, 16), IoError);
   }
   EXPECT_FALSE(fs::exists(folder / "spill"));

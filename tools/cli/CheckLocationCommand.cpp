@@ -28,7 +28,7 @@ std::string embree_answer(const LocationDisagreement& d) {
 }
 
 void run_check_location(const CheckLocationArguments& args) {
-  check_writable(args.report);
+  check_outputs_writable({args.report}, {args.index});
   const IndexReader reader(args.index);
   const TetMesh mesh = reader.read_mesh();
   const auto build_start = std::chrono::steady_clock::now();

@@ -11,6 +11,15 @@
 
 namespace tetrapage::cli {
 
+/// A CLI11 check that an option is a byte size (parse_byte_size: "64M", "1G", "1048576"), so
+/// that a bad value is a command-line mistake (exit 2) found before any work.
+CLI::Validator byte_size_check();
+/// A CLI11 check that a whole number lies in [lowest, highest], with a message that names the
+/// range as written (CLI11's own prints the type's limits).
+CLI::Validator whole_number_check(long long lowest, long long highest);
+/// A CLI11 check of an image size "WIDTHxHEIGHT", each 1 to 16384.
+CLI::Validator image_size_check();
+
 /// `generate scene|tetras|terrain|object` (tools/cli/GenerateEnvironment.cpp)
 void add_generate_environment_commands(CLI::App& generate);
 /// `generate flight` (tools/cli/GenerateFlight.cpp)

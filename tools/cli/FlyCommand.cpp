@@ -32,7 +32,7 @@ struct FlyArguments {
 };
 
 void run_fly(const FlyArguments& args) {
-  for (const auto* output : {&args.answers, &args.report}) check_writable(*output);
+  check_outputs_writable({args.answers, args.report}, {args.index, args.object, args.path, args.check});
   QueryOptions query_options;
   query_options.accuracy = geometry::parse_accuracy(args.accuracy);
   query_options.mode = args.all_contacts ? QueryMode::all_contacts : QueryMode::first_hit;
@@ -171,7 +171,9 @@ void add_fly_command(CLI::App& app) {
       ->check(CLI::ExistingFile);
   command->add_option("--object", args->object, "Flying object mesh")->required()->check(CLI::ExistingFile);
   command->add_option("--path", args->path, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz)")->required()->check(CLI::ExistingFile);
-  command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")->capture_default_str();
+  command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")
+      ->capture_default_str()
+      ->check(byte_size_check());
   command->add_option("--accuracy", args->accuracy,
                       "exact, double_eps, float_eps (optionally :EPSILON) or clearance:D")
       ->capture_default_str();

@@ -27,7 +27,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 }
 
 void run_generate_flight(const FlightArguments& args) {
-  for (const auto* output : {&args.output, &args.answers, &args.report}) check_writable(*output);
+  check_outputs_writable({args.output, args.answers, args.report}, {args.environment, args.index, args.object});
   if (args.environment.empty() == args.index.empty())
     throw InputError(args.environment.empty() ? "generate flight: give the environment (--env) or an index (--index)"
                                               : "generate flight: give --env or --index, not both");
@@ -123,7 +123,9 @@ void add_generate_flight_command(CLI::App& generate) {
                       "Instead of --env: an index (.tpi), collisions decided by tetrapage's exact runtime "
                       "(for models too large for the in-core oracle, ~150 B a triangle)")
       ->check(CLI::ExistingFile);
-  command->add_option("--memory", args->memory, "Shard budget of the runtime with --index")->capture_default_str();
+  command->add_option("--memory", args->memory, "Shard budget of the runtime with --index")
+      ->capture_default_str()
+      ->check(byte_size_check());
   command->add_option("--object", args->object, "Flying object mesh (its own frame)")
       ->required()
       ->check(CLI::ExistingFile);

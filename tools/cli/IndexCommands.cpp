@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "Commands.h"
+#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/IndexReader.h"
@@ -44,6 +45,7 @@ struct PreprocessArguments {
 };
 
 void run_preprocess(const PreprocessArguments& args) {
+  check_outputs(std::vector<std::filesystem::path>{args.output, args.report}, args.inputs);
   check_writable(args.report);
   PreprocessOptions options;
   options.region_triangles = args.region_triangles;
@@ -108,6 +110,7 @@ InteriorFigures component_figures(const IndexReader& reader, std::size_t tets) {
 }
 
 void run_inspect(const InspectArguments& args) {
+  check_outputs_writable({args.report}, {args.index});
   const IndexReader reader(args.index);
   const IndexHeader& header = reader.header();
   const TetMesh mesh = reader.read_mesh();
@@ -308,7 +311,7 @@ void run_validate(const ValidateArguments& args) {
     audit_shard_queries(reader, shards, args.boxes, args.seed, findings, progress);
     progress.finish();
   }
-  std::vector<std::filesystem::path> inputs = args.inputs.empty() ? source_inputs(reader.header()) : args.inputs;
+  std::vector<std::filesystem::path> inputs = args.inputs.empty() ? source_inputs(reader.header(), args.index) : args.inputs;
   std::string missing;
   for (const auto& input : inputs)
     if (!std::filesystem::exists(input)) missing = input.string();
@@ -353,10 +356,11 @@ void add_index_commands(CLI::App& app) {
                       "Target triangles per region; 0 (the default): 4096, or the model's triangles / 12,000 "
                       "when larger, so that the coarse mesh stays near 100k tets")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number_check(0, 1ll << 30));
   command->add_option("--memory", pre->memory,
                       "Working-memory budget (e.g. 512M, 4G); larger models spill to disk next to the output")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(byte_size_check());
   command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")->capture_default_str();
   command->add_option("--shard", pre->shard, "Shard kind: auto (measured cost model), grid or rtree")
       ->capture_default_str()

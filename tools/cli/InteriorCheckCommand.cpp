@@ -29,13 +29,13 @@ struct InteriorCheckArguments {
 };
 
 void run_check_interiors(const InteriorCheckArguments& args) {
-  check_writable(args.report);
+  check_outputs_writable({args.report}, {args.index});
   auto index = std::make_shared<const CollisionIndex>(args.index);
   if (!index->has_interiors())
     throw InputError(args.index.string() +
                      ": the index stores no interiors (preprocess it with --interiors on)");
   const std::vector<std::filesystem::path> inputs =
-      args.inputs.empty() ? source_inputs(index->header()) : args.inputs;
+      args.inputs.empty() ? source_inputs(index->header(), args.index) : args.inputs;
   TriangleSoup environment;
   for (const auto& input : inputs)
     environment.append(is_manifest_path(input) ? load_assembly(read_manifest(input))

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "Commands.h"
+#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
@@ -58,6 +59,7 @@ void print_bounds(const BoundingBox& box) {
 }
 
 void run_info(const InfoArguments& args) {
+  check_outputs(std::span<const std::filesystem::path>(&args.report, 1), args.files);
   nlohmann::json files = nlohmann::json::array();
   for (const auto& path : args.files) {
     std::vector<ReadReport> reports;
@@ -115,6 +117,7 @@ void run_info(const InfoArguments& args) {
 }
 
 void run_convert(const ConvertArguments& args) {
+  check_outputs_writable({args.output, args.report}, {args.input});
   if (!can_write_mesh(args.output)) {
     throw InputError("'" + args.output.string() + "': cannot write meshes with the extension '" +
                      args.output.extension().string() +

@@ -25,7 +25,7 @@ struct RenderArguments {
 
 void run_render(const RenderArguments& args) {
   // Before the work: a picture that cannot be written is known now, not after the render.
-  for (const auto* output : {&args.output, &args.report}) check_writable(*output);
+  check_outputs_writable({args.output, args.report}, {args.index, args.path, args.object});
   RenderOptions options;
   if (std::sscanf(args.size.c_str(), "%zux%zu", &options.width, &options.height) != 2)
     throw InputError("--size '" + args.size + "': expected WIDTHxHEIGHT, e.g. 1200x800");
@@ -113,8 +113,11 @@ void add_render_command(CLI::App& app) {
       ->capture_default_str();
   command->add_option("--object", args->object, "Flying object (for --color page-ins)")->check(CLI::ExistingFile);
   command->add_option("--memory", args->memory, "Shard budget of the replay (for --color page-ins)")
-      ->capture_default_str();
-  command->add_option("--size", args->size, "Image size WIDTHxHEIGHT")->capture_default_str();
+      ->capture_default_str()
+      ->check(byte_size_check());
+  command->add_option("--size", args->size, "Image size WIDTHxHEIGHT (each side 1 to 16384 pixels)")
+      ->capture_default_str()
+      ->check(image_size_check());
   command->add_option("--azimuth", args->azimuth, "Camera direction around +z, degrees from +x")->capture_default_str();
   command->add_option("--elevation", args->elevation, "Camera direction above the xy plane, degrees")
       ->capture_default_str();

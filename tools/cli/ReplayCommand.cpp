@@ -33,7 +33,7 @@ struct StepAnswer {
 };
 
 void run_replay(const ReplayArguments& args) {
-  for (const auto* output : {&args.answers, &args.report}) check_writable(*output);
+  check_outputs_writable({args.answers, args.report}, {args.environment, args.object, args.path, args.check});
   const bool embree = args.reference == "embree";
   const TriangleSoup environment = load_inputs({args.environment});
   const TriangleSoup object = read_mesh(args.object);

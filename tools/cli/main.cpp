@@ -3,9 +3,31 @@
 
 #include <cstdio>
 #include <exception>
+#include <new>
+#include <string>
 
 #include "Commands.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/TemporaryFiles.h"
+
+namespace {
+
+// Errors are one line on stderr (scripts read the last line): a message that spans lines
+// (a library's, HDF5's) is joined with "; ".
+std::string one_line(const char* message) {
+  std::string text;
+  for (const char* c = message; *c != 0; ++c) {
+    if (*c == '\n' || *c == '\r') {
+      while (!text.empty() && text.back() == ' ') text.pop_back();
+      if (!text.empty() && text.back() != ';' && c[1] != 0 && c[1] != '\n') text += "; ";
+    } else {
+      text += *c;
+    }
+  }
+  return text;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
@@ -28,6 +50,8 @@ int main(int argc, char** argv) {
   tetrapage::cli::add_check_location_command(app);
   tetrapage::cli::add_render_command(app);
 
+  // Ctrl-C or a kill during a long command leaves no temporary file behind.
+  tetrapage::remove_temporaries_on_signals();
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -38,10 +62,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tetrapage: %s (see --help)\n", e.what());
     return 2;
   } catch (const tetrapage::Error& e) {
-    std::fprintf(stderr, "tetrapage: %s\n", e.what());
+    std::fprintf(stderr, "tetrapage: %s\n", one_line(e.what()).c_str());
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "tetrapage: out of memory\n");
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "tetrapage: unexpected error: %s\n", e.what());
+    std::fprintf(stderr, "tetrapage: unexpected error: %s\n", one_line(e.what()).c_str());
     return 1;
   }
   return 0;

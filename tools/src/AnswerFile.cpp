@@ -4,10 +4,12 @@
 #include <string>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage {
 
 void write_answers(const std::filesystem::path& path, std::span<const std::uint8_t> collides) {
+  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
   const std::filesystem::path temporary(path.string() + ".tmp");
   {
     std::ofstream out(temporary);
@@ -29,6 +31,7 @@ void write_answers(const std::filesystem::path& path, std::span<const std::uint8
 }
 
 std::vector<std::uint8_t> read_answers(const std::filesystem::path& path) {
+  require_regular_file(path);  // a FIFO would block the read forever
   std::ifstream in(path);
   if (!in) throw IoError("cannot open answers file '" + path.string() + "'");
   std::string line;

@@ -106,13 +106,28 @@ class TetGrid {
 
 }  // namespace
 
-std::vector<std::filesystem::path> source_inputs(const IndexHeader& header) {
+std::vector<std::filesystem::path> source_inputs(const IndexHeader& header, const std::filesystem::path& index) {
   std::vector<std::filesystem::path> inputs;
   std::istringstream source(header.source);
-  for (std::string line; std::getline(source, line);)
-    if (!line.empty()) inputs.emplace_back(line);
+  const std::filesystem::path folder = index.parent_path();
+  for (std::string line; std::getline(source, line);) {
+    if (line.empty()) continue;
+    const std::size_t tab = line.find('\t');
+    const std::filesystem::path from_index = line.substr(0, tab);
+    std::error_code error;
+    if (tab == std::string::npos) {
+      inputs.push_back(from_index);
+    } else if (std::filesystem::exists(folder / from_index, error)) {
+      inputs.push_back(folder / from_index);
+    } else {
+      inputs.emplace_back(line.substr(tab + 1));  // the absolute path, found or not
+    }
+  }
+  if (inputs.empty())
+    throw FormatError(index.string() + ": its 'source' attribute names no input: give the model's files after the index");
   return inputs;
 }
+
 
 void AuditFindings::add(std::string problem) {
   ++mismatches;

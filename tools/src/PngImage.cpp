@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage {
 namespace {
@@ -60,6 +61,7 @@ void write_png(const std::filesystem::path& path, const RgbImage& image) {
   put_chunk(file, "IDAT", packed);
   put_chunk(file, "IEND", {});
 
+  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
   const std::filesystem::path temporary = path.string() + ".tmp";
   {
     std::ofstream out(temporary, std::ios::binary | std::ios::trunc);

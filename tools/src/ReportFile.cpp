@@ -5,10 +5,12 @@
 #include <fstream>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage {
 
 void write_report(const std::filesystem::path& path, const nlohmann::json& report) {
+  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
   const auto temporary = std::filesystem::path(path.string() + ".tmp");
   {
     std::ofstream out(temporary);
@@ -34,6 +36,13 @@ void check_writable(const std::filesystem::path& path) {
   }
   std::error_code ec;
   std::filesystem::remove(temporary, ec);
+}
+
+void check_outputs_writable(std::initializer_list<std::filesystem::path> outputs,
+                            std::initializer_list<std::filesystem::path> inputs) {
+  check_outputs(std::span<const std::filesystem::path>(outputs.begin(), outputs.size()),
+                std::span<const std::filesystem::path>(inputs.begin(), inputs.size()));
+  for (const auto& output : outputs) check_writable(output);
 }
 
 }  // namespace tetrapage

@@ -108,6 +108,8 @@ struct PreprocessSummary {
   std::uint64_t interior_undecided = 0;    ///< tets whose reference point could not be classified
   std::uint64_t buckets = 0;               ///< tet buckets processed one at a time
   bool spilled = false;                    ///< whether the stages used spill files
+  /// OUTPUT.tmp-PID files of processes that no longer exist (killed runs), removed at the start.
+  std::uint64_t stale_temporaries_removed = 0;
   std::uint64_t peak_resident_bytes = 0;   ///< the whole run
   double seconds = 0;
   std::vector<StageFigures> stages;
@@ -117,6 +119,11 @@ struct PreprocessSummary {
   /// A few human lines (stdout).
   std::string to_text() const;
 };
+
+/// The line of the index's `source` attribute that records `input` of an index written to
+/// `index`: its path from the index's folder, a tab, its absolute path (so that the index finds
+/// its model when both move together, and from any working directory).
+std::string source_line(const std::filesystem::path& input, const std::filesystem::path& index);
 
 /// Runs the pipeline over mesh files and manifests (.json) into `output`.
 /// @throw IoError, FormatError, InputError (from the readers, naming the file), InputError for

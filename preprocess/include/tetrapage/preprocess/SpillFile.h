@@ -1,7 +1,8 @@
 #pragma once
 /// @file SpillFile.h
-/// A temporary file the preprocess spills to: created (empty) when made, removed when
-/// destroyed (also on errors); a failed read or write is an IoError that names it.
+/// A temporary file the preprocess spills to: created (empty) when made and unlinked at once,
+/// so its name never outlives the call that made it, and its space is freed when it is
+/// destroyed or the process ends, however; a failed read or write is an IoError that names it.
 
 #include <cstdio>
 #include <filesystem>
@@ -59,13 +60,12 @@ class SpillFile {
   void open() {
     file_.reset(std::fopen(path_.c_str(), "w+b"));
     if (!file_) throw IoError(path_.string() + ": cannot create a spill file");
-  }
-  void remove() {
-    if (!file_) return;
-    file_.reset();
+    // Unlinked at once: the open stream keeps the data, and nothing is left behind however the
+    // process ends (an exception, Ctrl-C, a kill).
     std::error_code ignored;
     std::filesystem::remove(path_, ignored);
   }
+  void remove() { file_.reset(); }
 
   struct FileCloser {
     void operator()(std::FILE* f) const { std::fclose(f); }

@@ -31,8 +31,13 @@ struct AuditFindings {
   void add(std::string problem);
 };
 
-/// The files an index was built from, in preprocess's order (its header's `source`).
-std::vector<std::filesystem::path> source_inputs(const IndexHeader& header);
+/// The files an index was built from, in preprocess's order (its header's `source`: per input
+/// a line "PATH_FROM_THE_INDEX_FOLDER<tab>ABSOLUTE_PATH"), each resolved against the folder of
+/// `index` first (an index moved with its model still finds it), then by its absolute path; a
+/// line without a tab is taken as it stands. A file found neither way is returned by its
+/// absolute path, so that the caller can say it is missing.
+/// @throw FormatError naming the index when the source records no input.
+std::vector<std::filesystem::path> source_inputs(const IndexHeader& header, const std::filesystem::path& index);
 
 /// The model-wide ids of the triangles a tet holds.
 using StoredIds = std::function<std::vector<std::uint64_t>(std::uint32_t tet)>;

@@ -4,6 +4,7 @@
 /// can be written at all (before long work).
 
 #include <filesystem>
+#include <initializer_list>
 
 #include <nlohmann/json.hpp>
 
@@ -17,5 +18,11 @@ void write_report(const std::filesystem::path& path, const nlohmann::json& repor
 /// removes `path`.tmp. Empty paths (optional outputs not asked for) are skipped.
 /// @throw IoError naming the path and the reason.
 void check_writable(const std::filesystem::path& path);
+
+/// Every output checked before any work: none is an input, a non-regular file (a device node,
+/// FIFO or folder) or another output (FileChecks.h), and each can be written (check_writable).
+/// @throw InputError or IoError naming the output.
+void check_outputs_writable(std::initializer_list<std::filesystem::path> outputs,
+                            std::initializer_list<std::filesystem::path> inputs);
 
 }  // namespace tetrapage
