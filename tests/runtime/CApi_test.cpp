@@ -682,5 +682,44 @@ TEST_F(CApiTest, HandlesAreReleasedSafelyFromManyThreads) {
   EXPECT_EQ(failures, std::vector<int>(4, 0));
 }
 
+// Objects that could only fail later (no area, coordinates whose placement overflows), poses
+// that overflow, and budgets smaller than a shard are input errors where they are given.
+TEST_F(CApiTest, BadObjectsPosesAndBudgetsAreInputErrorsUpFront) {
+  tetrapage_object* object = nullptr;
+  const double collinear[] = {0, 0, 0, 0.1, 0.1, 0.1, 0.2, 0.2, 0.2};
+  const std::uint32_t triangles[] = {0, 1, 2, 2, 2, 0};
+  EXPECT_EQ(tetrapage_object_create(index_, collinear, 3, triangles, 2, &object), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("zero area"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(object, nullptr);
+  const auto soup = small_object();
+  auto vertices = flat_vertices(soup);
+  const auto indices = flat_triangles(soup);
+  vertices[4] = 1e308;
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), soup.vertices.size(), indices.data(),
+                                    soup.triangles.size(), &object),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("1e+308"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(object, nullptr);
+
+  object = create_object();
+  ASSERT_NE(object, nullptr);
+  const double overflowing[7] = {1e308, 1e308, 1e308, 1, 0, 0, 0};
+  int collides = -1;
+  EXPECT_EQ(tetrapage_query(object, overflowing, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("overflow"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_object_destroy(object), TETRAPAGE_OK);
+
+  const CollisionIndex probe(index_path_);
+  std::uint64_t largest = 0;
+  for (std::uint32_t s = 0; s < probe.shard_count(); ++s) largest = std::max(largest, probe.shard_bytes(s));
+  tetrapage_index* index = nullptr;
+  EXPECT_EQ(tetrapage_open(index_path_.c_str(), largest - 1, &index), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find(std::to_string(largest - 1)), std::string::npos)
+      << tetrapage_last_error();
+  EXPECT_EQ(index, nullptr);
+  ASSERT_EQ(tetrapage_open(index_path_.c_str(), largest, &index), TETRAPAGE_OK) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_close(index), TETRAPAGE_OK);
+}
+
 }  // namespace
 }  // namespace tetrapage

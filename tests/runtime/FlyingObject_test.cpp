@@ -5,10 +5,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <limits>
+#include <map>
+#include <optional>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "tetrapage/formats/SurfaceComponents.h"
@@ -439,6 +449,62 @@ TEST(FlyingObject, DamagedIndexesFailCleanly) {
     }
   }
   EXPECT_GT(caught, 0u);  // the flips do reach checked data
+}
+
+template <class Body>
+void expect_input_error(Body&& body, const std::vector<std::string>& words) {
+  try {
+    body();
+    ADD_FAILURE() << "no InputError; expected one naming " << words.front();
+  } catch (const InputError& e) {
+    for (const auto& word : words)
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what() << " (expected " << word << ")";
+  }
+}
+
+// Problems that used to surface at the first query ("mesh walk: point (-nan ...)", "no tet
+// reachable", a cache error) are input errors where the bad value is given.
+TEST(FlyingObject, BadObjectsPosesAndBudgetsAreRejectedUpFront) {
+  const World world = make_world(Kind::tetras, 2000, 4, 20, 10, 200);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+
+  TriangleSoup degenerate;  // collinear corners and a repeated corner: no triangle has area
+  degenerate.part_names = {"object"};
+  degenerate.vertices = {{0, 0, 0}, {0.01, 0.01, 0.01}, {0.02, 0.02, 0.02}, {0.5, 0.1, 0.3}};
+  degenerate.triangles = {{0, 1, 2}, {0, 3, 3}, {3, 0, 3}};
+  degenerate.part_of = {0, 0, 0};
+  expect_input_error([&] { FlyingObject(index, degenerate); }, {"all 3 triangles have zero area"});
+  degenerate.triangles.push_back({0, 1, 3});  // one triangle with an area is enough
+  degenerate.part_of.push_back(0);
+  EXPECT_NO_THROW(FlyingObject(index, degenerate));
+
+  TriangleSoup huge = world.object;
+  huge.vertices[1][2] = -1e308;
+  expect_input_error([&] { FlyingObject(index, huge); }, {"vertex 1", "-1e+308", "overflow"});
+  huge.vertices[1][2] = 1e300;  // the bound itself is accepted
+  EXPECT_NO_THROW(FlyingObject(index, huge));
+
+  FlyingObject object(index, world.object);
+  Pose far = world.flight.poses.front();
+  far.translation = {1e308, 1e308, 1e308};
+  expect_input_error([&] { object.query(far); }, {"1e+308", "overflow"});
+  far.translation[0] = 0.5, far.translation[1] = -1e301;
+  expect_input_error([&] { object.query(far); }, {"translation y", "-1e+301", "overflow"});
+  // The object is unharmed: the flight answers as the oracle.
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i)
+    EXPECT_EQ(object.query(world.flight.poses[i]).collides, bool(world.flight.collides[i])) << "step " << i;
+
+  std::uint64_t largest = 0;
+  std::uint32_t largest_shard = 0;
+  for (std::uint32_t s = 0; s < index->shard_count(); ++s)
+    if (index->shard_bytes(s) > largest) largest = index->shard_bytes(s), largest_shard = s;
+  CollisionIndexOptions options;
+  options.memory_budget_bytes = largest - 1;
+  expect_input_error([&] { CollisionIndex(world.index_path, options); },
+                     {world.index_path.string(), "budget of " + std::to_string(largest - 1) + " bytes",
+                      "shard " + std::to_string(largest_shard), std::to_string(largest) + " bytes"});
+  options.memory_budget_bytes = largest;
+  EXPECT_NO_THROW(CollisionIndex(world.index_path, options));
 }
 
 }  // namespace

@@ -96,8 +96,9 @@ typedef struct tetrapage_index tetrapage_index;
    NULL.
    Errors: TETRAPAGE_ERROR_IO (missing or unreadable file; the message names it),
            TETRAPAGE_ERROR_FORMAT (not an index, wrong version, inconsistent tables),
-           TETRAPAGE_ERROR_INPUT (a zero budget), TETRAPAGE_ERROR_INVALID_ARGUMENT (null path
-           or index). */
+           TETRAPAGE_ERROR_INPUT (a zero budget, or one smaller than the largest shard: the
+           message names the budget, the shard and its size),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT (null path or index). */
 tetrapage_status tetrapage_open(const char* path, uint64_t budget_bytes, tetrapage_index** index);
 
 /* Releases the handle, which becomes stale. Objects created from it stay usable: the index
@@ -117,7 +118,9 @@ typedef struct tetrapage_object tetrapage_object;
 /* Creates an object from a triangle mesh in its own coordinates: `vertices` holds
    3 * vertex_count doubles (x, y, z per vertex), `triangles` 3 * triangle_count vertex
    indices (0-based). The arrays are copied. On failure *object is set to NULL.
-   Errors: TETRAPAGE_ERROR_INPUT (no triangle, a non-finite coordinate, an index out of range),
+   Errors: TETRAPAGE_ERROR_INPUT (no triangle, a non-finite coordinate, a coordinate beyond
+           1e300 in magnitude (placing it could overflow), an index out of range, every
+           triangle of zero area),
            TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument; vertices may be null only when
            vertex_count is 0), TETRAPAGE_ERROR_STALE_HANDLE (a closed index). */
 tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* vertices,
@@ -126,8 +129,8 @@ tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* v
 
 /* Creates an object from a mesh file (OBJ, PLY, OFF, STL, glTF/GLB, ...; all parts merged).
    Errors: TETRAPAGE_ERROR_IO, TETRAPAGE_ERROR_FORMAT, TETRAPAGE_ERROR_INPUT (as the mesh
-           readers: the message names the file, the line or element and the value),
-           TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           readers: the message names the file, the line or element and the value; as
+           tetrapage_object_create for the mesh read), TETRAPAGE_ERROR_INVALID_ARGUMENT,
            TETRAPAGE_ERROR_STALE_HANDLE (a closed index). */
 tetrapage_status tetrapage_object_create_from_file(tetrapage_index* index, const char* path,
                                                    tetrapage_object** object);
@@ -165,11 +168,11 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
    all_contacts: 0 stops at the first contact found; non-zero collects every contact pair.
    On success *collides is 1 or 0 and the contacts are kept in the object until its next
    query (tetrapage_contact_count, tetrapage_get_contacts, tetrapage_last_query_info).
-   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, an invalid accuracy
-           or parameter, a budget smaller than one shard), TETRAPAGE_ERROR_IO /
-           TETRAPAGE_ERROR_FORMAT (a shard could not be read or failed its checksum),
-           TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. After a failure the
-           object holds no contact. */
+   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, a translation beyond
+           1e300 in magnitude (the placement would overflow), an invalid accuracy or
+           parameter), TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard could not be read
+           or failed its checksum), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. After a failure the object holds no contact. */
 tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
                                  tetrapage_accuracy accuracy, double parameter, int all_contacts,
                                  int* collides);
