@@ -22,6 +22,7 @@
 #include <tuple>
 #include <vector>
 
+#include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/formats/Pose.h"
@@ -718,6 +719,71 @@ TEST_F(CApiTest, BadObjectsPosesAndBudgetsAreInputErrorsUpFront) {
       << tetrapage_last_error();
   EXPECT_EQ(index, nullptr);
   ASSERT_EQ(tetrapage_open(index_path_.c_str(), largest, &index), TETRAPAGE_OK) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_close(index), TETRAPAGE_OK);
+}
+
+// A copy whose shards around the second box are overwritten on disk after it was opened (with
+// the prefetcher on): queries there fail naming the file and a shard, queries by the first box
+// keep answering, and the object that failed answers again elsewhere.
+TEST_F(CApiTest, ShardsDamagedAfterOpeningFailOnlyTheirQueries) {
+  const fs::path copy = folder_ / "damaged-later.tpi";
+  fs::copy_file(index_path_, copy, fs::copy_options::overwrite_existing);
+  tetrapage_index* index = nullptr;
+  ASSERT_EQ(tetrapage_open(copy.c_str(), kBudget, &index), TETRAPAGE_OK);
+  tetrapage_object* near_first = nullptr;
+  tetrapage_object* near_second = nullptr;
+  const auto object = small_object();
+  const auto vertices = flat_vertices(object);
+  const auto triangles = flat_triangles(object);
+  for (auto* created : {&near_first, &near_second})
+    ASSERT_EQ(tetrapage_object_create(index, vertices.data(), object.vertices.size(), triangles.data(),
+                                      object.triangles.size(), created),
+              TETRAPAGE_OK);
+  {
+    // Every shard holding only triangles of the second box: garbage over their stored chunks.
+    const CollisionIndex probe(copy);
+    const IndexReader reader(copy);
+    std::fstream file(copy, std::ios::in | std::ios::out | std::ios::binary);
+    for (std::uint32_t s = 0; s < probe.shard_count(); ++s) {
+      const auto& b = probe.shard_bounds(s);
+      if (b.lo[0] < 2.4 || b.lo[1] < 2.4 || b.lo[2] < 2.4) continue;
+      for (const StoredChunk& chunk : reader.shard_chunks(s)) {
+        const std::string garbage(chunk.stored_bytes / 2 + 1, '\x5a');
+        file.seekp(std::streamoff(chunk.file_offset + chunk.stored_bytes / 4));
+        file.write(garbage.data(), std::streamsize(garbage.size()));
+      }
+    }
+    ASSERT_TRUE(file.flush());
+  }
+  Uniform uniform(11);
+  int failed = 0;
+  for (int k = 0; k < 30; ++k) {
+    // Moving towards the second box's corner (2.5, 2.5, 2.5), then about the first box.
+    const double t = 1.5 + 0.04 * k;
+    const double second[7] = {t, t, t, 1, 0, 0, 0};
+    int collides = -1;
+    const tetrapage_status status =
+        tetrapage_query(near_second, second, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides);
+    if (status != TETRAPAGE_OK) {
+      ++failed;
+      EXPECT_EQ(status, TETRAPAGE_ERROR_FORMAT) << tetrapage_last_error();
+      EXPECT_NE(std::string(tetrapage_last_error()).find(copy.string()), std::string::npos) << tetrapage_last_error();
+      EXPECT_NE(std::string(tetrapage_last_error()).find("shard "), std::string::npos) << tetrapage_last_error();
+    }
+    auto first = random_pose(uniform);
+    for (int a = 0; a < 3; ++a) first[a] = uniform(0.2, 1.3);
+    ASSERT_EQ(tetrapage_query(near_first, first.data(), TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK)
+        << tetrapage_last_error();
+    EXPECT_EQ(collides, brute_force(first, geometry::Accuracy::exact()).empty() ? 0 : 1) << "pose " << k;
+  }
+  EXPECT_GT(failed, 0);
+  // The object that failed still answers where the shards are sound.
+  const double inside_first[7] = {0.75, 0.75, 0.75, 1, 0, 0, 0};
+  int collides = -1;
+  EXPECT_EQ(tetrapage_query(near_second, inside_first, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_object_destroy(near_first), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_object_destroy(near_second), TETRAPAGE_OK);
   EXPECT_EQ(tetrapage_close(index), TETRAPAGE_OK);
 }
 

@@ -170,8 +170,10 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
    query (tetrapage_contact_count, tetrapage_get_contacts, tetrapage_last_query_info).
    Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, a translation beyond
            1e300 in magnitude (the placement would overflow), an invalid accuracy or
-           parameter), TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard could not be read
-           or failed its checksum), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           parameter), TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard this query needs
+           could not be read or failed its checksum, also when the background prefetcher met
+           the fault first: the message names the shard and the file; other shards and other
+           objects stay usable), TETRAPAGE_ERROR_INVALID_ARGUMENT,
            TETRAPAGE_ERROR_STALE_HANDLE. After a failure the object holds no contact. */
 tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
                                  tetrapage_accuracy accuracy, double parameter, int all_contacts,
