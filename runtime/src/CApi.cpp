@@ -1,15 +1,26 @@
 // The C API (tetrapage.h) over CollisionIndex and FlyingObject. Every entry point runs its
 // body inside guarded(), which turns every exception into a status and a thread-local message:
 // nothing thrown in C++ may unwind through a C caller's frames.
+//
+// Handles are ids, never addresses: each is looked up in a process-wide table under a lock,
+// so a handle released already (or never issued) is found missing and reported, never
+// dereferenced. Ids come from one 64-bit counter and are never reused, so a stale handle
+// cannot alias a newer index or object.
 
 #include "tetrapage/tetrapage.h"
 
 #include <algorithm>
 #include <cmath>
+#include <atomic>
+#include <cinttypes>
+#include <cstdio>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <new>
+#include <shared_mutex>
 #include <string>
+#include <unordered_map>
 #include <utility>
 
 #include "tetrapage/formats/Error.h"
@@ -17,17 +28,6 @@
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
-
-struct tetrapage_index {
-  // Shared with the objects, so that closing the handle before them is safe.
-  std::shared_ptr<const tetrapage::CollisionIndex> index;
-};
-
-struct tetrapage_object {
-  tetrapage::FlyingObject flying;
-  tetrapage::QueryResult result;
-  bool has_result = false;
-};
 
 namespace {
 
@@ -46,6 +46,108 @@ class NullArgument : public std::exception {
 template <class T>
 void require(const T* pointer, const char* name) {
   if (pointer == nullptr) throw NullArgument(name);
+}
+
+/// A handle that names no live index or object: reported as TETRAPAGE_ERROR_STALE_HANDLE.
+class StaleHandle : public std::exception {
+ public:
+  explicit StaleHandle(std::string message) : message_(std::move(message)) {}
+  const char* what() const noexcept override { return message_.c_str(); }
+
+ private:
+  std::string message_;
+};
+
+// What a handle stands for. The object holds the index through its FlyingObject (shared
+// ownership), so closing the index handle first leaves the object answering.
+struct IndexState {
+  std::shared_ptr<const tetrapage::CollisionIndex> index;
+};
+
+struct ObjectState {
+  tetrapage::FlyingObject flying;
+  tetrapage::QueryResult result;
+  bool has_result = false;
+};
+
+// Shared by both tables: an index's id is never an object's.
+std::atomic<std::uint64_t> next_handle_id{1};
+
+/// The live handles of one kind. Lookups share the lock and return a reference-counted state,
+/// so a release on another thread cannot free what a call is using.
+template <class State>
+class HandleTable {
+ public:
+  explicit HandleTable(const char* kind) : kind_(kind) {}
+
+  std::uintptr_t add(std::shared_ptr<State> state) {
+    const std::uint64_t id = next_handle_id.fetch_add(1, std::memory_order_relaxed);
+    if (id > std::uint64_t(UINTPTR_MAX)) throw std::bad_alloc();  // 32-bit ids exhausted
+    std::unique_lock lock(mutex_);
+    live_.emplace(std::uintptr_t(id), std::move(state));
+    return std::uintptr_t(id);
+  }
+
+  /// @throw StaleHandle naming the function's argument and the id.
+  std::shared_ptr<State> get(std::uintptr_t id) const {
+    {
+      std::shared_lock lock(mutex_);
+      if (auto found = live_.find(id); found != live_.end()) return found->second;
+    }
+    throw stale(id);
+  }
+
+  /// The state removed from the table (to be destroyed by the caller, outside the lock).
+  /// @throw StaleHandle when the id is not live.
+  std::shared_ptr<State> remove(std::uintptr_t id) {
+    std::shared_ptr<State> removed;
+    {
+      std::unique_lock lock(mutex_);
+      if (auto found = live_.find(id); found != live_.end()) {
+        removed = std::move(found->second);
+        live_.erase(found);
+      }
+    }
+    if (!removed) throw stale(id);
+    return removed;
+  }
+
+ private:
+  StaleHandle stale(std::uintptr_t id) const {
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "%s handle 0x%" PRIxPTR " is stale: released already, or never returned by tetrapage",
+                  kind_, id);
+    return StaleHandle(text);
+  }
+
+  const char* kind_;
+  mutable std::shared_mutex mutex_;
+  std::unordered_map<std::uintptr_t, std::shared_ptr<State>> live_;
+};
+
+// Never destroyed: a caller may release handles from its own static destructors, and the
+// states of handles never released must not be torn down (with their threads) at exit.
+HandleTable<IndexState>& indexes() {
+  static auto* table = new HandleTable<IndexState>("index");
+  return *table;
+}
+
+HandleTable<ObjectState>& objects() {
+  static auto* table = new HandleTable<ObjectState>("object");
+  return *table;
+}
+
+std::uintptr_t id_of(const void* handle) { return reinterpret_cast<std::uintptr_t>(handle); }
+
+std::shared_ptr<IndexState> index_state(const tetrapage_index* index) {
+  require(index, "index");
+  return indexes().get(id_of(index));
+}
+
+std::shared_ptr<ObjectState> object_state(const tetrapage_object* object) {
+  require(object, "object");
+  return objects().get(id_of(object));
 }
 
 tetrapage_status fail(tetrapage_status status, const char* function, const char* what) noexcept {
@@ -68,6 +170,8 @@ tetrapage_status guarded(const char* function, Body&& body) noexcept {
   } catch (const NullArgument& e) {
     return fail(TETRAPAGE_ERROR_INVALID_ARGUMENT, function,
                 (std::string(e.what()) + " is null").c_str());
+  } catch (const StaleHandle& e) {
+    return fail(TETRAPAGE_ERROR_STALE_HANDLE, function, e.what());
   } catch (const tetrapage::IoError& e) {
     return fail(TETRAPAGE_ERROR_IO, function, e.what());
   } catch (const tetrapage::FormatError& e) {
@@ -140,6 +244,7 @@ const char* tetrapage_status_string(tetrapage_status status) {
     case TETRAPAGE_ERROR_INVALID_ARGUMENT: return "invalid argument";
     case TETRAPAGE_ERROR_OUT_OF_MEMORY: return "out of memory";
     case TETRAPAGE_ERROR_INTERNAL: return "internal error";
+    case TETRAPAGE_ERROR_STALE_HANDLE: return "stale handle";
   }
   return "unknown status";
 }
@@ -151,23 +256,26 @@ tetrapage_status tetrapage_open(const char* path, uint64_t budget_bytes, tetrapa
     require(index, "index");
     tetrapage::CollisionIndexOptions options;
     options.memory_budget_bytes = budget_bytes;
-    auto opened = std::make_unique<tetrapage_index>();
+    auto opened = std::make_shared<IndexState>();
     opened->index = std::make_shared<const tetrapage::CollisionIndex>(path, options);
-    *index = opened.release();
+    *index = reinterpret_cast<tetrapage_index*>(indexes().add(std::move(opened)));
   });
 }
 
-void tetrapage_close(tetrapage_index* index) {
-  // Releasing only drops references and frees memory: nothing can throw here.
-  delete index;
+tetrapage_status tetrapage_close(tetrapage_index* index) {
+  return guarded(__func__, [&] {
+    if (index == nullptr) return;
+    // The last reference (unless objects hold the index) goes here, outside the table's lock.
+    indexes().remove(id_of(index)).reset();
+  });
 }
 
 tetrapage_status tetrapage_index_bounds(const tetrapage_index* index, double lo[3], double hi[3]) {
   return guarded(__func__, [&] {
-    require(index, "index");
+    const auto state = index_state(index);
     require(lo, "lo");
     require(hi, "hi");
-    const auto& bounds = index->index->header().bounds;
+    const auto& bounds = state->index->header().bounds;
     for (int a = 0; a < 3; ++a) {
       lo[a] = bounds.lo[a];
       hi[a] = bounds.hi[a];
@@ -180,14 +288,14 @@ tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* v
                                          size_t triangle_count, tetrapage_object** object) {
   if (object) *object = nullptr;
   return guarded(__func__, [&] {
-    require(index, "index");
+    const auto state = index_state(index);
     require(object, "object");
     if (vertex_count > 0) require(vertices, "vertices");
     if (triangle_count > 0) require(triangles, "triangles");
     auto soup = object_soup(vertices, vertex_count, triangles, triangle_count);
-    auto created = std::make_unique<tetrapage_object>(
-        tetrapage_object{tetrapage::FlyingObject(index->index, std::move(soup)), {}, false});
-    *object = created.release();
+    auto created = std::make_shared<ObjectState>(
+        ObjectState{tetrapage::FlyingObject(state->index, std::move(soup)), {}, false});
+    *object = reinterpret_cast<tetrapage_object*>(objects().add(std::move(created)));
   });
 }
 
@@ -195,16 +303,21 @@ tetrapage_status tetrapage_object_create_from_file(tetrapage_index* index, const
                                                    tetrapage_object** object) {
   if (object) *object = nullptr;
   return guarded(__func__, [&] {
-    require(index, "index");
+    const auto state = index_state(index);
     require(path, "path");
     require(object, "object");
-    auto created = std::make_unique<tetrapage_object>(
-        tetrapage_object{tetrapage::FlyingObject(index->index, tetrapage::read_mesh(path)), {}, false});
-    *object = created.release();
+    auto created = std::make_shared<ObjectState>(
+        ObjectState{tetrapage::FlyingObject(state->index, tetrapage::read_mesh(path)), {}, false});
+    *object = reinterpret_cast<tetrapage_object*>(objects().add(std::move(created)));
   });
 }
 
-void tetrapage_object_destroy(tetrapage_object* object) { delete object; }
+tetrapage_status tetrapage_object_destroy(tetrapage_object* object) {
+  return guarded(__func__, [&] {
+    if (object == nullptr) return;
+    objects().remove(id_of(object)).reset();
+  });
+}
 
 tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* accuracy,
                                           double* parameter) {
@@ -246,9 +359,9 @@ tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double p
                                         tetrapage_object_shape shape, tetrapage_motion motion,
                                         int all_contacts, int* collides) {
   if (collides) *collides = 0;
-  if (object) object->has_result = false;
   return guarded(__func__, [&] {
-    require(object, "object");
+    const auto state = object_state(object);
+    state->has_result = false;  // a failed query leaves no contact behind
     require(pose, "pose");
     require(collides, "collides");
     tetrapage::QueryOptions options;
@@ -268,18 +381,18 @@ tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double p
     tetrapage::Pose placed;
     placed.translation = {pose[0], pose[1], pose[2]};
     placed.rotation = {pose[3], pose[4], pose[5], pose[6]};
-    object->flying.query(placed, options, object->result);
-    object->has_result = true;
-    *collides = object->result.collides ? 1 : 0;
+    state->flying.query(placed, options, state->result);
+    state->has_result = true;
+    *collides = state->result.collides ? 1 : 0;
   });
 }
 
 tetrapage_status tetrapage_contact_count(const tetrapage_object* object, size_t* count) {
   if (count) *count = 0;
   return guarded(__func__, [&] {
-    require(object, "object");
+    const auto state = object_state(object);
     require(count, "count");
-    *count = object->has_result ? object->result.contacts.size() : 0;
+    *count = state->has_result ? state->result.contacts.size() : 0;
   });
 }
 
@@ -288,11 +401,11 @@ tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
                                         size_t* written) {
   if (written) *written = 0;
   return guarded(__func__, [&] {
-    require(object, "object");
+    const auto state = object_state(object);
     require(written, "written");
     if (capacity > 0) require(contacts, "contacts");
-    if (!object->has_result) return;
-    const auto& found = object->result.contacts;
+    if (!state->has_result) return;
+    const auto& found = state->result.contacts;
     const std::size_t n = std::min(capacity, found.size());
     for (std::size_t i = 0; i < n; ++i)
       contacts[i] = {found[i].environment_triangle, found[i].environment_part, found[i].object_triangle,
@@ -304,11 +417,11 @@ tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
 tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
                                            tetrapage_query_info* info) {
   return guarded(__func__, [&] {
-    require(object, "object");
+    const auto state = object_state(object);
     require(info, "info");
     *info = tetrapage_query_info{};
-    if (!object->has_result) return;
-    const auto& result = object->result;
+    if (!state->has_result) return;
+    const auto& result = state->result;
     const auto& counters = result.counters;
     info->collides = result.collides ? 1 : 0;
     info->outside_model = result.outside_model ? 1 : 0;

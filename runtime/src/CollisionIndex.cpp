@@ -43,6 +43,7 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
     shard_bytes_[s] = reader_.shard_size(s) + 4096;
     total_shard_bytes_ += shard_bytes_[s];
   }
+  check_budget_fits_shards();
   read_components(where);
   stores_input_coordinates_ = header().precision != "float";
   read_interiors(where);
@@ -73,6 +74,16 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
 }
 
 CollisionIndex::~CollisionIndex() = default;
+
+// A budget that cannot hold the largest shard would fail at the first query that needs it:
+// say so at open, naming the budget and the shard.
+void CollisionIndex::check_budget_fits_shards() const {
+  const auto largest = std::max_element(shard_bytes_.begin(), shard_bytes_.end());
+  if (largest == shard_bytes_.end() || *largest <= options_.memory_budget_bytes) return;
+  throw InputError(path().string() + ": the memory budget of " + std::to_string(options_.memory_budget_bytes) +
+                   " bytes is smaller than shard " + std::to_string(largest - shard_bytes_.begin()) + ", which needs " +
+                   std::to_string(*largest) + " bytes decoded");
+}
 
 void CollisionIndex::read_components(const std::string& where) {
   component_part_ = reader_.read_table_uint32("component_part");

@@ -180,6 +180,16 @@ void FlyingObject::place(const Pose& pose) {
                   pose.rotation[1], pose.rotation[2], pose.rotation[3]);
     throw InputError(text);
   }
+  // Object coordinates are within the same bound (ObjectModel): R x + t then stays finite.
+  for (int a = 0; a < 3; ++a)
+    if (std::fabs(pose.translation[a]) > kMaxCoordinateMagnitude) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "invalid pose: translation %c = %g is beyond %g in magnitude: placing the object "
+                    "there would overflow",
+                    "xyz"[a], pose.translation[a], kMaxCoordinateMagnitude);
+      throw InputError(text);
+    }
   // rotation_matrix normalises a q off unit norm: every prune here assumes an orthogonal
   // matrix up to rounding.
   rotation_ = rotation_matrix(pose.rotation);

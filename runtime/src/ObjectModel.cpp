@@ -7,11 +7,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <map>
 #include <numbers>
 
 #include "ConvexHull.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Pose.h"
 #include "tetrapage/formats/SurfaceComponents.h"
+#include "tetrapage/runtime/geometry/Predicates.h"
 
 namespace tetrapage {
 namespace {
@@ -80,9 +85,43 @@ void build_hull_graph(ObjectModel& model, const TriangleSoup& object) {
   }
 }
 
+// Whether the triangle's corners are collinear (exactly: its three projections have zero
+// signed area), so that it has no area and no normal.
+bool zero_area(const TriangleSoup& soup, std::size_t t) {
+  const auto& a = soup.vertices[soup.triangles[t][0]];
+  const auto& b = soup.vertices[soup.triangles[t][1]];
+  const auto& c = soup.vertices[soup.triangles[t][2]];
+  for (int u = 0; u < 3; ++u) {
+    const int v = (u + 1) % 3;
+    if (geometry::orient2d_cgal(a[u], a[v], b[u], b[v], c[u], c[v]) != geometry::Sign::zero) return false;
+  }
+  return true;
+}
+
+// What the BVH does not check but placing needs: coordinates whose placement cannot overflow,
+// and some triangle with an area (a wholly degenerate object has no hull, normal or inside,
+// and its queries would fail later on NaN points).
+void check_placeable(const TriangleSoup& soup) {
+  for (std::size_t v = 0; v < soup.vertices.size(); ++v)
+    for (int a = 0; a < 3; ++a)
+      if (std::fabs(soup.vertices[v][a]) > kMaxCoordinateMagnitude) {
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "object: vertex %zu has coordinate %c = %g, beyond %g in magnitude: placing it "
+                      "by a pose could overflow",
+                      v, "xyz"[a], soup.vertices[v][a], kMaxCoordinateMagnitude);
+        throw InputError(text);
+      }
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
+    if (!zero_area(soup, t)) return;
+  throw InputError("object: all " + std::to_string(soup.triangle_count()) +
+                   " triangles have zero area (collinear or repeated corners): the object is degenerate");
+}
+
 }  // namespace
 
 ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mesh) {
+  check_placeable(mesh);  // after the BVH, which checked the indices and finiteness
   for (const auto& v : mesh.vertices) {
     radius = std::max(radius, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
     box.extend(v);

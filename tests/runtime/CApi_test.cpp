@@ -22,6 +22,7 @@
 #include <tuple>
 #include <vector>
 
+#include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/formats/Pose.h"
@@ -205,7 +206,7 @@ class CApiTest : public ::testing::Test {
 
 TEST_F(CApiTest, StatusStringsAreDistinctAndNeverNull) {
   std::set<std::string> names;
-  for (int s = TETRAPAGE_OK; s <= TETRAPAGE_ERROR_INTERNAL; ++s) {
+  for (int s = TETRAPAGE_OK; s <= TETRAPAGE_ERROR_STALE_HANDLE; ++s) {
     const char* name = tetrapage_status_string(static_cast<tetrapage_status>(s));
     ASSERT_NE(name, nullptr);
     EXPECT_TRUE(names.insert(name).second) << "status " << s << " repeats " << name;
@@ -568,8 +569,14 @@ TEST_F(CApiTest, ObjectsFromFilesAnswerAsObjectsFromArraysAndOutliveTheirIndex) 
   tetrapage_object* from_file = nullptr;
   ASSERT_EQ(tetrapage_object_create_from_file(index_, (folder_ / "object.obj").c_str(), &from_file), TETRAPAGE_OK)
       << tetrapage_last_error();
-  // Closing the index handle leaves the objects working.
-  tetrapage_close(index_);
+  // Closing the index handle leaves the objects working; the handle itself is stale.
+  ASSERT_EQ(tetrapage_close(index_), TETRAPAGE_OK);
+  double lo[3], hi[3];
+  EXPECT_EQ(tetrapage_index_bounds(index_, lo, hi), TETRAPAGE_ERROR_STALE_HANDLE);
+  tetrapage_object* late = nullptr;
+  EXPECT_EQ(tetrapage_object_create_from_file(index_, (folder_ / "object.obj").c_str(), &late),
+            TETRAPAGE_ERROR_STALE_HANDLE);
+  EXPECT_EQ(late, nullptr);
   index_ = nullptr;
   Uniform uniform(7);
   for (int k = 0; k < 40; ++k) {
@@ -580,8 +587,13 @@ TEST_F(CApiTest, ObjectsFromFilesAnswerAsObjectsFromArraysAndOutliveTheirIndex) 
     EXPECT_EQ(a, b) << "pose " << k << " (seed 7)";
     EXPECT_EQ(a, brute_force(p, geometry::Accuracy::exact()).empty() ? 0 : 1) << "pose " << k << " (seed 7)";
   }
-  tetrapage_object_destroy(from_arrays);
-  tetrapage_object_destroy(from_file);
+  EXPECT_EQ(tetrapage_object_destroy(from_arrays), TETRAPAGE_OK);
+  // The last object frees the index; the other keeps answering until then.
+  int collides = -1;
+  const double pose[7] = {1.5, 0.75, 0.75, 1, 0, 0, 0};
+  EXPECT_EQ(tetrapage_query(from_file, pose, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK);
+  EXPECT_EQ(collides, 1);
+  EXPECT_EQ(tetrapage_object_destroy(from_file), TETRAPAGE_OK);
 }
 
 TEST_F(CApiTest, NoQueryMeansNoContacts) {
@@ -596,6 +608,183 @@ TEST_F(CApiTest, NoQueryMeansNoContacts) {
   EXPECT_EQ(info.collides, 0);
   EXPECT_EQ(info.triangle_tests, 0u);
   tetrapage_object_destroy(object);
+}
+
+// Closing or destroying twice, and any use of a released handle, is a status, never a crash:
+// handles are ids looked up in a table, not pointers to freed memory.
+TEST_F(CApiTest, StaleHandlesAreReportedNeverDereferenced) {
+  constexpr auto stale = TETRAPAGE_ERROR_STALE_HANDLE;
+  const auto names = [](const char* word) {
+    return std::string(tetrapage_last_error()).find(word) != std::string::npos;
+  };
+  tetrapage_index* index = nullptr;
+  ASSERT_EQ(tetrapage_open(index_path_.c_str(), kBudget, &index), TETRAPAGE_OK);
+  tetrapage_object* object = nullptr;
+  ASSERT_EQ(tetrapage_object_create_from_file(index, (folder_ / "object.obj").c_str(), &object), TETRAPAGE_OK);
+  ASSERT_EQ(tetrapage_close(index), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_close(index), stale);
+  EXPECT_TRUE(names("tetrapage_close") && names("index handle") && names("stale")) << tetrapage_last_error();
+  double lo[3], hi[3];
+  EXPECT_EQ(tetrapage_index_bounds(index, lo, hi), stale);
+
+  const double pose[7] = {0.75, 0.75, 0.75, 1, 0, 0, 0};
+  int collides = -1;
+  ASSERT_EQ(tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_object_destroy(object), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_object_destroy(object), stale);
+  EXPECT_TRUE(names("object handle")) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), stale);
+  EXPECT_EQ(collides, 0);
+  EXPECT_EQ(tetrapage_query_shaped(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, TETRAPAGE_SHAPE_HULL,
+                                   TETRAPAGE_MOTION_SWEPT, 0, &collides),
+            stale);
+  std::size_t count = 7, written = 7;
+  tetrapage_contact contact;
+  tetrapage_query_info info;
+  EXPECT_EQ(tetrapage_contact_count(object, &count), stale);
+  EXPECT_EQ(count, 0u);
+  EXPECT_EQ(tetrapage_get_contacts(object, &contact, 1, &written), stale);
+  EXPECT_EQ(written, 0u);
+  EXPECT_EQ(tetrapage_last_query_info(object, &info), stale);
+
+  // A handle of the other kind, and one this library never returned, are stale too.
+  tetrapage_object* live = create_object();
+  ASSERT_NE(live, nullptr);
+  EXPECT_EQ(tetrapage_close(reinterpret_cast<tetrapage_index*>(live)), stale);
+  EXPECT_EQ(tetrapage_object_destroy(reinterpret_cast<tetrapage_object*>(index_)), stale);
+  int local = 0;
+  EXPECT_EQ(tetrapage_object_destroy(reinterpret_cast<tetrapage_object*>(&local)), stale);
+  EXPECT_EQ(tetrapage_query(live, pose, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK)
+      << "a failed release must not touch live handles";
+  EXPECT_EQ(tetrapage_object_destroy(live), TETRAPAGE_OK);
+  // Null stays a no-op, and a success clears the message.
+  EXPECT_EQ(tetrapage_close(nullptr), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_object_destroy(nullptr), TETRAPAGE_OK);
+  EXPECT_STREQ(tetrapage_last_error(), "");
+}
+
+// Threads creating, querying and releasing handles at once while others release theirs twice:
+// the table stays consistent (run under the sanitizers by the threads build too).
+TEST_F(CApiTest, HandlesAreReleasedSafelyFromManyThreads) {
+  std::vector<std::thread> threads;
+  std::vector<int> failures(4, 0);
+  for (int t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] {
+      const double pose[7] = {0.75 + 0.1 * t, 0.75, 0.75, 1, 0, 0, 0};
+      for (int round = 0; round < 20; ++round) {
+        tetrapage_object* object = create_object();
+        int collides = -1;
+        if (tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides) != TETRAPAGE_OK) ++failures[t];
+        if (tetrapage_object_destroy(object) != TETRAPAGE_OK) ++failures[t];
+        if (tetrapage_object_destroy(object) != TETRAPAGE_ERROR_STALE_HANDLE) ++failures[t];
+      }
+    });
+  for (auto& thread : threads) thread.join();
+  EXPECT_EQ(failures, std::vector<int>(4, 0));
+}
+
+// Objects that could only fail later (no area, coordinates whose placement overflows), poses
+// that overflow, and budgets smaller than a shard are input errors where they are given.
+TEST_F(CApiTest, BadObjectsPosesAndBudgetsAreInputErrorsUpFront) {
+  tetrapage_object* object = nullptr;
+  const double collinear[] = {0, 0, 0, 0.1, 0.1, 0.1, 0.2, 0.2, 0.2};
+  const std::uint32_t triangles[] = {0, 1, 2, 2, 2, 0};
+  EXPECT_EQ(tetrapage_object_create(index_, collinear, 3, triangles, 2, &object), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("zero area"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(object, nullptr);
+  const auto soup = small_object();
+  auto vertices = flat_vertices(soup);
+  const auto indices = flat_triangles(soup);
+  vertices[4] = 1e308;
+  EXPECT_EQ(tetrapage_object_create(index_, vertices.data(), soup.vertices.size(), indices.data(),
+                                    soup.triangles.size(), &object),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("1e+308"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(object, nullptr);
+
+  object = create_object();
+  ASSERT_NE(object, nullptr);
+  const double overflowing[7] = {1e308, 1e308, 1e308, 1, 0, 0, 0};
+  int collides = -1;
+  EXPECT_EQ(tetrapage_query(object, overflowing, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("overflow"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_object_destroy(object), TETRAPAGE_OK);
+
+  const CollisionIndex probe(index_path_);
+  std::uint64_t largest = 0;
+  for (std::uint32_t s = 0; s < probe.shard_count(); ++s) largest = std::max(largest, probe.shard_bytes(s));
+  tetrapage_index* index = nullptr;
+  EXPECT_EQ(tetrapage_open(index_path_.c_str(), largest - 1, &index), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find(std::to_string(largest - 1)), std::string::npos)
+      << tetrapage_last_error();
+  EXPECT_EQ(index, nullptr);
+  ASSERT_EQ(tetrapage_open(index_path_.c_str(), largest, &index), TETRAPAGE_OK) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_close(index), TETRAPAGE_OK);
+}
+
+// A copy whose shards around the second box are overwritten on disk after it was opened (with
+// the prefetcher on): queries there fail naming the file and a shard, queries by the first box
+// keep answering, and the object that failed answers again elsewhere.
+TEST_F(CApiTest, ShardsDamagedAfterOpeningFailOnlyTheirQueries) {
+  const fs::path copy = folder_ / "damaged-later.tpi";
+  fs::copy_file(index_path_, copy, fs::copy_options::overwrite_existing);
+  tetrapage_index* index = nullptr;
+  ASSERT_EQ(tetrapage_open(copy.c_str(), kBudget, &index), TETRAPAGE_OK);
+  tetrapage_object* near_first = nullptr;
+  tetrapage_object* near_second = nullptr;
+  const auto object = small_object();
+  const auto vertices = flat_vertices(object);
+  const auto triangles = flat_triangles(object);
+  for (auto* created : {&near_first, &near_second})
+    ASSERT_EQ(tetrapage_object_create(index, vertices.data(), object.vertices.size(), triangles.data(),
+                                      object.triangles.size(), created),
+              TETRAPAGE_OK);
+  {
+    // Every shard holding only triangles of the second box: garbage over their stored chunks.
+    const CollisionIndex probe(copy);
+    const IndexReader reader(copy);
+    std::fstream file(copy, std::ios::in | std::ios::out | std::ios::binary);
+    for (std::uint32_t s = 0; s < probe.shard_count(); ++s) {
+      const auto& b = probe.shard_bounds(s);
+      if (b.lo[0] < 2.4 || b.lo[1] < 2.4 || b.lo[2] < 2.4) continue;
+      for (const StoredChunk& chunk : reader.shard_chunks(s)) {
+        const std::string garbage(chunk.stored_bytes / 2 + 1, '\x5a');
+        file.seekp(std::streamoff(chunk.file_offset + chunk.stored_bytes / 4));
+        file.write(garbage.data(), std::streamsize(garbage.size()));
+      }
+    }
+    ASSERT_TRUE(file.flush());
+  }
+  Uniform uniform(11);
+  int failed = 0;
+  for (int k = 0; k < 30; ++k) {
+    // Moving towards the second box's corner (2.5, 2.5, 2.5), then about the first box.
+    const double t = 1.5 + 0.04 * k;
+    const double second[7] = {t, t, t, 1, 0, 0, 0};
+    int collides = -1;
+    const tetrapage_status status =
+        tetrapage_query(near_second, second, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides);
+    if (status != TETRAPAGE_OK) {
+      ++failed;
+      EXPECT_EQ(status, TETRAPAGE_ERROR_FORMAT) << tetrapage_last_error();
+      EXPECT_NE(std::string(tetrapage_last_error()).find(copy.string()), std::string::npos) << tetrapage_last_error();
+      EXPECT_NE(std::string(tetrapage_last_error()).find("shard "), std::string::npos) << tetrapage_last_error();
+    }
+    auto first = random_pose(uniform);
+    for (int a = 0; a < 3; ++a) first[a] = uniform(0.2, 1.3);
+    ASSERT_EQ(tetrapage_query(near_first, first.data(), TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK)
+        << tetrapage_last_error();
+    EXPECT_EQ(collides, brute_force(first, geometry::Accuracy::exact()).empty() ? 0 : 1) << "pose " << k;
+  }
+  EXPECT_GT(failed, 0);
+  // The object that failed still answers where the shards are sound.
+  const double inside_first[7] = {0.75, 0.75, 0.75, 1, 0, 0, 0};
+  int collides = -1;
+  EXPECT_EQ(tetrapage_query(near_second, inside_first, TETRAPAGE_ACCURACY_EXACT, 0, 0, &collides), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_object_destroy(near_first), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_object_destroy(near_second), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_close(index), TETRAPAGE_OK);
 }
 
 }  // namespace

@@ -5,10 +5,20 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cctype>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <limits>
+#include <map>
+#include <optional>
 #include <set>
+#include <string>
 #include <thread>
 
 #include "tetrapage/formats/SurfaceComponents.h"
@@ -439,6 +449,246 @@ TEST(FlyingObject, DamagedIndexesFailCleanly) {
     }
   }
   EXPECT_GT(caught, 0u);  // the flips do reach checked data
+}
+
+template <class Body>
+void expect_input_error(Body&& body, const std::vector<std::string>& words) {
+  try {
+    body();
+    ADD_FAILURE() << "no InputError; expected one naming " << words.front();
+  } catch (const InputError& e) {
+    for (const auto& word : words)
+      EXPECT_NE(std::string(e.what()).find(word), std::string::npos) << e.what() << " (expected " << word << ")";
+  }
+}
+
+// Problems that used to surface at the first query ("mesh walk: point (-nan ...)", "no tet
+// reachable", a cache error) are input errors where the bad value is given.
+TEST(FlyingObject, BadObjectsPosesAndBudgetsAreRejectedUpFront) {
+  const World world = make_world(Kind::tetras, 2000, 4, 20, 10, 200);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+
+  TriangleSoup degenerate;  // collinear corners and a repeated corner: no triangle has area
+  degenerate.part_names = {"object"};
+  degenerate.vertices = {{0, 0, 0}, {0.01, 0.01, 0.01}, {0.02, 0.02, 0.02}, {0.5, 0.1, 0.3}};
+  degenerate.triangles = {{0, 1, 2}, {0, 3, 3}, {3, 0, 3}};
+  degenerate.part_of = {0, 0, 0};
+  expect_input_error([&] { FlyingObject(index, degenerate); }, {"all 3 triangles have zero area"});
+  degenerate.triangles.push_back({0, 1, 3});  // one triangle with an area is enough
+  degenerate.part_of.push_back(0);
+  EXPECT_NO_THROW(FlyingObject(index, degenerate));
+
+  TriangleSoup huge = world.object;
+  huge.vertices[1][2] = -1e308;
+  expect_input_error([&] { FlyingObject(index, huge); }, {"vertex 1", "-1e+308", "overflow"});
+  huge.vertices[1][2] = 1e300;  // the bound itself is accepted
+  EXPECT_NO_THROW(FlyingObject(index, huge));
+
+  FlyingObject object(index, world.object);
+  Pose far = world.flight.poses.front();
+  far.translation = {1e308, 1e308, 1e308};
+  expect_input_error([&] { object.query(far); }, {"1e+308", "overflow"});
+  far.translation[0] = 0.5, far.translation[1] = -1e301;
+  expect_input_error([&] { object.query(far); }, {"translation y", "-1e+301", "overflow"});
+  // The object is unharmed: the flight answers as the oracle.
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i)
+    EXPECT_EQ(object.query(world.flight.poses[i]).collides, bool(world.flight.collides[i])) << "step " << i;
+
+  std::uint64_t largest = 0;
+  std::uint32_t largest_shard = 0;
+  for (std::uint32_t s = 0; s < index->shard_count(); ++s)
+    if (index->shard_bytes(s) > largest) largest = index->shard_bytes(s), largest_shard = s;
+  CollisionIndexOptions options;
+  options.memory_budget_bytes = largest - 1;
+  expect_input_error([&] { CollisionIndex(world.index_path, options); },
+                     {world.index_path.string(), "budget of " + std::to_string(largest - 1) + " bytes",
+                      "shard " + std::to_string(largest_shard), std::to_string(largest) + " bytes"});
+  options.memory_budget_bytes = largest;
+  EXPECT_NO_THROW(CollisionIndex(world.index_path, options));
+}
+
+// Runs `body` on its own thread; a hang fails the whole test program (it cannot be cancelled).
+template <class Body>
+void within(std::chrono::seconds limit, Body&& body) {
+  auto done = std::async(std::launch::async, std::forward<Body>(body));
+  if (done.wait_for(limit) == std::future_status::timeout) {
+    std::fprintf(stderr, "FAILED: still running after %lld s: a hang\n", static_cast<long long>(limit.count()));
+    std::_Exit(1);
+  }
+  done.get();
+}
+
+// The step of the flight at which each shard is first acquired (max() for never), from a
+// run without prefetching in a budget that holds everything (each shard paged in once).
+std::vector<std::size_t> first_needs(const World& world) {
+  CollisionIndexOptions options;
+  options.prefetch = false;
+  auto index = std::make_shared<const CollisionIndex>(world.index_path, options);
+  std::vector<std::size_t> first(index->shard_count(), std::numeric_limits<std::size_t>::max());
+  FlyingObject object(index, world.object);
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i) {
+    (void)object.query(world.flight.poses[i]);
+    const auto page_ins = index->cache().page_ins_per_shard();
+    for (std::uint32_t s = 0; s < page_ins.size(); ++s)
+      if (page_ins[s] > 0 && first[s] == std::numeric_limits<std::size_t>::max()) first[s] = i;
+  }
+  return first;
+}
+
+// The shards the prefetcher pages in before the step that first needs them, when each step
+// waits for the prefetcher to settle (as fly_through_damage does), and at which step.
+std::map<std::uint32_t, std::size_t> prefetched_early(const World& world, const std::vector<std::size_t>& first) {
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+  std::map<std::uint32_t, std::size_t> early;
+  FlyingObject object(index, world.object);
+  for (std::size_t i = 0; i < world.flight.poses.size(); ++i) {
+    (void)object.query(world.flight.poses[i]);
+    index->cache().wait_prefetch_idle();
+    const auto page_ins = index->cache().page_ins_per_shard();
+    for (std::uint32_t s = 0; s < page_ins.size(); ++s)
+      if (page_ins[s] > 0 && first[s] > i && first[s] != std::numeric_limits<std::size_t>::max())
+        early.emplace(s, i);  // the first step only
+  }
+  return early;
+}
+
+struct Damage {
+  std::uint32_t victim = 0;        ///< the shard damaged on purpose
+  std::uint64_t cut = 0;           ///< truncation: the new file size; else 0
+  std::set<std::uint32_t> shards;  ///< every shard the damage reaches
+  std::size_t earliest = 0;        ///< the first step that needs one of them
+};
+
+// A shard the prefetcher loads (after step `from`) before it is needed, overwritten in the
+// middle of its chunks or (truncate) with the file cut at its first chunk; of the choices,
+// the one whose damage the flight meets latest.
+std::optional<Damage> plan_damage(const IndexReader& reader, const std::vector<std::size_t>& first,
+                                  const std::map<std::uint32_t, std::size_t>& prefetched, std::size_t from,
+                                  bool truncate) {
+  std::optional<Damage> best;
+  for (const auto& [victim, step] : prefetched) {
+    if (step < from) continue;
+    Damage damage;
+    damage.victim = victim;
+    damage.shards = {victim};
+    if (truncate) {
+      damage.cut = reader.shard_chunks(victim).front().file_offset;
+      for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+        if (reader.shard_size(s) == 0) continue;
+        const StoredChunk last = reader.shard_chunks(s).back();
+        if (last.file_offset + last.stored_bytes > damage.cut) damage.shards.insert(s);
+      }
+    }
+    damage.earliest = first[victim];
+    for (const std::uint32_t s : damage.shards) damage.earliest = std::min(damage.earliest, first[s]);
+    if (damage.earliest > from && (!best || damage.earliest > best->earliest)) best = damage;
+  }
+  return best;
+}
+
+// What a process writing over the file does: through the page cache, under the index reader.
+void apply_damage(const fs::path& path, const IndexReader& reader, const Damage& damage) {
+  if (damage.cut > 0) return fs::resize_file(path, damage.cut);
+  std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+  std::uint32_t noise = 12345;
+  for (const StoredChunk& chunk : reader.shard_chunks(damage.victim)) {
+    std::vector<char> garbage(std::max<std::uint64_t>(1, chunk.stored_bytes / 2));
+    for (char& c : garbage) c = char((noise = noise * 1664525u + 1013904223u) >> 24);
+    file.seekp(std::streamoff(chunk.file_offset + chunk.stored_bytes / 4));
+    file.write(garbage.data(), std::streamsize(garbage.size()));
+  }
+  ASSERT_TRUE(file.flush()) << path;
+}
+
+// The damaged shard that the error names with the file, or max() when it names none.
+std::uint32_t named_damage(const Error& e, const fs::path& path, const Damage& damage) {
+  const std::string message = e.what();
+  if (message.find(path.string()) == std::string::npos) return std::numeric_limits<std::uint32_t>::max();
+  for (const std::uint32_t s : damage.shards) {
+    const std::string name = "shard " + std::to_string(s);
+    const auto at = message.find(name);
+    if (at != std::string::npos && !std::isdigit(static_cast<unsigned char>(message[at + name.size()]))) return s;
+  }
+  return std::numeric_limits<std::uint32_t>::max();
+}
+
+void fly_through_damage(const World& world, const std::vector<std::size_t>& first,
+                        const std::map<std::uint32_t, std::size_t>& prefetched, bool truncate) {
+  const fs::path copy = world.index_path.parent_path() / (truncate ? "truncated-copy.tpi" : "overwritten-copy.tpi");
+  fs::copy_file(world.index_path, copy, fs::copy_options::overwrite_existing);
+  constexpr std::size_t kDamageStep = 10;
+  const IndexReader reader(copy);
+  const auto planned = plan_damage(reader, first, prefetched, kDamageStep, truncate);
+  ASSERT_TRUE(planned) << "no shard is prefetched after step " << kDamageStep << " and needed later";
+  const Damage& damage = *planned;
+  const std::size_t k = first[damage.victim];
+  const auto& poses = world.flight.poses;
+  const auto& oracle = world.flight.collides;
+
+  auto index = std::make_shared<const CollisionIndex>(copy);  // the prefetcher on, by default
+  ASSERT_GT(index->options().prefetch_threads, 0u);
+  FlyingObject a(index, world.object);
+  for (std::size_t i = 0; i < kDamageStep; ++i) {
+    ASSERT_EQ(a.query(poses[i]).collides, bool(oracle[i])) << i;
+    index->cache().wait_prefetch_idle();  // as prefetched_early: the same shards are hinted
+  }
+  // (Other shards the truncation reaches may be resident already: they answer from memory.)
+  ASSERT_FALSE(index->cache().contains(damage.victim)) << "shard " << damage.victim << " must be on disk only";
+  apply_damage(copy, reader, damage);
+
+  std::uint64_t prefetch_failures = 0;
+  std::size_t failed = 0;
+  bool failed_at_k = false;
+  for (std::size_t i = kDamageStep; i < poses.size(); ++i) {
+    // Every load that failed so far and failed no query was the prefetcher's (a failing
+    // query stops at its first failed load).
+    if (i == k) prefetch_failures = index->cache().counters().load_failures - failed;
+    try {
+      EXPECT_EQ(a.query(poses[i]).collides, bool(oracle[i])) << "step " << i;
+    } catch (const Error& e) {
+      ++failed;
+      failed_at_k |= i == k;
+      // Only a step that needs a damaged shard fails, naming it and the file.
+      const std::uint32_t named = named_damage(e, copy, damage);
+      EXPECT_NE(named, std::numeric_limits<std::uint32_t>::max()) << "step " << i << ": " << e.what();
+      if (named != std::numeric_limits<std::uint32_t>::max()) {
+        EXPECT_LE(first[named], i) << e.what();
+      }
+    }
+    // Settled before the next step, so that the prefetcher meets the fault before the step.
+    index->cache().wait_prefetch_idle();
+  }
+  EXPECT_TRUE(failed_at_k) << "step " << k << " needs the damaged shard " << damage.victim;
+  // The prefetcher met the fault first: it was hinted the shard before step k needed it.
+  EXPECT_GT(prefetch_failures, 0u) << "the prefetcher did not load shard " << damage.victim;
+
+  // Another object, in the regions the flight crossed before the damage: all answers.
+  FlyingObject b(index, world.object);
+  for (std::size_t i = 0; i < damage.earliest; ++i)
+    EXPECT_EQ(b.query(poses[i]).collides, bool(oracle[i])) << "object b, step " << i;
+  // The fault is not forgotten: the step that needs the shard fails again, and nothing is
+  // left reserved in the cache.
+  try {
+    (void)a.query(poses[k]);
+    ADD_FAILURE() << "step " << k << " answered with shard " << damage.victim << " damaged";
+  } catch (const Error& e) {
+    EXPECT_NE(named_damage(e, copy, damage), std::numeric_limits<std::uint32_t>::max()) << e.what();
+  }
+  index->cache().wait_prefetch_idle();
+  EXPECT_EQ(index->cache().counters().reserved_bytes, 0u);
+  EXPECT_GT(failed, 0u);
+}
+
+// An I/O or checksum fault met by the prefetch thread in the middle of a flight: the query
+// that needs the shard throws an Error naming it and the file; other regions keep answering.
+TEST(FlyingObject, AShardDamagedMidFlightFailsOnlyTheQueriesThatNeedIt) {
+  const World world = make_world(Kind::tetras, 4000, 116, 400, 11, 200);
+  const std::vector<std::size_t> first = first_needs(world);
+  const std::map<std::uint32_t, std::size_t> prefetched = prefetched_early(world, first);
+  for (const bool truncate : {false, true}) {
+    SCOPED_TRACE(truncate ? "truncated" : "overwritten");
+    within(std::chrono::seconds(300), [&] { fly_through_damage(world, first, prefetched, truncate); });
+  }
 }
 
 }  // namespace

@@ -11,6 +11,16 @@
  * exception ever crosses this interface. Null handles and null output pointers are reported as
  * TETRAPAGE_ERROR_INVALID_ARGUMENT, never dereferenced.
  *
+ * Handles are opaque ids, not addresses: every call looks its handle up in a process-wide
+ * table. A handle already closed or destroyed (or one never returned by this library, or an
+ * object handle passed as an index) is reported as TETRAPAGE_ERROR_STALE_HANDLE; closing or
+ * destroying twice is such an error, never a crash. Ids are never reused within a process.
+ *
+ * Ownership: an object shares ownership of the index it was created from. Closing the index
+ * handle while objects live is safe: the handle becomes stale at once (no new object can be
+ * created from it), while the objects keep answering queries; the index itself is freed with
+ * the last of them.
+ *
  * Threads: an index may be shared by any number of objects used from different threads; one
  * object is used from one thread at a time. Error messages are kept per thread.
  *
@@ -58,7 +68,10 @@ typedef enum tetrapage_status {
   /* Memory could not be allocated (std::bad_alloc). */
   TETRAPAGE_ERROR_OUT_OF_MEMORY = 5,
   /* Any other failure (another tetrapage::Error or an unexpected exception). */
-  TETRAPAGE_ERROR_INTERNAL = 6
+  TETRAPAGE_ERROR_INTERNAL = 6,
+  /* A non-null handle that names no live index or object: closed or destroyed already, never
+     returned by tetrapage, or of the other kind. Never dereferenced. */
+  TETRAPAGE_ERROR_STALE_HANDLE = 7
 } tetrapage_status;
 
 /* The message of the last call on this thread that returned a status: empty ("") after a
@@ -83,16 +96,18 @@ typedef struct tetrapage_index tetrapage_index;
    NULL.
    Errors: TETRAPAGE_ERROR_IO (missing or unreadable file; the message names it),
            TETRAPAGE_ERROR_FORMAT (not an index, wrong version, inconsistent tables),
-           TETRAPAGE_ERROR_INPUT (a zero budget), TETRAPAGE_ERROR_INVALID_ARGUMENT (null path
-           or index). */
+           TETRAPAGE_ERROR_INPUT (a zero budget, or one smaller than the largest shard: the
+           message names the budget, the shard and its size),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT (null path or index). */
 tetrapage_status tetrapage_open(const char* path, uint64_t budget_bytes, tetrapage_index** index);
 
-/* Releases the handle. Objects created from it stay usable: the index itself is freed with
-   the last of them. A null index is ignored. */
-void tetrapage_close(tetrapage_index* index);
+/* Releases the handle, which becomes stale. Objects created from it stay usable: the index
+   itself is freed with the last of them. A null index is ignored (TETRAPAGE_OK).
+   Errors: TETRAPAGE_ERROR_STALE_HANDLE (closed already, or not an index handle). */
+tetrapage_status tetrapage_close(tetrapage_index* index);
 
 /* The box of the model's triangles as stored in the index: lo[3] and hi[3].
-   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument). */
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument), TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_index_bounds(const tetrapage_index* index, double lo[3], double hi[3]);
 
 /* ------------------------------------------------------------------------------------------ */
@@ -103,22 +118,27 @@ typedef struct tetrapage_object tetrapage_object;
 /* Creates an object from a triangle mesh in its own coordinates: `vertices` holds
    3 * vertex_count doubles (x, y, z per vertex), `triangles` 3 * triangle_count vertex
    indices (0-based). The arrays are copied. On failure *object is set to NULL.
-   Errors: TETRAPAGE_ERROR_INPUT (no triangle, a non-finite coordinate, an index out of range),
+   Errors: TETRAPAGE_ERROR_INPUT (no triangle, a non-finite coordinate, a coordinate beyond
+           1e300 in magnitude (placing it could overflow), an index out of range, every
+           triangle of zero area),
            TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument; vertices may be null only when
-           vertex_count is 0). */
+           vertex_count is 0), TETRAPAGE_ERROR_STALE_HANDLE (a closed index). */
 tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* vertices,
                                          size_t vertex_count, const uint32_t* triangles,
                                          size_t triangle_count, tetrapage_object** object);
 
 /* Creates an object from a mesh file (OBJ, PLY, OFF, STL, glTF/GLB, ...; all parts merged).
    Errors: TETRAPAGE_ERROR_IO, TETRAPAGE_ERROR_FORMAT, TETRAPAGE_ERROR_INPUT (as the mesh
-           readers: the message names the file, the line or element and the value),
-           TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+           readers: the message names the file, the line or element and the value; as
+           tetrapage_object_create for the mesh read), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE (a closed index). */
 tetrapage_status tetrapage_object_create_from_file(tetrapage_index* index, const char* path,
                                                    tetrapage_object** object);
 
-/* Releases the object (and the index, if it was closed already). A null object is ignored. */
-void tetrapage_object_destroy(tetrapage_object* object);
+/* Releases the object, whose handle becomes stale (and the index, if it was closed already).
+   A null object is ignored (TETRAPAGE_OK).
+   Errors: TETRAPAGE_ERROR_STALE_HANDLE (destroyed already, or not an object handle). */
+tetrapage_status tetrapage_object_destroy(tetrapage_object* object);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Queries                                                                                     */
@@ -148,10 +168,13 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
    all_contacts: 0 stops at the first contact found; non-zero collects every contact pair.
    On success *collides is 1 or 0 and the contacts are kept in the object until its next
    query (tetrapage_contact_count, tetrapage_get_contacts, tetrapage_last_query_info).
-   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, an invalid accuracy
-           or parameter, a budget smaller than one shard), TETRAPAGE_ERROR_IO /
-           TETRAPAGE_ERROR_FORMAT (a shard could not be read or failed its checksum),
-           TETRAPAGE_ERROR_INVALID_ARGUMENT. After a failure the object holds no contact. */
+   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, a translation beyond
+           1e300 in magnitude (the placement would overflow), an invalid accuracy or
+           parameter), TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard this query needs
+           could not be read or failed its checksum, also when the background prefetcher met
+           the fault first: the message names the shard and the file; other shards and other
+           objects stay usable), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. After a failure the object holds no contact. */
 tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
                                  tetrapage_accuracy accuracy, double parameter, int all_contacts,
                                  int* collides);
@@ -192,12 +215,12 @@ typedef struct tetrapage_contact {
 } tetrapage_contact;
 
 /* The number of contacts of the last successful query (first hit: 0 or 1).
-   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_contact_count(const tetrapage_object* object, size_t* count);
 
 /* Copies the first min(capacity, count) contacts of the last query to `contacts` and their
    number to *written. `contacts` may be null when capacity is 0.
-   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
                                         tetrapage_contact* contacts, size_t capacity,
                                         size_t* written);
@@ -227,7 +250,7 @@ typedef struct tetrapage_query_info {
 } tetrapage_query_info;
 
 /* Fills *info for the last successful query (all zero before the first one).
-   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT. */
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
                                            tetrapage_query_info* info);
 

@@ -12,6 +12,11 @@
 
 namespace tetrapage {
 
+/// The largest magnitude of an object coordinate or a pose translation the runtime accepts:
+/// R(q) x + t then stays far from overflow (under 3e300), and so do the differences and
+/// extents computed from placed coordinates.
+inline constexpr double kMaxCoordinateMagnitude = 1e300;
+
 struct Pose {
   Vec3 translation{0.0, 0.0, 0.0};
   std::array<double, 4> rotation{1.0, 0.0, 0.0, 0.0};  ///< unit quaternion qw, qx, qy, qz

@@ -48,7 +48,8 @@ class CollisionIndex {
  public:
   /// Opens and checks the index (format, version, tables) and reads the coarse mesh.
   /// @throw IoError (missing, unreadable), FormatError (not an index, wrong version,
-  ///        inconsistent tables: names the file and the object), InputError (a zero budget).
+  ///        inconsistent tables: names the file and the object), InputError (a zero budget,
+  ///        or one smaller than the largest shard: names the budget, the shard and its size).
   explicit CollisionIndex(const std::filesystem::path& path, CollisionIndexOptions options = {});
   ~CollisionIndex();
   CollisionIndex(const CollisionIndex&) = delete;
@@ -118,6 +119,7 @@ class CollisionIndex {
   static constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
 
  private:
+  void check_budget_fits_shards() const;
   void read_components(const std::string& where);
   void read_interiors(const std::string& where);
 

@@ -135,7 +135,8 @@ struct QueryResult {
 
 class FlyingObject {
  public:
-  /// @throw InputError for an empty object or non-finite coordinates (as ObjectBVH).
+  /// @throw InputError for an object ObjectModel rejects (empty, non-finite or too large
+  ///        coordinates, every triangle of zero area).
   FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object);
   /// A flying instance of a shared model (built beforehand, e.g. while the index opened).
   /// @throw InputError for a null index or model.
@@ -146,7 +147,8 @@ class FlyingObject {
 
   /// One step at `pose`. Reuses `result`'s buffers. A quaternion within 1e-6 of unit squared
   /// norm stands for its rotation (rotation_matrix normalises it).
-  /// @throw InputError for a non-finite or non-unit pose; what the shard cache throws (a
+  /// @throw InputError for a non-finite or non-unit pose, or a translation beyond
+  ///        kMaxCoordinateMagnitude (the placement would overflow); what the shard cache throws (a
   ///        budget smaller than one shard, I/O and checksum errors naming the index).
   void query(const Pose& pose, const QueryOptions& options, QueryResult& result);
   QueryResult query(const Pose& pose, const QueryOptions& options = {}) {

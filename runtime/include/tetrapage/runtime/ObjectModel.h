@@ -19,7 +19,9 @@ namespace tetrapage {
 
 class ObjectModel {
  public:
-  /// @throw InputError for an empty object or non-finite coordinates (as ObjectBVH).
+  /// @throw InputError for an empty object, non-finite coordinates, an index out of range (as
+  ///        ObjectBVH), a coordinate beyond kMaxCoordinateMagnitude (its placement could
+  ///        overflow), or an object whose every triangle has zero area.
   explicit ObjectModel(TriangleSoup object);
 
   /// Read-only after construction (models are shared as std::shared_ptr<const ObjectModel>).

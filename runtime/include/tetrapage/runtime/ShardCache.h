@@ -193,7 +193,10 @@ class ShardCache {
   /// Queues hints for the prefetch threads and returns at once. A hint is loaded only if it
   /// fits after evicting unpinned shards older than options.protected_recent acquisitions;
   /// otherwise, or when the queue overflows (oldest first), or when the load fails, it is
-  /// dropped and counted.
+  /// dropped and counted. A failed load (an I/O or checksum error) leaves the shard empty, so
+  /// the next acquire of it loads it again in the caller's thread and throws the loader's
+  /// error there: a fault the prefetcher meets surfaces in the query that needs the shard,
+  /// and the other shards stay usable.
   /// @throw InputError if a shard id is out of range (nothing is queued then).
   void prefetch(std::span<const std::uint32_t> shards) { enqueue(shards, false); }
   /// The same, ahead of every queued hint, the last shard first: for the shards a query is
