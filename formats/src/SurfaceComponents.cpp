@@ -2,35 +2,21 @@
 
 #include <bit>
 #include <numeric>
-#include <unordered_map>
 
 #include "tetrapage/formats/EdgeParity.h"
 
 namespace tetrapage {
 namespace {
 
-// A vertex position within a part, bit for bit (-0.0 read as 0.0).
-struct PositionKey {
-  std::uint32_t part;
-  std::array<std::uint64_t, 3> bits;
-  bool operator==(const PositionKey&) const = default;
-};
+// Bits of a coordinate, -0.0 read as 0.0.
+std::uint64_t bits_of(double x) { return std::bit_cast<std::uint64_t>(x == 0.0 ? 0.0 : x); }
 
-struct PositionKeyHash {
-  std::size_t operator()(const PositionKey& key) const {
-    std::uint64_t h = 0x9e3779b97f4a7c15ULL * (key.part + 1);
-    for (const std::uint64_t w : key.bits) {
-      h ^= w + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
-      h *= 0xbf58476d1ce4e5b9ULL;
-    }
-    return std::size_t(h ^ (h >> 31));
-  }
-};
-
-PositionKey key_of(std::uint32_t part, const Vec3& p) {
-  PositionKey key{part, {}};
-  for (int a = 0; a < 3; ++a) key.bits[a] = std::bit_cast<std::uint64_t>(p[a] == 0.0 ? 0.0 : p[a]);
-  return key;
+std::uint64_t mix(std::uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
 }
 
 class UnionFind {
@@ -52,29 +38,70 @@ class UnionFind {
   std::vector<std::uint32_t> parent_;
 };
 
-// Per triangle corner, the node of its position within the triangle's part. Most soups index
-// shared vertices, so a vertex index keeps the node it was last given (for its part).
-std::vector<std::array<std::uint32_t, 3>> corner_nodes(const TriangleSoup& soup, UnionFind& sets) {
-  std::unordered_map<PositionKey, std::uint32_t, PositionKeyHash> node_of_position;
-  node_of_position.reserve(soup.vertices.size());
-  constexpr std::uint32_t kNone = 0xffffffffu;
-  std::vector<std::uint32_t> node_of_vertex(soup.vertices.size(), kNone), part_of_vertex(soup.vertices.size(), kNone);
-  std::vector<std::array<std::uint32_t, 3>> nodes(soup.triangle_count());
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
-    const std::uint32_t part = soup.part_of.empty() ? 0 : soup.part_of[t];
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t v = soup.triangles[t][k];
-      if (part_of_vertex[v] != part) {
-        const auto [it, added] = node_of_position.try_emplace(key_of(part, soup.vertices[v]), 0);
-        if (added) it->second = sets.add();
-        node_of_vertex[v] = it->second;
-        part_of_vertex[v] = part;
-      }
-      nodes[t][k] = node_of_vertex[v];
-    }
+// The distinct (part, position) pairs of a soup's corners, each a node of the union-find.
+// Open addressing over a power-of-two table at most half full, keyed by a vertex that holds the
+// position (no allocation per vertex: a node-based map tripled the ingest of a 10M file).
+class PositionNodes {
+ public:
+  explicit PositionNodes(const TriangleSoup& soup) : soup_(soup) {
+    std::size_t slots = 16;
+    while (slots < 2 * soup.vertices.size()) slots *= 2;
+    slots_.assign(slots, kEmpty);
+    node_of_vertex_.assign(soup.vertices.size(), kEmpty);
+    part_of_vertex_.assign(soup.vertices.size(), kEmpty);
   }
-  return nodes;
-}
+  // The node of vertex v in `part`, made on first sight.
+  std::uint32_t node(std::uint32_t v, std::uint32_t part, UnionFind& sets) {
+    if (part_of_vertex_[v] == part) return node_of_vertex_[v];  // indexed soups share vertices
+    const Vec3& p = soup_.vertices[v];
+    const std::array<std::uint64_t, 3> key{bits_of(p[0]), bits_of(p[1]), bits_of(p[2])};
+    std::uint32_t found = kEmpty;
+    for (std::size_t slot = hash(key, part) & (slots_.size() - 1);; slot = (slot + 1) & (slots_.size() - 1)) {
+      const std::uint32_t entry = slots_[slot];
+      if (entry == kEmpty) {
+        slots_[slot] = std::uint32_t(entries_.size());
+        found = sets.add();
+        entries_.push_back({v, part, found});
+        if (2 * entries_.size() > slots_.size()) grow();
+        break;
+      }
+      const Entry& e = entries_[entry];
+      const Vec3& q = soup_.vertices[e.vertex];
+      if (e.part == part && bits_of(q[0]) == key[0] && bits_of(q[1]) == key[1] && bits_of(q[2]) == key[2]) {
+        found = e.node;
+        break;
+      }
+    }
+    node_of_vertex_[v] = found;
+    part_of_vertex_[v] = part;
+    return found;
+  }
+  std::size_t count() const { return entries_.size(); }
+
+ private:
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
+  struct Entry {
+    std::uint32_t vertex, part, node;
+  };
+  static std::uint64_t hash(const std::array<std::uint64_t, 3>& key, std::uint32_t part) {
+    return mix(mix(mix(key[0] ^ part) + key[1]) + key[2]);
+  }
+  void grow() {
+    std::vector<std::uint32_t> slots(2 * slots_.size(), kEmpty);
+    for (std::uint32_t i = 0; i < entries_.size(); ++i) {
+      const Vec3& q = soup_.vertices[entries_[i].vertex];
+      std::size_t slot = hash({bits_of(q[0]), bits_of(q[1]), bits_of(q[2])}, entries_[i].part) & (slots.size() - 1);
+      while (slots[slot] != kEmpty) slot = (slot + 1) & (slots.size() - 1);
+      slots[slot] = i;
+    }
+    slots_ = std::move(slots);
+  }
+
+  const TriangleSoup& soup_;
+  std::vector<std::uint32_t> slots_;  ///< entry numbers
+  std::vector<Entry> entries_;        ///< node i is entries_[i] (nodes are added in order)
+  std::vector<std::uint32_t> node_of_vertex_, part_of_vertex_;
+};
 
 }  // namespace
 
@@ -85,34 +112,47 @@ std::size_t SurfaceComponents::closed_count() const {
 }
 
 SurfaceComponents find_surface_components(const TriangleSoup& soup) {
+  const auto part_of = [&](std::size_t t) { return soup.part_of.empty() ? 0u : soup.part_of[t]; };
   UnionFind sets;
-  const auto nodes = corner_nodes(soup, sets);
-  for (const auto& n : nodes) sets.unite(n[0], n[1]), sets.unite(n[0], n[2]);
+  PositionNodes nodes(soup);
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    const auto& c = soup.triangles[t];
+    const std::uint32_t a = nodes.node(c[0], part_of(t), sets);
+    sets.unite(a, nodes.node(c[1], part_of(t), sets));
+    sets.unite(a, nodes.node(c[2], part_of(t), sets));
+  }
+  // Each node's position hashed once (a vertex is shared by about six triangles).
+  std::vector<EdgeParity::VertexHash> hashes(nodes.count());
+  std::vector<std::uint8_t> hashed(nodes.count(), 0);
 
   SurfaceComponents result;
   result.component_of.resize(soup.triangle_count());
   constexpr std::uint32_t kNone = 0xffffffffu;
-  std::vector<std::uint32_t> component_of_root;
+  std::vector<std::uint32_t> component_of_root(nodes.count(), kNone);
   std::vector<EdgeParity> parity;
   for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
-    const std::uint32_t root = sets.find(nodes[t][0]);
-    if (root >= component_of_root.size()) component_of_root.resize(root + 1, kNone);
-    std::uint32_t& c = component_of_root[root];
+    const auto& c = soup.triangles[t];
+    std::array<std::uint32_t, 3> node{};
+    for (int k = 0; k < 3; ++k) {
+      node[k] = nodes.node(c[k], part_of(t), sets);
+      if (!hashed[node[k]]) hashes[node[k]] = EdgeParity::hash_vertex(soup.vertices[c[k]]), hashed[node[k]] = 1;
+    }
+    std::uint32_t& id = component_of_root[sets.find(node[0])];
     const auto corners = soup.corners(t);
-    if (c == kNone) {
-      c = std::uint32_t(result.components.size());
+    if (id == kNone) {
+      id = std::uint32_t(result.components.size());
       SurfaceComponent component;
-      component.part = soup.part_of.empty() ? 0 : soup.part_of[t];
+      component.part = part_of(t);
       component.vertex = corners[0];
       component.first_triangle = t;
       result.components.push_back(component);
       parity.emplace_back();
     }
-    result.component_of[t] = c;
-    SurfaceComponent& component = result.components[c];
+    result.component_of[t] = id;
+    SurfaceComponent& component = result.components[id];
     ++component.triangles;
     for (const Vec3& p : corners) component.bounds.extend(p);
-    parity[c].add_triangle(corners);
+    parity[id].add_hashed_triangle(hashes[node[0]], hashes[node[1]], hashes[node[2]]);
   }
   for (std::size_t c = 0; c < parity.size(); ++c) result.components[c].closed = parity[c].closed();
   return result;
