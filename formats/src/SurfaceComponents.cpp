@@ -43,9 +43,13 @@ class UnionFind {
 // position (no allocation per vertex: a node-based map tripled the ingest of a 10M file).
 class PositionNodes {
  public:
+  // Sized for the distinct positions expected: about one per vertex entry in an indexed soup,
+  // about one per six in a soup whose triangles share no entries (an STL); it doubles beyond.
   explicit PositionNodes(const TriangleSoup& soup) : soup_(soup) {
-    std::size_t slots = 16;
-    while (slots < 2 * soup.vertices.size()) slots *= 2;
+    const bool indexed = soup.vertices.size() <= 2 * soup.triangle_count();
+    const std::size_t expected = indexed ? soup.vertices.size() : soup.vertices.size() / 6;
+    std::size_t slots = 1 << 12;
+    while (slots < 2 * expected) slots *= 2;
     slots_.assign(slots, kEmpty);
     node_of_vertex_.assign(soup.vertices.size(), kEmpty);
     part_of_vertex_.assign(soup.vertices.size(), kEmpty);
