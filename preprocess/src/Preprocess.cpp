@@ -701,6 +701,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   summary.output = output;
   summary.memory_budget_bytes = options.memory_bytes;
   summary.stale_temporaries_removed = stale;
+  summary.resident_at_start_bytes = resident_bytes();
   summary.precision = std::string(to_string(options.precision));
   summary.compression = std::string(to_string(options.compression));
   const std::filesystem::path spill_folder =
@@ -1110,6 +1111,8 @@ std::string PreprocessSummary::to_json() const {
   j["seconds"] = seconds;
   j["triangles_per_second"] = seconds > 0 ? double(triangles_read) / seconds : 0.0;
   j["peak_rss_bytes"] = peak_resident_bytes;
+  j["resident_at_start_bytes"] = resident_at_start_bytes;
+  j["budget_exceeded_bytes"] = peak_resident_bytes > memory_budget_bytes ? peak_resident_bytes - memory_budget_bytes : 0;
   auto& stage_list = j["stages"] = nlohmann::ordered_json::array();
   for (const auto& stage : stages)
     stage_list.push_back({{"name", stage.name}, {"seconds", stage.seconds}, {"peak_rss_bytes", stage.peak_resident_bytes}});
@@ -1153,6 +1156,15 @@ std::string PreprocessSummary::to_text() const {
                 format_byte_size(peak_resident_bytes).c_str(), format_byte_size(memory_budget_bytes).c_str(),
                 spilled ? " (spilled to disk)" : "");
   text << line;
+  if (peak_resident_bytes > memory_budget_bytes) {
+    // --memory bounds the stages' data; the process itself and the file being read come on top.
+    std::snprintf(line, sizeof line,
+                  "budget exceeded by %s: the process held %s before any work (libraries, threads), and "
+                  "each input file's soup is held whole while it is read\n",
+                  format_byte_size(peak_resident_bytes - memory_budget_bytes).c_str(),
+                  format_byte_size(resident_at_start_bytes).c_str());
+    text << line;
+  }
   return text.str();
 }
 

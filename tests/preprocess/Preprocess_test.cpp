@@ -4,6 +4,7 @@
 // writes the same index as one in memory, and bad input leaves nothing behind.
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -232,6 +233,25 @@ TEST(Preprocess, FloatInputIsStoredExactlyInFloats) {
     const PreprocessSummary doubles = preprocess({input}, folder / "double.tpi", options);
     EXPECT_LT(summary.shard_payload_bytes, doubles.shard_payload_bytes) << offset;
   }
+}
+
+// --memory bounds the stages' data; what comes on top (the process, the file being read) is
+// reported: the summary says by how much the peak exceeded the budget, or nothing when it held.
+TEST(Preprocess, ABudgetIsKeptOrTheExcessIsSaid) {
+  const fs::path folder = test_folder("budget");
+  const fs::path input = make_tetras(folder, 50'000, 4);
+  PreprocessOptions options;
+  options.memory_bytes = std::uint64_t(16) << 20;
+  const PreprocessSummary tight = preprocess({input}, folder / "tight.tpi", options);
+  EXPECT_GT(tight.resident_at_start_bytes, 0u);
+  const auto report = nlohmann::json::parse(tight.to_json());
+  const std::uint64_t excess = report.at("budget_exceeded_bytes").get<std::uint64_t>();
+  EXPECT_EQ(excess, tight.peak_resident_bytes > tight.memory_budget_bytes ? tight.peak_resident_bytes - tight.memory_budget_bytes : 0);
+  EXPECT_EQ(tight.to_text().find("budget exceeded by") != std::string::npos, excess > 0) << tight.to_text();
+  options.memory_bytes = std::uint64_t(16) << 30;
+  const PreprocessSummary roomy = preprocess({input}, folder / "roomy.tpi", options);
+  EXPECT_LT(roomy.peak_resident_bytes, roomy.memory_budget_bytes);
+  EXPECT_EQ(roomy.to_text().find("budget exceeded"), std::string::npos) << roomy.to_text();
 }
 
 // The budget forces spill files and several buckets; the index must be the same as in memory.

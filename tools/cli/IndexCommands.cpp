@@ -358,7 +358,10 @@ void add_index_commands(CLI::App& app) {
       ->capture_default_str()
       ->check(whole_number_check(0, 1ll << 30));
   command->add_option("--memory", pre->memory,
-                      "Working-memory budget (e.g. 512M, 4G); larger models spill to disk next to the output")
+                      "Working-memory budget of the stages' data (e.g. 512M, 4G, at least 16M): larger models\n"
+                      "spill to disk next to the output. It bounds what the stages hold; the process itself\n"
+                      "(about 22 MiB) and each input file's soup while it is read come on top, and the summary\n"
+                      "says by how much the peak exceeded the budget")
       ->capture_default_str()
       ->check(byte_size_check());
   command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")->capture_default_str();

@@ -111,6 +111,9 @@ struct PreprocessSummary {
   /// OUTPUT.tmp-PID files of processes that no longer exist (killed runs), removed at the start.
   std::uint64_t stale_temporaries_removed = 0;
   std::uint64_t peak_resident_bytes = 0;   ///< the whole run
+  /// The process's resident bytes when the run started (libraries, the caller's data): the
+  /// budget bounds what the stages hold on top of this and of the input file being read.
+  std::uint64_t resident_at_start_bytes = 0;
   double seconds = 0;
   std::vector<StageFigures> stages;
 
