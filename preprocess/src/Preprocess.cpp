@@ -34,6 +34,7 @@
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/Pose.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/preprocess/CoarseMesh.h"
 #include "tetrapage/preprocess/RayParity.h"
@@ -340,6 +341,20 @@ struct LoadedSoup {
   std::vector<SurfaceComponent> components;
 };
 
+// Coordinates beyond kMaxCoordinateMagnitude overflow the coarse mesh's enlarged box and the
+// exact predicates' products: refused, naming the file and the value.
+void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& piece) {
+  for (const Vec3& v : soup.vertices)
+    for (const double x : v)
+      if (std::fabs(x) > kMaxCoordinateMagnitude) {
+        char value[64];
+        std::snprintf(value, sizeof value, "%g", x);
+        const std::string file = piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
+        throw InputError(file + ": a vertex coordinate of " + value +
+                         " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
+      }
+}
+
 LoadedSoup load_soup(const InputPiece& piece) {
   LoadedSoup loaded;
   std::vector<ReadReport> reports;
@@ -349,6 +364,7 @@ LoadedSoup load_soup(const InputPiece& piece) {
     ++loaded.files_read;
   }
   TriangleSoup& soup = loaded.soup;
+  check_coordinate_magnitudes(soup, piece);
   SurfaceComponents found = find_surface_components(soup);
   soup.part_of = std::move(found.component_of);
   loaded.components = std::move(found.components);
@@ -470,8 +486,9 @@ struct Interiors {
 // containment could be missed, so the preprocess stops unless the user accepts it.
 [[noreturn]] void throw_undecided(const Ingest& in, const TetMesh& mesh, std::uint32_t tet, std::uint32_t component) {
   const auto c = mesh.corners(tet);
-  std::string where = "tet " + std::to_string(tet) + " (first corner " + std::to_string(c[0][0]) + ", " +
-                      std::to_string(c[0][1]) + ", " + std::to_string(c[0][2]) + ")";
+  char corner[128];
+  std::snprintf(corner, sizeof corner, "(first corner %.9g, %.9g, %.9g)", c[0][0], c[0][1], c[0][2]);
+  const std::string where = "tet " + std::to_string(tet) + " " + corner;
   if (component == kInteriorUndecided)
     throw InputError("interiors: " + where + " has no point strictly inside it to classify; pass "
                      "--accept-undecided to store it as undecided (containment there is then unknown)");

@@ -167,6 +167,19 @@ TEST_F(HostileInput, BadOptionValuesAreCommandLineMistakes) {
   EXPECT_FALSE(fs::exists(folder_ / "view.png"));
 }
 
+// Coordinates whose placement or box would overflow are named, not taken for "no tet reachable".
+TEST_F(HostileInput, CoordinatesThatWouldOverflowAreNamed) {
+  std::ofstream(folder_ / "huge.obj") << "v 0 0 0\nv 1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\nf 1 2 3\nf 1 3 4\nf 1 2 4\nf 2 3 4\n";
+  expect_refused(run(folder_, "preprocess huge.obj -o huge.tpi"), "1e+308");
+  EXPECT_FALSE(fs::exists(folder_ / "huge.tpi"));
+  make_model("model.ply", 400);
+  ASSERT_EQ(run(folder_, "preprocess model.ply -o model.tpi").status, 0);
+  ASSERT_EQ(run(folder_, "generate object --triangles 4 -o object.ply").status, 0);
+  std::ofstream(folder_ / "far.csv") << "tx,ty,tz,qw,qx,qy,qz\n1e308,0,0,1,0,0,0\n";
+  expect_refused(run(folder_, "fly model.tpi --object object.ply --path far.csv"), "1e+308");
+  expect_refused(run(folder_, "fly model.tpi --object huge.obj --path far.csv"), "1e+308");
+}
+
 // SIGINT and SIGTERM during a preprocess that spills remove its temporary index and spill
 // files; a SIGKILL's leftovers are removed by the next preprocess of the same output.
 TEST_F(HostileInput, InterruptedAndKilledRunsLeaveNothingBehind) {
