@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/Pose.h"
 #include "tetrapage/tools/BspPartition.h"
 
@@ -42,8 +43,8 @@ void check_open_fraction(double open_fraction) {
 }
 
 // The triangles an opened copy keeps, in their order: those with a corner on or below the
-// plane, then only the largest piece of them (connected by shared vertex indices), so that
-// an opened copy stays one connected shell even when the cut severs a leg.
+// plane, then only the largest connected piece of them (the first of the largest), so that an
+// opened copy stays one connected shell even when the cut severs a leg.
 void cut_open(const TriangleSoup& soup, const SceneCut& cut, std::vector<TriangleIndices>& kept) {
   std::vector<double> height(soup.vertices.size());
   double lo = 1e300, hi = -1e300;
@@ -54,35 +55,17 @@ void cut_open(const TriangleSoup& soup, const SceneCut& cut, std::vector<Triangl
     hi = std::max(hi, height[v]);
   }
   const double plane = lo + cut.height * (hi - lo);
-  const auto below = [&](const TriangleIndices& t) {
-    return std::min({height[t[0]], height[t[1]], height[t[2]]}) <= plane;
-  };
-
-  std::vector<std::uint32_t> parent(soup.vertices.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  const auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const auto& t : soup.triangles) {
-    if (!below(t)) continue;
-    parent[find(t[1])] = find(t[0]);
-    parent[find(t[2])] = find(t[0]);
-  }
-  // Triangles per piece (counted at the piece's root); ties go to the piece seen first.
-  std::vector<std::uint32_t> piece_size(soup.vertices.size(), 0);
-  std::uint32_t largest = 0, largest_size = 0;
-  for (const auto& t : soup.triangles) {
-    if (!below(t)) continue;
-    const std::uint32_t root = find(t[0]);
-    if (++piece_size[root] > largest_size) {
-      largest = root;
-      largest_size = piece_size[root];
-    }
-  }
-  kept.clear();
+  TriangleSoup below;
+  below.vertices = soup.vertices;
   for (const auto& t : soup.triangles)
-    if (below(t) && find(t[0]) == largest) kept.push_back(t);
+    if (std::min({height[t[0]], height[t[1]], height[t[2]]}) <= plane) below.triangles.push_back(t);
+  const SurfaceComponents pieces = find_surface_components(below);
+  std::size_t largest = 0;
+  for (std::size_t c = 1; c < pieces.components.size(); ++c)
+    if (pieces.components[c].triangles > pieces.components[largest].triangles) largest = c;
+  kept.clear();
+  for (std::size_t t = 0; t < below.triangles.size(); ++t)
+    if (pieces.component_of[t] == largest) kept.push_back(below.triangles[t]);
 }
 
 // Renumbers `triangles` to the vertices they use, gathered in index order into `used`: an
