@@ -63,11 +63,26 @@ class JsonPlace {
   std::string path_;
 };
 
+/// A short description of a value for a message: arrays and objects by their size (printing
+/// them costs as much as they hold), strings cut at 57 characters.
 std::string shown(const json& value) {
+  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " values";
+  if (value.is_object()) return "an object of " + std::to_string(value.size()) + " fields";
+  if (value.is_string() && value.get_ref<const std::string&>().size() > 57)
+    return json(value.get_ref<const std::string&>().substr(0, 57)).dump() + "...";
   std::string text = value.dump();
   if (text.size() > 60) text = text.substr(0, 57) + "...";
   return text;
 }
+
+/// Deeper nesting than any manifest needs is refused while parsing: the parse itself is
+/// iterative, but what follows (messages, copies) need not be.
+constexpr int kMaxJsonDepth = 64;
+
+/// Thrown by the parser callback, caught in read_manifest.
+struct TooDeep {
+  int depth = 0;
+};
 
 void require_keys(const json& object, const JsonPlace& place,
                   std::initializer_list<std::string_view> allowed) {
@@ -192,10 +207,23 @@ Manifest read_manifest(const std::filesystem::path& path) {
   if (!stream) throw IoError("cannot open manifest '" + file + "': " + std::strerror(errno));
   json document;
   try {
+    // The callback sees each array or object open, with the number already open around it.
+    const json::parser_callback_t limit_depth = [](int depth, json::parse_event_t event, json&) {
+      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+          depth + 1 > kMaxJsonDepth)
+        throw TooDeep{depth + 1};
+      return true;
+    };
     // Comments are allowed, so a manifest can explain itself.
-    document = json::parse(stream, nullptr, true, true);
+    document = json::parse(stream, limit_depth, true, true);
+  } catch (const TooDeep& deep) {
+    throw FormatError(file + ": arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
+                      " levels (depth " + std::to_string(deep.depth) + "); a manifest needs 6");
   } catch (const json::parse_error& error) {
-    throw FormatError(file + ": not valid JSON: " + error.what());
+    // Its text quotes the token read last, which can be as long as the file.
+    std::string what = error.what();
+    if (what.size() > 200) what = what.substr(0, 197) + "...";
+    throw FormatError(file + ": not valid JSON: " + what);
   }
   if (stream.bad()) throw IoError("cannot read manifest '" + file + "'");
 

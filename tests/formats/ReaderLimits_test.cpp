@@ -2,11 +2,13 @@
 // of 2^32 - 1 corners) must be rejected from the file's size before anything is sized by them,
 // naming the file, the element and the value; each case runs in a child whose address space is
 // capped, so that a reader allocating gigabytes fails here even where memory is overcommitted.
+// Deeply nested manifests are rejected by their depth, before their value is ever printed.
 
 #include <string>
 
 #include "../MemoryLimit.h"
 #include "TestSupport.h"
+#include "tetrapage/formats/Manifest.h"
 
 namespace tetrapage::test {
 namespace {
@@ -121,6 +123,28 @@ TEST(ReaderLimits, StlAndObjNeverSizeAnythingByAClaim) {
   for (int k = 0; k < 100000; ++k) text += k % 2 == 0 ? " 1" : " 2";
   write_file(obj, text + " 3\n");
   expect_capped_error("returned", [&] { read_mesh(obj); }, {});
+}
+
+TEST(ReaderLimits, DeeplyNestedManifestIsRejectedByItsDepth) {
+  const auto folder = scratch_folder("manifest_depth");
+  const auto path = folder / "deep.json";
+  // 50,000 levels: printing this value (or destroying it recursively) overflowed the stack.
+  constexpr int depth = 50000;
+  write_file(path, "{\"units\": " + std::string(depth, '[') + std::string(depth, ']') + "}");
+  expect_capped_error("FormatError", [&] { read_manifest(path); },
+                      {path.string(), "nested deeper than 64"});
+  // Deep enough to be refused, shallow enough to show the message is short.
+  write_file(path, "{\"parts\": [{\"file\": \"a.ply\", \"instances\": " + std::string(70, '[') +
+                       std::string(70, ']') + "}]}");
+  expect_capped_error("FormatError", [&] { read_manifest(path); }, {path.string(), "depth 65"});
+  // A large but flat value is summarised, not printed whole.
+  std::string wide = "{\"units\": [";
+  for (int i = 0; i < 200000; ++i) wide += i == 0 ? "1" : ",1";
+  write_file(path, wide + "]}");
+  const ChildOutcome outcome = run_with_memory_limit([&] { read_manifest(path); });
+  EXPECT_EQ(outcome.kind, "FormatError") << outcome.message;
+  EXPECT_NE(outcome.message.find("units"), std::string::npos) << outcome.message;
+  EXPECT_LT(outcome.message.size(), 300u) << outcome.message;
 }
 
 }  // namespace
