@@ -219,8 +219,9 @@ Manifest read_manifest(const std::filesystem::path& path) {
   } catch (const TooDeep& deep) {
     throw FormatError(file + ": arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
                       " levels (depth " + std::to_string(deep.depth) + "); a manifest needs 6");
-  } catch (const json::parse_error& error) {
-    // Its text quotes the token read last, which can be as long as the file.
+  } catch (const json::exception& error) {
+    // A syntax error, or a number beyond double's range (out_of_range, found by fuzzing). Its
+    // text quotes the token read last, which can be as long as the file.
     std::string what = error.what();
     if (what.size() > 200) what = what.substr(0, 197) + "...";
     throw FormatError(file + ": not valid JSON: " + what);

@@ -147,5 +147,16 @@ TEST(ReaderLimits, DeeplyNestedManifestIsRejectedByItsDepth) {
   EXPECT_LT(outcome.message.size(), 300u) << outcome.message;
 }
 
+// Found by fuzz_manifest: a number beyond double's range made nlohmann-json throw its
+// out_of_range, which escaped read_manifest as no tetrapage::Error.
+TEST(ReaderLimits, ManifestNumberBeyondDoubleIsAFormatError) {
+  const auto folder = scratch_folder("manifest_number");
+  const auto path = folder / "big.json";
+  write_file(path, "2522222222222222222222222222222222222222222E22222222222222222222222222222222222222");
+  test::expect_error<FormatError>([&] { read_manifest(path); }, {path.string(), "not valid JSON", "overflow"});
+  write_file(path, "{\"parts\": [{\"file\": \"a.ply\", \"instances\": [{\"scale\": 1e999}]}]}");
+  test::expect_error<FormatError>([&] { read_manifest(path); }, {path.string(), "not valid JSON", "1e999"});
+}
+
 }  // namespace
 }  // namespace tetrapage::test
