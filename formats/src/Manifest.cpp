@@ -63,16 +63,42 @@ class JsonPlace {
   std::string path_;
 };
 
+/// At most 57 bytes of `text`, not splitting a UTF-8 character (the parser checked it).
+std::string cut(const std::string& text, bool& was_cut) {
+  was_cut = text.size() > 57;
+  if (!was_cut) return text;
+  std::size_t end = 57;
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xc0) == 0x80) --end;
+  return text.substr(0, end);
+}
+
+/// A string as JSON writes it (so a message stays one line), cut short.
+std::string escaped(const std::string& text) {
+  bool was_cut = false;
+  const std::string json_text = json(cut(text, was_cut)).dump(-1, ' ', false, json::error_handler_t::replace);
+  return json_text.substr(1, json_text.size() - 2) + (was_cut ? "..." : "");
+}
+
+/// `text` escaped between two `quote` characters. Built by append: GCC 12 warns falsely
+/// (-Wrestrict) on "'" + std::string(...).
+std::string between(char quote, const std::string& text) {
+  std::string result(1, quote);
+  result.append(escaped(text));
+  result.push_back(quote);
+  return result;
+}
+
+/// A name from the file, quoted for a message: 'name'.
+std::string in_quotes(const std::string& text) { return between('\'', text); }
+
 /// A short description of a value for a message: arrays and objects by their size (printing
-/// them costs as much as they hold), strings cut at 57 characters.
+/// them costs as much as they hold), strings cut (fuzz_manifest: cutting the printed text
+/// could split a character, which dump() then refused), numbers as they are.
 std::string shown(const json& value) {
   if (value.is_array()) return "an array of " + std::to_string(value.size()) + " values";
   if (value.is_object()) return "an object of " + std::to_string(value.size()) + " fields";
-  if (value.is_string() && value.get_ref<const std::string&>().size() > 57)
-    return json(value.get_ref<const std::string&>().substr(0, 57)).dump() + "...";
-  std::string text = value.dump();
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
-  return text;
+  if (value.is_string()) return between('"', value.get_ref<const std::string&>());
+  return value.dump(-1, ' ', false, json::error_handler_t::replace);
 }
 
 /// Deeper nesting than any manifest needs is refused while parsing: the parse itself is
@@ -91,7 +117,7 @@ void require_keys(const json& object, const JsonPlace& place,
     if (std::find(allowed.begin(), allowed.end(), item.key()) == allowed.end()) {
       std::string list;
       for (const auto key : allowed) list += (list.empty() ? "" : ", ") + std::string(key);
-      place.format_error("unknown field '" + item.key() + "' (allowed: " + list + ")");
+      place.format_error("unknown field " + in_quotes(item.key()) + " (allowed: " + list + ")");
     }
   }
 }
@@ -122,8 +148,8 @@ double unit_of(const json& value, const JsonPlace& place) {
   const std::string unit = text(value, place);
   try {
     return metres_per_unit(unit);
-  } catch (const InputError& error) {
-    place.input_error(error.what());
+  } catch (const InputError&) {
+    place.input_error("unknown unit " + in_quotes(unit) + " (known: m, cm, mm, um, in, ft)");
   }
 }
 
@@ -258,7 +284,7 @@ Manifest read_manifest(const std::filesystem::path& path) {
         part.contains("name") ? text(part["name"], place.field("name")) : part_file.stem().string();
     if (result.name.empty()) place.field("name").format_error("empty part name");
     if (const auto [it, inserted] = names.emplace(result.name, i); !inserted) {
-      place.field("name").input_error("duplicate part name '" + result.name + "' (also parts[" +
+      place.field("name").input_error("duplicate part name " + in_quotes(result.name) + " (also parts[" +
                                       std::to_string(it->second) + "]; give each part a name)");
     }
     if (part.contains("units")) {

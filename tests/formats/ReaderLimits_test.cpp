@@ -158,5 +158,21 @@ TEST(ReaderLimits, ManifestNumberBeyondDoubleIsAFormatError) {
   test::expect_error<FormatError>([&] { read_manifest(path); }, {path.string(), "not valid JSON", "1e999"});
 }
 
+// Found by fuzz_manifest: a string value cut for the message inside a two-byte character,
+// which nlohmann-json's dump() then refused (type_error 316, no tetrapage::Error).
+TEST(ReaderLimits, ManifestMessagesCutStringsBetweenCharactersAndStayOneLine) {
+  const auto folder = scratch_folder("manifest_strings");
+  const auto path = folder / "strings.json";
+  std::string name = "x";  // then 'v' and a two-byte character: byte 57 is inside one
+  for (int i = 0; i < 40; ++i) name += "v\u02e0";
+  write_file(path, "\"" + name + "\"");
+  test::expect_error<FormatError>([&] { read_manifest(path); }, {path.string(), "top level", "expected an object"});
+  // Names quoted in messages keep them on one line.
+  write_file(path, "{\"units\": \"furlong\\nper fortnight\", \"parts\": [{\"file\": \"a.ply\"}]}");
+  test::expect_error<InputError>([&] { read_manifest(path); }, {path.string(), "'furlong\\nper fortnight'"});
+  write_file(path, "{\"parts\": [{\"file\": \"a.ply\", \"bad\\nfield\": 1}]}");
+  test::expect_error<FormatError>([&] { read_manifest(path); }, {path.string(), "'bad\\nfield'"});
+}
+
 }  // namespace
 }  // namespace tetrapage::test
