@@ -213,6 +213,62 @@ TEST(IndexLimits, StringAttributeClaimingGigabytesIsRejected) {
   expect_capped_format_error(open, {"model.tpi", "'build_report'", "global heap"});
 }
 
+// Found by fuzz_index: HDF5 allocates a whole chunk to read a dataset, so a damaged chunk
+// shape cost gigabytes, and a damaged character size of a variable-length string made HDF5's
+// conversion allocate the length times that size (the strings are now read from their heap
+// objects, not converted).
+TEST(IndexLimits, DamagedChunkShapesAndStringTypesAllocateNothing) {
+  const auto folder = scratch_folder("fuzzed");
+  const auto path = folder / "model.tpi";
+  write_index(path, small_index());
+  edit(path, [](hid_t file) {
+    H5Ldelete(file, "/tables/weights", H5P_DEFAULT);
+    const hsize_t dims = 33, max_dims = H5S_UNLIMITED, chunk = hsize_t{1} << 28;  // 2 GiB of doubles
+    const hid_t space = H5Screate_simple(1, &dims, &max_dims);
+    const hid_t creation = H5Pcreate(H5P_DATASET_CREATE);
+    H5Pset_chunk(creation, 1, &chunk);
+    H5Dclose(H5Dcreate2(file, "/tables/weights", H5T_IEEE_F64LE, space, H5P_DEFAULT, creation, H5P_DEFAULT));
+    H5Pclose(creation);
+    H5Sclose(space);
+  });
+  expect_capped_format_error([&] { IndexReader(path).read_table_double("weights"); },
+                             {"model.tpi", "/tables/weights", "268435456", "chunks"});
+  // A variable-length string's type: 16 bytes stored, then its character type (fixed-point,
+  // 1 byte, 8 bits); each character claimed 2^29 + 1 bytes long.
+  write_index(path, small_index());
+  std::string bytes = test::read_file(path);
+  const std::string character("\x10\x00\x00\x00\x01\x00\x00\x00\x00\x00\x08\x00", 12);
+  int patched = 0;
+  for (std::size_t at = bytes.find(character); at != std::string::npos; at = bytes.find(character, at + 1)) {
+    const std::uint32_t huge = (1u << 29) + 1;
+    std::memcpy(bytes.data() + at + 4, &huge, 4);
+    ++patched;
+  }
+  ASSERT_GE(patched, 5);  // format, precision, source, build_report, created_by
+  test::write_file(path, bytes);
+  const ChildOutcome outcome = run_with_memory_limit([&] { IndexReader reader(path); });
+  EXPECT_TRUE(outcome.kind == "returned" || outcome.kind == "FormatError") << outcome.kind << ": " << outcome.message;
+}
+
+// Found by fuzz_index: HDF5 allocates and reads a filtered chunk at the size its chunk index
+// (a version 1 B-tree, "TREE", node type 1; each key starts with the chunk's stored size)
+// claims, gigabytes in a small file.
+TEST(IndexLimits, ChunkIndexClaimingGigabytesIsRejected) {
+  const auto folder = scratch_folder("chunk_index");
+  const auto path = write_index(folder / "model.tpi", small_index());
+  std::string bytes = test::read_file(path);
+  int patched = 0;
+  for (std::size_t at = bytes.find("TREE"); at != std::string::npos; at = bytes.find("TREE", at + 4)) {
+    if (at + 28 > bytes.size() || bytes[at + 4] != 1 || bytes[at + 5] != 0 || bytes[at + 6] == 0) continue;
+    const std::uint32_t huge = 0xf0000000u;  // the first chunk's stored size
+    std::memcpy(bytes.data() + at + 24, &huge, 4);
+    ++patched;
+  }
+  ASSERT_GT(patched, 0);
+  test::write_file(path, bytes);
+  expect_capped_format_error([&] { IndexReader reader(path); }, {"model.tpi", "stores the chunk", "4026531840"});
+}
+
 TEST(IndexLimits, ShardOfAFileTruncatedUnderTheReaderSaysSo) {
   const auto folder = scratch_folder("truncated");
   const auto path = write_index(folder / "model.tpi", small_index());
