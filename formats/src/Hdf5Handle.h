@@ -4,6 +4,7 @@
 
 #include <hdf5.h>
 
+#include <cstdint>
 #include <string>
 #include <utility>
 
@@ -18,6 +19,20 @@ void enter_hdf5();
 /// The innermost message of the calling thread's HDF5 error stack ("" when empty), then
 /// clears the stack.
 std::string take_hdf5_error();
+
+/// What a file stores for one variable-length string: its claimed length and the global heap
+/// object (collection address, index) that holds its bytes.
+struct StoredVlenString {
+  std::uint64_t length = 0;
+  std::uint64_t heap_address = 0;
+  std::uint32_t heap_index = 0;
+};
+
+/// The stored descriptor of a scalar variable-length string attribute, read without HDF5's
+/// conversion (which allocates the claimed length, twice, before reading a byte of it): a
+/// conversion to an opaque type of our own leaves the stored bytes as they are. `address_bytes`
+/// is the file's size of addresses (H5Pget_sizes). False if HDF5 cannot read the attribute.
+bool read_stored_vlen_string(hid_t attribute, std::size_t address_bytes, StoredVlenString& stored);
 
 /// An owned HDF5 identifier closed by `Close` (H5Fclose, H5Dclose, ...).
 template <herr_t (*Close)(hid_t)>

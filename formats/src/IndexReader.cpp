@@ -8,9 +8,12 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <atomic>
+#include <cstdio>
 #include <cstring>
+#include <map>
 #include <mutex>
 #include <numeric>
 #include <string>
@@ -19,6 +22,7 @@
 
 #include "ChunkCodec.h"
 #include "Hdf5Handle.h"
+#include "TextNumbers.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/SpinThenBlock.h"
 
@@ -82,6 +86,16 @@ bool type_matches(hid_t type, Element element) {
   return false;
 }
 
+std::uint64_t element_bytes(Element element) {
+  switch (element) {
+    case Element::uint8: return 1;
+    case Element::uint32: return 4;
+    case Element::uint64:
+    case Element::float64: return 8;
+  }
+  return 8;
+}
+
 hid_t memory_type(Element element) {
   switch (element) {
     case Element::uint8: return H5T_NATIVE_UINT8;
@@ -125,6 +139,56 @@ struct ChunkLocation {
   std::uint32_t filter_mask = 0;
 };
 
+// What a decoded dataset can hold for each stored byte: 1 unfiltered; through a filter, at
+// most deflate's limit (1032:1; LZ4's is 255:1). A larger claim is damage, not a size.
+constexpr std::uint64_t kMaxFilterRatio = 1032;
+// LZ4 writes at least one byte per 255 it decodes (a chunk's frame and checksum add more).
+constexpr std::uint64_t kMaxLz4Ratio = 256;
+// The writer's largest chunk of /shards/data (IndexWriterOptions).
+constexpr std::uint64_t kMaxChunkBytes = 64u << 20;
+// The least a stored chunk of /shards/data takes: a frame header, a block and the checksum.
+constexpr std::uint64_t kMinStoredChunkBytes = 16;
+
+std::uint64_t load_le(const unsigned char* bytes, std::size_t count) {
+  std::uint64_t value = 0;
+  for (std::size_t i = count; i-- > 0;) value = (value << 8) | bytes[i];
+  return value;
+}
+
+/// Where a variable-length string's bytes lie: HDF5's global heap collection (the HDF5 file
+/// format, "Global Heap"), walked object by object as HDF5 does when it loads one, checked
+/// before HDF5 reads it (HDF5 1.10 trusts the sizes it finds there and reads past the
+/// collection). `collection` is the collection's bytes; "" or what is wrong.
+std::string heap_object_problem(const std::vector<unsigned char>& collection, std::size_t length_bytes,
+                                const detail::StoredVlenString& stored, std::uint64_t& object_at) {
+  const auto align8 = [](std::uint64_t x) { return (x + 7) / 8 * 8; };
+  const std::uint64_t header = align8(8 + length_bytes), object_header = 8 + length_bytes;
+  if (collection.size() < header || std::memcmp(collection.data(), "GCOL", 4) != 0 || collection[4] != 1)
+    return "no global heap collection there";
+  const std::uint64_t size = collection.size();
+  bool found = false;
+  std::uint64_t at = header;
+  while (at < size) {
+    if (size - at < object_header) break;  // too small for an object: free space, as HDF5 reads it
+    const std::uint64_t index = load_le(&collection[at], 2);
+    const std::uint64_t bytes = load_le(&collection[at + 8], length_bytes);
+    if (bytes > size) return "object " + std::to_string(index) + " claims " + std::to_string(bytes) + " bytes";
+    // Index 0 is the free space, whose size counts its header.
+    const std::uint64_t step = index == 0 ? bytes : object_header + align8(bytes);
+    if (step == 0 || step > size - at)
+      return "object " + std::to_string(index) + " of " + std::to_string(bytes) + " bytes runs past the collection";
+    if (index == stored.heap_index && index != 0) {
+      if (bytes != stored.length)
+        return "object " + std::to_string(index) + " holds " + std::to_string(bytes) + " bytes, not " +
+               std::to_string(stored.length);
+      found = true;
+      object_at = at + object_header;
+    }
+    at += step;
+  }
+  return found ? std::string() : "no object " + std::to_string(stored.heap_index) + " in the collection";
+}
+
 }  // namespace
 
 struct IndexReader::Impl {
@@ -132,6 +196,7 @@ struct IndexReader::Impl {
   std::chrono::microseconds spin_before_sleep{100};
   IndexHeader header;
   std::uint64_t file_bytes = 0;
+  timespec modified{};  // when the file was last changed, as it was opened
   Descriptor descriptor;
   FileHandle file;
   DatasetHandle shard_data;
@@ -154,7 +219,13 @@ struct IndexReader::Impl {
   /// False when the file has a user block: chunk addresses are then not file offsets we can
   /// pread() with confidence, so stored chunks come through H5Dread_chunk instead.
   bool raw_reads = true;
+  // The file's user block (where HDF5 addresses start) and its sizes of addresses and lengths.
+  std::uint64_t base_address = 0;
+  std::size_t address_bytes = 8, length_bytes = 8;
   std::vector<std::string> tables;
+  std::uint64_t tet_count = 0;  // rows of /mesh/tets, found at open
+  // Lengths the preprocess's tables must have, fixed by the mesh, the shards and the components.
+  std::map<std::string, std::uint64_t, std::less<>> expected_lengths;
 
   std::string where() const { return "index '" + path.string() + "'"; }
   [[noreturn]] void format_error(const std::string& what) const {
@@ -162,6 +233,32 @@ struct IndexReader::Impl {
   }
   [[noreturn]] void hdf5_format_error(const std::string& what) const {
     throw FormatError(where() + ": " + what + ": " + detail::take_hdf5_error());
+  }
+
+  /// Whether the open file's size or modification time is not what it was when opened: a
+  /// file rewritten or truncated under a running reader, which a message should say rather
+  /// than describe the bytes it now finds.
+  bool file_changed(std::uint64_t& bytes_now) const {
+    struct stat status {};
+    if (::fstat(descriptor.get(), &status) != 0) return false;
+    bytes_now = static_cast<std::uint64_t>(status.st_size);
+    return bytes_now != file_bytes || status.st_mtim.tv_sec != modified.tv_sec ||
+           status.st_mtim.tv_nsec != modified.tv_nsec;
+  }
+
+  /// @throw FormatError for a shard's chunk that cannot be read or decoded: "the file changed or
+  /// is truncated" when it did, or when the chunk read as zeros (HDF5 reads zeros past the end
+  /// of a file), else `problem` as it is. With `hdf5`, HDF5's reason is appended.
+  [[noreturn]] void shard_read_error(const std::string& what, const std::string& problem, bool read_zeros = false,
+                                     bool hdf5 = false) const {
+    const std::string reason = (read_zeros ? std::string("it reads as zeros where data was stored") : problem) +
+                               (hdf5 ? ": " + detail::take_hdf5_error() : std::string());
+    std::uint64_t bytes_now = 0;
+    if (file_changed(bytes_now))
+      format_error("the file changed or is truncated: " + what + ": " + reason + " (the file has " +
+                   std::to_string(bytes_now) + " bytes, " + std::to_string(file_bytes) + " when opened)");
+    if (read_zeros) format_error("the file changed or is truncated: " + what + ": " + reason);
+    format_error(what + ": " + reason);
   }
 
   void check_shard(std::uint32_t shard) const {
@@ -181,6 +278,229 @@ struct IndexReader::Impl {
     if (c < chunks.size() && chunks[c].address != kUnallocated)
       text += " at file offset " + std::to_string(chunks[c].address);
     return text + ")";
+  }
+
+  // ---- opening ----------------------------------------------------------------------------
+
+  void open_file() {
+    descriptor = Descriptor(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
+    if (descriptor.get() < 0) throw IoError("cannot open " + where() + ": " + std::strerror(errno));
+    struct stat status {};
+    if (::fstat(descriptor.get(), &status) != 0)
+      throw IoError("cannot inspect " + where() + ": " + std::strerror(errno));
+    if (!S_ISREG(status.st_mode)) throw IoError("cannot open " + where() + ": not a regular file");
+    file_bytes = static_cast<std::uint64_t>(status.st_size);
+    modified = status.st_mtim;
+
+    const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
+    if (is_hdf5 <= 0) {
+      detail::take_hdf5_error();
+      format_error("not an HDF5 file (no HDF5 signature in its " + std::to_string(file_bytes) +
+                   " bytes); expected a tetrapage index");
+    }
+    file = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+    if (!file) hdf5_format_error("HDF5 cannot open it (damaged or truncated)");
+    PropertyListHandle creation(H5Fget_create_plist(file.get()));
+    hsize_t user_block = 0;
+    std::size_t address_size = 0, length_size = 0;
+    if (!creation || H5Pget_userblock(creation.get(), &user_block) < 0 ||
+        H5Pget_sizes(creation.get(), &address_size, &length_size) < 0)
+      hdf5_format_error("cannot inspect the file creation properties");
+    raw_reads = user_block == 0;
+    base_address = user_block;
+    address_bytes = address_size;
+    length_bytes = length_size;
+  }
+
+  /// The root attributes; the format name first, so a foreign HDF5 file gets the clearest message.
+  void read_header(hid_t g) {
+    if (H5Aexists(g, "format") <= 0)
+      format_error("no root attribute 'format': not a tetrapage index (expected format '" +
+                   std::string(kIndexFormatName) + "')");
+    const std::string format = read_string_attribute(g, "format");
+    if (format != kIndexFormatName)
+      format_error("root attribute 'format' is '" + format + "', expected '" + std::string(kIndexFormatName) +
+                   "': not a tetrapage index");
+    const std::uint64_t version = read_number_attribute<std::uint64_t>(g, "version", 1)[0];
+    if (version != kIndexVersion)
+      format_error("version " + std::to_string(version) + " is not supported (this program reads version " +
+                   std::to_string(kIndexVersion) + "): rebuild the index");
+    IndexHeader& h = header;
+    h.version = static_cast<std::uint32_t>(version);
+    h.precision = read_string_attribute(g, "precision");
+    h.input_triangles = read_number_attribute<std::uint64_t>(g, "input_triangles", 1)[0];
+    h.stored_triangles = read_number_attribute<std::uint64_t>(g, "stored_triangles", 1)[0];
+    h.region_count = read_number_attribute<std::uint64_t>(g, "region_count", 1)[0];
+    h.shard_count = read_number_attribute<std::uint64_t>(g, "shard_count", 1)[0];
+    h.max_rounding_distance = read_number_attribute<double>(g, "max_rounding_distance", 1)[0];
+    const auto bounds = read_number_attribute<double>(g, "bounds", 6);
+    h.bounds.lo = {bounds[0], bounds[1], bounds[2]};
+    h.bounds.hi = {bounds[3], bounds[4], bounds[5]};
+    h.source = read_string_attribute(g, "source");
+    h.build_report_json = read_string_attribute(g, "build_report");
+    h.created_by = read_string_attribute(g, "created_by");
+  }
+
+  /// The shapes of the mesh's datasets (read_mesh reads them).
+  void check_mesh_shapes() {
+    DatasetHandle vertices = open_dataset("/mesh/vertices");
+    const auto vertex_rows = check_dataset(vertices.get(), "/mesh/vertices", Element::float64, 3);
+    check_dataset_size(vertices.get(), "/mesh/vertices", Element::float64, vertex_rows, 3);
+    DatasetHandle tets = open_dataset("/mesh/tets");
+    const auto tet_rows = check_dataset(tets.get(), "/mesh/tets", Element::uint32, 4);
+    check_dataset_size(tets.get(), "/mesh/tets", Element::uint32, tet_rows, 4);
+    DatasetHandle neighbours = open_dataset("/mesh/neighbours");
+    const auto neighbour_rows = check_dataset(neighbours.get(), "/mesh/neighbours", Element::uint32, 4);
+    if (tet_rows != neighbour_rows)
+      format_error("'/mesh/tets' has " + std::to_string(tet_rows) + " rows but '/mesh/neighbours' has " +
+                   std::to_string(neighbour_rows));
+    // Indices are 32-bit: no more vertices or tets than they can name.
+    if (vertex_rows > 0xffffffffu || tet_rows >= 0xffffffffu)
+      format_error("the mesh has " + std::to_string(vertex_rows) + " vertices and " + std::to_string(tet_rows) +
+                   " tets, more than 32-bit indices can name");
+    tet_count = tet_rows;
+  }
+
+  /// The names under /tables (each is read on demand).
+  void list_tables() {
+    GroupHandle group(H5Lexists(file.get(), "tables", H5P_DEFAULT) > 0 ? H5Gopen2(file.get(), "tables", H5P_DEFAULT)
+                                                                      : H5I_INVALID_HID);
+    if (!group) format_error("group '/tables' is missing");
+    hsize_t index = 0;
+    const auto collect = [](hid_t, const char* name, const H5L_info_t*, void* names) -> herr_t {
+      static_cast<std::vector<std::string>*>(names)->emplace_back(name);
+      return 0;
+    };
+    if (H5Literate(group.get(), H5_INDEX_NAME, H5_ITER_INC, &index, collect, &tables) < 0)
+      hdf5_format_error("cannot list '/tables'");
+    std::sort(tables.begin(), tables.end());
+  }
+
+  // ---- what the header says, checked -------------------------------------------------------
+
+  /// The header's own values: a known precision, a rounding distance that is a distance (and
+  /// 0 where nothing is rounded), bounds that are finite and not inverted (or the empty box).
+  void check_header_values() const {
+    const IndexHeader& h = header;
+    if (h.precision != "float" && h.precision != "double" && h.precision != "exact")
+      format_error("root attribute 'precision' is '" + h.precision + "', expected 'exact', 'float' or 'double'");
+    if (h.shard_count >= 0xffffffffu)
+      format_error("root attribute 'shard_count' is " + std::to_string(h.shard_count) + ", more than 2^32 - 1");
+    const double distance = h.max_rounding_distance;
+    if (!std::isfinite(distance) || distance < 0)
+      format_error("root attribute 'max_rounding_distance' is " + number_text(distance) +
+                   ", expected a finite distance >= 0");
+    if (h.precision != "float" && distance != 0)
+      format_error("root attribute 'max_rounding_distance' is " + number_text(distance) + ", but precision '" +
+                   h.precision + "' stores coordinates unrounded (expected 0)");
+    const BoundingBox& b = h.bounds;
+    if (is_empty_convention(b)) return;
+    for (int a = 0; a < 3; ++a) {
+      if (!std::isfinite(b.lo[a]) || !std::isfinite(b.hi[a]))
+        format_error("root attribute 'bounds' holds " + number_text(!std::isfinite(b.lo[a]) ? b.lo[a] : b.hi[a]) +
+                     " on axis " + "xyz"[a] + ", expected finite coordinates");
+      if (b.lo[a] > b.hi[a])
+        format_error("root attribute 'bounds' is inverted on axis " + std::string(1, "xyz"[a]) + " (lo " +
+                     number_text(b.lo[a]) + ", hi " + number_text(b.hi[a]) + ")");
+    }
+  }
+
+  /// The writer's empty box (lo 1e300, hi -1e300), for a model without triangles.
+  static bool is_empty_convention(const BoundingBox& b) {
+    const BoundingBox empty;
+    return b.lo == empty.lo && b.hi == empty.hi;
+  }
+
+  /// The shortest text that reads back as `value` ("1e-07", "nan").
+  static std::string number_text(double value) {
+    std::string text;
+    detail::append_double(text, value);
+    return text;
+  }
+
+  /// The tables the preprocess writes have lengths the other tables fix (docs/FORMAT.md):
+  /// checked from their shapes before any is read, and again (as a bound) when one is.
+  void check_table_lengths() {
+    const std::uint64_t shards = header.shard_count;
+    expected_lengths = {{"shard_tet", shards},         {"shard_kind", shards},
+                        {"shard_triangles", shards},   {"shard_bounds", 6 * shards},
+                        {"tet_shard", tet_count},      {"reference_points", 3 * tet_count},
+                        {"interior_offsets", tet_count + 1}};
+    if (has_table_named("component_part")) {
+      const std::uint64_t components = table_length("component_part");
+      expected_lengths.emplace("component_closed", components);
+      if (components > file_bytes) format_error("'/tables/component_part' claims " + std::to_string(components) +
+                                                " entries, more than the " + std::to_string(file_bytes) +
+                                                "-byte file can hold");
+      expected_lengths.emplace("component_bounds", 6 * components);
+    }
+    for (const auto& [name, expected] : expected_lengths) {
+      if (!has_table_named(name)) continue;
+      const std::uint64_t length = table_length(name);
+      if (length != expected)
+        format_error("'/tables/" + name + "' has " + std::to_string(length) + " entries, expected " +
+                     std::to_string(expected) + " (" + length_reason(name) + ")");
+    }
+  }
+
+  static std::string length_reason(const std::string& name) {
+    if (name.starts_with("shard_")) return name == "shard_bounds" ? "6 per shard" : "one per shard";
+    if (name.starts_with("component_")) return name == "component_bounds" ? "6 per component" : "one per component";
+    if (name == "reference_points") return "3 per tet";
+    return name == "interior_offsets" ? "one per tet, and one" : "one per tet";
+  }
+
+  bool has_table_named(std::string_view name) const { return std::binary_search(tables.begin(), tables.end(), name); }
+
+  /// A table's length from its shape, without reading it.
+  std::uint64_t table_length(const std::string& name) const {
+    const std::string dataset_name = "/tables/" + name;
+    DatasetHandle dataset = open_dataset(dataset_name);
+    DataspaceHandle space(H5Dget_space(dataset.get()));
+    hsize_t length = 0;
+    if (!space || H5Sget_simple_extent_ndims(space.get()) != 1 ||
+        H5Sget_simple_extent_dims(space.get(), &length, nullptr) < 0)
+      format_error("'" + dataset_name + "' is not a 1-D dataset");
+    return length;
+  }
+
+  /// The model's bounds against the data: the coarse mesh covers them (the preprocess encloses
+  /// the model in a larger box), and they hold every shard's stored triangles (grown by the
+  /// rounding distance and the few ulps the builder adds).
+  void check_bounds_against_data() const {
+    const BoundingBox& b = header.bounds;
+    const bool empty_model = is_empty_convention(b);
+    BoundingBox mesh_box;
+    for (const Vec3& v : mesh_vertices()) mesh_box.extend(v);
+    if (!empty_model && tet_count > 0)
+      for (int a = 0; a < 3; ++a)
+        if (!(mesh_box.lo[a] <= b.lo[a] && b.hi[a] <= mesh_box.hi[a]))
+          format_error("root attribute 'bounds' [" + number_text(b.lo[a]) + ", " + number_text(b.hi[a]) +
+                       "] on axis " + "xyz"[a] + " is not inside the coarse mesh's [" + number_text(mesh_box.lo[a]) +
+                       ", " + number_text(mesh_box.hi[a]) + "]");
+    if (!has_table_named("shard_bounds")) return;
+    const auto boxes = read_table<double>("shard_bounds");
+    for (std::size_t s = 0; 6 * s + 5 < boxes.size(); ++s) {
+      const BoundingBox box{{boxes[6 * s], boxes[6 * s + 1], boxes[6 * s + 2]},
+                            {boxes[6 * s + 3], boxes[6 * s + 4], boxes[6 * s + 5]}};
+      if (is_empty_convention(box)) continue;  // a shard without triangles
+      for (int a = 0; a < 3; ++a) {
+        const double slack = header.max_rounding_distance + 0x1p-40 * std::max(std::fabs(b.lo[a]), std::fabs(b.hi[a]));
+        if (!empty_model && b.lo[a] - slack <= box.lo[a] && box.hi[a] <= b.hi[a] + slack) continue;
+        const std::string shard_box = "shard " + std::to_string(s) + "'s box [" + number_text(box.lo[a]) + ", " +
+                                      number_text(box.hi[a]) + "] on axis " + "xyz"[a] + " ('/tables/shard_bounds')";
+        if (empty_model) format_error("root attribute 'bounds' is the empty box, but " + shard_box + " is not");
+        format_error("root attribute 'bounds' [" + number_text(b.lo[a]) + ", " + number_text(b.hi[a]) +
+                     "] does not hold " + shard_box);
+      }
+    }
+  }
+
+  std::vector<Vec3> mesh_vertices() const {
+    const auto values = read_dataset<double>("/mesh/vertices", 3);
+    std::vector<Vec3> vertices(values.size() / 3);
+    std::memcpy(vertices.data(), values.data(), values.size() * sizeof(double));
+    return vertices;
   }
 
   // ---- attributes -------------------------------------------------------------------------
@@ -203,23 +523,50 @@ struct IndexReader::Impl {
       format_error("root attribute '" + std::string(name) + "' is " + describe_type(type.get()) +
                    " with " + std::to_string(H5Sget_simple_extent_npoints(space.get())) +
                    " elements, expected one string");
-    if (H5Tis_variable_str(type.get()) > 0) {
-      DatatypeHandle memory(H5Tcopy(H5T_C_S1));
-      if (!memory || H5Tset_size(memory.get(), H5T_VARIABLE) < 0 ||
-          H5Tset_cset(memory.get(), H5Tget_cset(type.get())) < 0)
-        hdf5_format_error("cannot read root attribute '" + std::string(name) + "'");
-      char* text = nullptr;
-      if (H5Aread(attribute.get(), memory.get(), &text) < 0)
-        hdf5_format_error("cannot read root attribute '" + std::string(name) + "'");
-      std::string value = text != nullptr ? std::string(text) : std::string();
-      H5free_memory(text);
-      return value;
-    }
+    if (H5Tis_variable_str(type.get()) > 0) return stored_string(attribute.get(), name);
+    if (H5Tget_size(type.get()) > file_bytes)
+      format_error("root attribute '" + std::string(name) + "' claims a string of " +
+                   std::to_string(H5Tget_size(type.get())) + " bytes, more than the " +
+                   std::to_string(file_bytes) + "-byte file holds");
     std::string value(H5Tget_size(type.get()), '\0');
     if (H5Aread(attribute.get(), type.get(), value.data()) < 0)
       hdf5_format_error("cannot read root attribute '" + std::string(name) + "'");
     value.resize(std::strlen(value.c_str()));  // fixed-length strings are padded with NULs
     return value;
+  }
+
+  /// A variable-length string attribute, read from the global heap object that holds it once
+  /// its claimed length is checked against the file and the object against its collection.
+  /// Not through HDF5's conversion: HDF5 1.10 allocates the claimed length twice (and, for a
+  /// damaged type, the length times a damaged character size: fuzz_index) before reading.
+  std::string stored_string(hid_t attribute, const char* name) const {
+    detail::StoredVlenString stored;
+    if (!detail::read_stored_vlen_string(attribute, address_bytes, stored))
+      hdf5_format_error("cannot read root attribute '" + std::string(name) + "'");
+    const std::string what = "root attribute '" + std::string(name) + "'";
+    if (stored.length > file_bytes)
+      format_error(what + " claims a string of " + std::to_string(stored.length) + " bytes, more than the " +
+                   std::to_string(file_bytes) + "-byte file holds");
+    if (stored.length == 0) return {};  // nothing is stored in the heap
+    const std::uint64_t offset = base_address + stored.heap_address;
+    const std::string place = " (global heap collection at " + std::to_string(stored.heap_address) + ", object " +
+                              std::to_string(stored.heap_index) + ")";
+    unsigned char head[16];
+    if (offset > file_bytes || file_bytes - offset < sizeof head)
+      format_error(what + ": its string" + place + " lies past the end of the " + std::to_string(file_bytes) +
+                   "-byte file");
+    pread_all(reinterpret_cast<std::byte*>(head), sizeof head, offset, what);
+    const std::uint64_t size = load_le(head + 8, std::min<std::size_t>(length_bytes, 8));
+    if (size > file_bytes - offset)
+      format_error(what + ": its string" + place + " is in a collection of " + std::to_string(size) +
+                   " bytes, past the end of the " + std::to_string(file_bytes) + "-byte file");
+    std::vector<unsigned char> collection(size);
+    pread_all(reinterpret_cast<std::byte*>(collection.data()), size, offset, what);
+    std::uint64_t object_at = 0;
+    const std::string problem = heap_object_problem(collection, length_bytes, stored, object_at);
+    if (!problem.empty()) format_error(what + ": its string" + place + ": " + problem);
+    const auto* text = reinterpret_cast<const char*>(collection.data() + object_at);
+    return std::string(text, std::find(text, text + stored.length, '\0'));
   }
 
   template <class T>
@@ -283,10 +630,73 @@ struct IndexReader::Impl {
     return dims[0];
   }
 
+  /// A dataset's claimed size against the file's, before anything is sized by it: stored
+  /// unfiltered, it cannot decode to more bytes than the file has; through a compressing
+  /// filter, to more than deflate's ratio allows.
+  void check_dataset_size(hid_t dataset, const std::string& name, Element element, std::uint64_t rows,
+                          std::uint64_t columns) const {
+    PropertyListHandle creation(H5Dget_create_plist(dataset));
+    if (!creation) hdf5_format_error("cannot inspect '" + name + "'");
+    std::uint64_t ratio = 1;
+    const int filters = H5Pget_nfilters(creation.get());
+    for (int f = 0; f < filters; ++f) {
+      unsigned flags = 0;
+      std::size_t values = 0;
+      if (H5Pget_filter2(creation.get(), static_cast<unsigned>(f), &flags, &values, nullptr, 0, nullptr,
+                         nullptr) != H5Z_FILTER_FLETCHER32)
+        ratio = kMaxFilterRatio;
+    }
+    const std::uint64_t row_bytes = std::max<std::uint64_t>(columns, 1) * element_bytes(element);
+    if (rows > file_bytes / row_bytes * ratio)
+      format_error("'" + name + "' claims " + std::to_string(rows) + " rows of " + std::to_string(row_bytes) +
+                   " bytes, more than the " + std::to_string(file_bytes) + "-byte file can hold");
+    if (H5Pget_layout(creation.get()) != H5D_CHUNKED) return;
+    // HDF5 allocates a whole chunk to read one: a damaged chunk shape must not size gigabytes.
+    std::array<hsize_t, 2> chunk{1, 1};
+    const int rank = H5Pget_chunk(creation.get(), 2, chunk.data());
+    std::uint64_t chunk_bytes = element_bytes(element);
+    for (int d = 0; d < std::min(rank, 2); ++d)
+      chunk_bytes = chunk[d] > kMaxChunkBytes ? kMaxChunkBytes + 1
+                                              : std::min<std::uint64_t>(chunk_bytes * chunk[d], kMaxChunkBytes + 1);
+    if (rank < 1 || chunk[0] == 0 || chunk_bytes > kMaxChunkBytes)
+      format_error("'" + name + "' has chunks of " + std::to_string(chunk[0]) + " x " + std::to_string(chunk[1]) +
+                   " elements, more than " + std::to_string(kMaxChunkBytes) + " bytes");
+    check_stored_chunks(dataset, name, rows, chunk[0]);
+  }
+
+  /// Each stored chunk's size from the chunk index against the file's: HDF5 allocates and
+  /// reads a filtered chunk at the size its index claims (fuzz_index: 3.5 GB in a 60 KB file).
+  void check_stored_chunks(hid_t dataset, const std::string& name, std::uint64_t rows, std::uint64_t chunk_rows) const {
+    const std::uint64_t chunks = rows / chunk_rows + (rows % chunk_rows != 0);
+    if (chunks > file_bytes / kMinStoredChunkBytes)  // the writer stores every chunk it uses
+      format_error("'" + name + "' claims " + std::to_string(chunks) + " chunks of " + std::to_string(chunk_rows) +
+                   " rows, more than the " + std::to_string(file_bytes) + "-byte file can store");
+    for (std::uint64_t first = 0; first < rows; first += chunk_rows) {
+      std::array<hsize_t, 2> coordinate{first, 0};
+      hsize_t stored = 0;
+      if (H5Dget_chunk_storage_size(dataset, coordinate.data(), &stored) < 0) {
+        detail::take_hdf5_error();  // an unallocated chunk reads as fill values
+        continue;
+      }
+      if (stored > file_bytes)
+        format_error("'" + name + "' stores the chunk at row " + std::to_string(first) + " in " +
+                     std::to_string(stored) + " bytes, more than the " + std::to_string(file_bytes) + "-byte file");
+    }
+  }
+
+  static constexpr std::uint64_t kAnyRows = ~std::uint64_t{0};
+
+  /// The whole dataset; with `expected_rows`, a dataset of another length is rejected first.
   template <class T>
-  std::vector<T> read_dataset(const std::string& name, std::uint64_t columns) const {
+  std::vector<T> read_dataset(const std::string& name, std::uint64_t columns,
+                              std::uint64_t expected_rows = kAnyRows,
+                              const std::string& expected_by = std::string()) const {
     DatasetHandle dataset = open_dataset(name);
     const std::uint64_t rows = check_dataset(dataset.get(), name, element_of<T>(), columns);
+    if (expected_rows != kAnyRows && rows != expected_rows)
+      format_error("'" + name + "' has " + std::to_string(rows) + " entries, expected " +
+                   std::to_string(expected_rows) + " (" + expected_by + ")");
+    check_dataset_size(dataset.get(), name, element_of<T>(), rows, columns);
     std::vector<T> values(rows * std::max<std::uint64_t>(columns, 1));
     if (!values.empty() && H5Dread(dataset.get(), memory_type(element_of<T>()), H5S_ALL, H5S_ALL,
                                    H5P_DEFAULT, values.data()) < 0)
@@ -299,7 +709,9 @@ struct IndexReader::Impl {
     detail::enter_hdf5();
     if (!std::binary_search(tables.begin(), tables.end(), name))
       format_error("table '/tables/" + std::string(name) + "' is missing");
-    return read_dataset<T>("/tables/" + std::string(name), 0);
+    const auto expected = expected_lengths.find(name);
+    if (expected == expected_lengths.end()) return read_dataset<T>("/tables/" + std::string(name), 0);
+    return read_dataset<T>("/tables/" + std::string(name), 0, expected->second, length_reason(expected->first));
   }
 
   // ---- shard data -------------------------------------------------------------------------
@@ -307,14 +719,26 @@ struct IndexReader::Impl {
   void check_shard_data_layout() {
     const std::string name = "/shards/data";
     // 8-byte words (the shuffle filter's element); extents and chunks are counted in bytes.
-    data_extent = check_dataset(shard_data.get(), name, Element::uint64, 0) * kWordBytes;
+    const std::uint64_t words = check_dataset(shard_data.get(), name, Element::uint64, 0);
+    if (words > file_bytes / kMinStoredChunkBytes * (kMaxChunkBytes / kWordBytes))
+      format_error("'" + name + "' claims " + std::to_string(words) + " words, more than the " +
+                   std::to_string(file_bytes) + "-byte file can hold");
+    data_extent = words * kWordBytes;
     PropertyListHandle creation(H5Dget_create_plist(shard_data.get()));
     if (!creation) hdf5_format_error("cannot inspect '" + name + "'");
     if (H5Pget_layout(creation.get()) != H5D_CHUNKED) format_error("'" + name + "' is not chunked");
     hsize_t chunk = 0;
-    if (H5Pget_chunk(creation.get(), 1, &chunk) != 1 || chunk == 0 || chunk > 0xffffffffu / kWordBytes)
-      format_error("'" + name + "' has an unusable chunk shape");
+    if (H5Pget_chunk(creation.get(), 1, &chunk) != 1 || chunk == 0 || chunk > kMaxChunkBytes / kWordBytes)
+      format_error("'" + name + "' has an unusable chunk shape (" + std::to_string(chunk) + " words; at most " +
+                   std::to_string(kMaxChunkBytes / kWordBytes) + ")");
     chunk_bytes = static_cast<std::uint32_t>(chunk * kWordBytes);
+    // Every chunk a shard uses is stored, in a few bytes at least: the chunk table that locating
+    // them fills (inspect, validate) is sized by this.
+    const std::uint64_t chunk_count = data_extent / chunk_bytes + (data_extent % chunk_bytes != 0);
+    if (chunk_count > file_bytes / kMinStoredChunkBytes)
+      format_error("'" + name + "' claims " + std::to_string(data_extent / kWordBytes) + " words (" +
+                   std::to_string(data_extent) + " bytes) in " + std::to_string(chunk_count) +
+                   " chunks, more than the " + std::to_string(file_bytes) + "-byte file can hold");
     const int filters = H5Pget_nfilters(creation.get());
     std::array<H5Z_filter_t, 3> expected{H5Z_FILTER_SHUFFLE, detail::kLz4FilterId, H5Z_FILTER_FLETCHER32};
     bool pipeline_ok = filters == 3;
@@ -398,8 +822,7 @@ struct IndexReader::Impl {
         throw IoError("cannot read " + what + " of " + where() + ": " + std::strerror(errno));
       }
       if (got == 0)
-        format_error(what + " lies past the end of the file (truncated at " +
-                     std::to_string(offset) + " bytes?)");
+        shard_read_error(what, "it lies past the end of the file (at byte " + std::to_string(offset) + ")");
       buffer += got;
       bytes -= static_cast<std::uint64_t>(got);
       offset += static_cast<std::uint64_t>(got);
@@ -417,14 +840,27 @@ struct IndexReader::Impl {
     hsize_t coordinate = (first_chunk(shard) + k) * chunk_bytes / kWordBytes;
     hsize_t stored_bytes = 0;
     if (H5Dget_chunk_storage_size(shard_data.get(), &coordinate, &stored_bytes) < 0)
-      hdf5_format_error("cannot locate " + chunk_name(shard, k));
-    if (stored_bytes == 0) format_error(chunk_name(shard, k) + " is not stored");
+      shard_read_error(chunk_name(shard, k), "cannot locate it", false, true);
+    if (stored_bytes == 0) shard_read_error(chunk_name(shard, k), "it is not stored");
     if (stored_bytes > max_stored_bytes())
       format_error(chunk_name(shard, k) + " claims " + std::to_string(stored_bytes) +
                    " stored bytes for a " + std::to_string(chunk_bytes) + "-byte chunk");
     stored.resize(stored_bytes);
     if (H5Dread_chunk(shard_data.get(), H5P_DEFAULT, &coordinate, &mask, stored.data()) < 0)
-      hdf5_format_error("cannot read " + chunk_name(shard, k));
+      shard_read_error(chunk_name(shard, k), "cannot read it", false, true);
+  }
+
+  /// Bytes of the shard's payload that chunk k holds.
+  std::uint64_t payload_in_chunk(std::uint32_t shard, std::uint64_t k) const {
+    return std::min<std::uint64_t>(chunk_bytes, sizes[shard] - k * chunk_bytes);
+  }
+
+  /// A stored chunk's size against the payload it must decode to, before the payload is
+  /// allocated: LZ4 cannot decode more than kMaxLz4Ratio bytes per stored byte.
+  void check_stored_claim(std::uint32_t shard, std::uint64_t k, std::uint64_t stored_bytes) const {
+    if (stored_bytes * kMaxLz4Ratio < payload_in_chunk(shard, k))
+      format_error(chunk_name(shard, k) + " holds " + std::to_string(stored_bytes) + " stored bytes for " +
+                   std::to_string(payload_in_chunk(shard, k)) + " bytes of payload, more than LZ4 decodes to");
   }
 
   /// Checks and decompresses stored chunk k of a shard into its place in `payload`. A page-in
@@ -440,15 +876,22 @@ struct IndexReader::Impl {
       whole_chunk->resize(chunk_bytes);
       target = *whole_chunk;
     }
+    // The writer never stores zeros (an LZ4 frame names its size; zeros are compressed), but
+    // HDF5 reads them past the end of a file: checked first, as zeros pass the checksum.
+    if (std::all_of(stored.begin(), stored.end(), [](std::byte b) { return b == std::byte{0}; }))
+      shard_read_error(chunk_name(shard, k), "", true);
     const std::string problem = detail::decode_chunk(stored, filter_mask, target, chunk_bytes);
-    if (!problem.empty()) format_error(chunk_name(shard, k) + ": " + problem);
+    if (!problem.empty()) shard_read_error(chunk_name(shard, k), problem);
     if (target.data() != payload.data() + begin) std::memcpy(payload.data() + begin, target.data(), bytes);
   }
 
   void read_shard(std::uint32_t shard, std::vector<std::byte>& payload) const {
     check_shard(shard);
-    payload.resize(sizes[shard]);
-    if (payload.empty()) return;
+    if (sizes[shard] == 0) {
+      payload.clear();
+      return;
+    }
+    // The payload is sized once its chunks are known to be stored, each in enough bytes.
     const std::uint64_t first = first_chunk(shard);
     const std::uint64_t count = chunk_count(shard);
     // Buffers kept by the thread: fresh ones made every page-in fault new pages in (a tenth
@@ -473,6 +916,8 @@ struct IndexReader::Impl {
       stored_total += location.stored_bytes;
     }
     if (one_read && high - low <= stored_total + kMaxHoleBytes) {
+      for (std::uint64_t k = 0; k < count; ++k) check_stored_claim(shard, k, chunks[first + k].stored_bytes);
+      payload.resize(sizes[shard]);
       stored.resize(1);
       stored[0].resize(high - low);
       pread_all(stored[0].data(), stored[0].size(), low, "shard " + std::to_string(shard));
@@ -496,6 +941,8 @@ struct IndexReader::Impl {
       const std::unique_lock lock = lock_spinning_first(chunk_read_mutex(), spin_before_sleep);
       for (std::uint64_t k = 0; k < count; ++k) read_stored_chunk(shard, k, masks[k], stored[k]);
     }
+    for (std::uint64_t k = 0; k < count; ++k) check_stored_claim(shard, k, stored[k].size());
+    payload.resize(sizes[shard]);
     for (std::uint64_t k = 0; k < count; ++k) decode_into(shard, k, stored[k], masks[k], payload);
     constexpr std::size_t kKeptChunks = kKeptBufferBytes / 16384;
     if (stored.size() > kKeptChunks) {  // a rare large shard: keep a megabyte's worth
@@ -515,104 +962,20 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
   detail::enter_hdf5();
   Impl& r = *impl_;
   r.path = path;
-  r.descriptor = Descriptor(::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC));
-  if (r.descriptor.get() < 0)
-    throw IoError("cannot open " + r.where() + ": " + std::strerror(errno));
-  struct stat status {};
-  if (::fstat(r.descriptor.get(), &status) != 0)
-    throw IoError("cannot inspect " + r.where() + ": " + std::strerror(errno));
-  if (!S_ISREG(status.st_mode)) throw IoError("cannot open " + r.where() + ": not a regular file");
-  r.file_bytes = static_cast<std::uint64_t>(status.st_size);
-
-  const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-  if (is_hdf5 <= 0) {
-    detail::take_hdf5_error();
-    r.format_error("not an HDF5 file (no HDF5 signature in its " + std::to_string(r.file_bytes) +
-                   " bytes); expected a tetrapage index");
-  }
-  r.file = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
-  if (!r.file) r.hdf5_format_error("HDF5 cannot open it (damaged or truncated)");
+  r.open_file();
   {
-    PropertyListHandle creation(H5Fget_create_plist(r.file.get()));
-    hsize_t user_block = 0;
-    if (!creation || H5Pget_userblock(creation.get(), &user_block) < 0)
-      r.hdf5_format_error("cannot inspect the file creation properties");
-    r.raw_reads = user_block == 0;
+    GroupHandle root(H5Gopen2(r.file.get(), "/", H5P_DEFAULT));
+    if (!root) r.hdf5_format_error("cannot open the root group");
+    r.read_header(root.get());
   }
-
-  // Root attributes; the format name first, so a foreign HDF5 file gets the clearest message.
-  GroupHandle root(H5Gopen2(r.file.get(), "/", H5P_DEFAULT));
-  if (!root) r.hdf5_format_error("cannot open the root group");
-  const hid_t g = root.get();
-  if (H5Aexists(g, "format") <= 0)
-    r.format_error("no root attribute 'format': not a tetrapage index (expected format '" +
-                   std::string(kIndexFormatName) + "')");
-  const std::string format = r.read_string_attribute(g, "format");
-  if (format != kIndexFormatName)
-    r.format_error("root attribute 'format' is '" + format + "', expected '" +
-                   std::string(kIndexFormatName) + "': not a tetrapage index");
-  const std::uint64_t version = r.read_number_attribute<std::uint64_t>(g, "version", 1)[0];
-  if (version != kIndexVersion)
-    r.format_error("version " + std::to_string(version) + " is not supported (this program reads "
-                   "version " + std::to_string(kIndexVersion) + "): rebuild the index");
-  IndexHeader& h = r.header;
-  h.version = static_cast<std::uint32_t>(version);
-  h.precision = r.read_string_attribute(g, "precision");
-  if (h.precision != "float" && h.precision != "double" && h.precision != "exact")
-    r.format_error("root attribute 'precision' is '" + h.precision +
-                   "', expected 'exact', 'float' or 'double'");
-  h.input_triangles = r.read_number_attribute<std::uint64_t>(g, "input_triangles", 1)[0];
-  h.stored_triangles = r.read_number_attribute<std::uint64_t>(g, "stored_triangles", 1)[0];
-  h.region_count = r.read_number_attribute<std::uint64_t>(g, "region_count", 1)[0];
-  h.shard_count = r.read_number_attribute<std::uint64_t>(g, "shard_count", 1)[0];
-  h.max_rounding_distance = r.read_number_attribute<double>(g, "max_rounding_distance", 1)[0];
-  const auto bounds = r.read_number_attribute<double>(g, "bounds", 6);
-  h.bounds.lo = {bounds[0], bounds[1], bounds[2]};
-  h.bounds.hi = {bounds[3], bounds[4], bounds[5]};
-  h.source = r.read_string_attribute(g, "source");
-  h.build_report_json = r.read_string_attribute(g, "build_report");
-  h.created_by = r.read_string_attribute(g, "created_by");
-  if (h.shard_count >= 0xffffffffu)
-    r.format_error("root attribute 'shard_count' is " + std::to_string(h.shard_count) +
-                   ", more than 2^32 - 1");
-
-  // Shapes of the mesh (read lazily by read_mesh).
-  {
-    DatasetHandle vertices = r.open_dataset("/mesh/vertices");
-    r.check_dataset(vertices.get(), "/mesh/vertices", Element::float64, 3);
-    DatasetHandle tets = r.open_dataset("/mesh/tets");
-    const auto tet_rows = r.check_dataset(tets.get(), "/mesh/tets", Element::uint32, 4);
-    DatasetHandle neighbours = r.open_dataset("/mesh/neighbours");
-    const auto neighbour_rows =
-        r.check_dataset(neighbours.get(), "/mesh/neighbours", Element::uint32, 4);
-    if (tet_rows != neighbour_rows)
-      r.format_error("'/mesh/tets' has " + std::to_string(tet_rows) +
-                     " rows but '/mesh/neighbours' has " + std::to_string(neighbour_rows));
-  }
-
-  // Tables: just their names; each is checked when read.
-  {
-    GroupHandle tables(H5Lexists(r.file.get(), "tables", H5P_DEFAULT) > 0
-                           ? H5Gopen2(r.file.get(), "tables", H5P_DEFAULT)
-                           : H5I_INVALID_HID);
-    if (!tables) r.format_error("group '/tables' is missing");
-    hsize_t index = 0;
-    const auto collect = [](hid_t, const char* name, const H5L_info_t*, void* names) -> herr_t {
-      static_cast<std::vector<std::string>*>(names)->emplace_back(name);
-      return 0;
-    };
-    if (H5Literate(tables.get(), H5_INDEX_NAME, H5_ITER_INC, &index, collect, &r.tables) < 0)
-      r.hdf5_format_error("cannot list '/tables'");
-    std::sort(r.tables.begin(), r.tables.end());
-  }
-
-  // Shards: extents, layout and chunk addresses.
-  r.offsets = r.read_dataset<std::uint64_t>("/shards/offsets", 0);
-  r.sizes = r.read_dataset<std::uint64_t>("/shards/sizes", 0);
-  if (r.offsets.size() != h.shard_count || r.sizes.size() != h.shard_count)
-    r.format_error("'/shards/offsets' has " + std::to_string(r.offsets.size()) +
-                   " entries and '/shards/sizes' " + std::to_string(r.sizes.size()) +
-                   ", but root attribute 'shard_count' is " + std::to_string(h.shard_count));
+  r.check_header_values();
+  r.check_mesh_shapes();
+  // Shards: extents and layout.
+  const IndexHeader& h = r.header;
+  r.offsets = r.read_dataset<std::uint64_t>("/shards/offsets", 0, h.shard_count, "root attribute 'shard_count'");
+  r.sizes = r.read_dataset<std::uint64_t>("/shards/sizes", 0, h.shard_count, "root attribute 'shard_count'");
+  r.list_tables();
+  r.check_table_lengths();
   r.shard_data = r.open_dataset("/shards/data");
   r.check_shard_data_layout();
   const auto problems = r.extent_problems();
@@ -621,6 +984,7 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
                    (problems.size() > 1
                         ? " (and " + std::to_string(problems.size() - 1) + " more problems)"
                         : std::string()));
+  r.check_bounds_against_data();
 }
 
 IndexReader::~IndexReader() = default;
@@ -778,12 +1142,15 @@ std::vector<std::string> IndexReader::validate(
     // on the 10M index.
     std::vector<std::byte> stored, payload, scratch;
     for (std::uint32_t s = 0; s < r.offsets.size(); ++s) {
-      payload.resize(r.sizes[s]);
+      payload.clear();
       bool intact = true;
       for (std::uint64_t k = 0; k < r.chunk_count(s); ++k) {
         try {
           std::uint32_t mask = 0;
           r.read_stored_chunk(s, k, mask, stored);
+          r.check_stored_claim(s, k, stored.size());
+          // Grown with each chunk read, so that a damaged size costs no more than its chunks.
+          payload.resize(k * r.chunk_bytes + r.payload_in_chunk(s, k));
           r.decode_into(s, k, stored, mask, payload, &scratch);
         } catch (const FormatError& error) {
           problems.push_back(error.what());

@@ -32,6 +32,9 @@ InputFile::InputFile(const std::filesystem::path& path, std::size_t block_size)
   }
   ::fcntl(descriptor_, F_SETFL, ::fcntl(descriptor_, F_GETFL) & ~O_NONBLOCK);
   size_ = static_cast<std::uint64_t>(status.st_size);
+  // A small file needs no large block (one byte more than it holds sees its end in one read);
+  // the buffer still grows if the file does.
+  capacity_ = static_cast<std::size_t>(std::min<std::uint64_t>(capacity_, std::max<std::uint64_t>(size_ + 1, 4096)));
   // The kernel reads ahead more aggressively for a file declared sequential.
   ::posix_fadvise(descriptor_, 0, 0, POSIX_FADV_SEQUENTIAL);
   buffer_ = std::make_unique_for_overwrite<char[]>(capacity_);

@@ -3,6 +3,7 @@
 // file in memory. Text readers take it line by line (views into the block), binary readers
 // take fixed-size records; both are views that stay valid until the next call.
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -57,10 +58,14 @@ class InputFile {
     }
   }
 
-  /// Up to `count` bytes (fewer only at the end of the file), consumed.
+  /// Bytes of the file (as large as it was when opened) not handed out yet.
+  std::uint64_t bytes_left() const { return size_ > consumed_ ? size_ - consumed_ : 0; }
+
+  /// Up to `count` bytes (fewer only at the end of the file), consumed. A count beyond the
+  /// file's end reads what is there: it never sizes the buffer (a header's claim may be huge).
   /// @throw IoError on a read failure.
   std::span<const char> take(std::size_t count) {
-    if (end_ - begin_ < count) fill_at_least(count);
+    if (end_ - begin_ < count) fill_at_least(capped(count));
     const std::size_t available = std::min(count, end_ - begin_);
     const char* first = buffer_.get() + begin_;
     consume(available);
@@ -69,11 +74,17 @@ class InputFile {
 
   /// Up to `count` bytes from the current position, not consumed.
   std::string_view peek(std::size_t count) {
-    if (end_ - begin_ < count) fill_at_least(count);
+    if (end_ - begin_ < count) fill_at_least(capped(count));
     return {buffer_.get() + begin_, std::min(count, end_ - begin_)};
   }
 
  private:
+  /// `count`, or what the file held (when opened) past the bytes handed out, if less: what a
+  /// read may wait for. Bytes already buffered stay available either way.
+  std::size_t capped(std::size_t count) const {
+    const std::uint64_t most = std::max<std::uint64_t>(end_ - begin_, bytes_left());
+    return static_cast<std::size_t>(std::min<std::uint64_t>(count, most));
+  }
   void consume(std::size_t count) {
     begin_ += count;
     consumed_ += count;

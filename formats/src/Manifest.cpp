@@ -64,11 +64,52 @@ class JsonPlace {
   std::string path_;
 };
 
-std::string shown(const json& value) {
-  std::string text = value.dump();
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
-  return text;
+/// At most 57 bytes of `text`, not splitting a UTF-8 character (the parser checked it).
+std::string cut(const std::string& text, bool& was_cut) {
+  was_cut = text.size() > 57;
+  if (!was_cut) return text;
+  std::size_t end = 57;
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xc0) == 0x80) --end;
+  return text.substr(0, end);
 }
+
+/// A string as JSON writes it (so a message stays one line), cut short.
+std::string escaped(const std::string& text) {
+  bool was_cut = false;
+  const std::string json_text = json(cut(text, was_cut)).dump(-1, ' ', false, json::error_handler_t::replace);
+  return json_text.substr(1, json_text.size() - 2) + (was_cut ? "..." : "");
+}
+
+/// `text` escaped between two `quote` characters. Built by append: GCC 12 warns falsely
+/// (-Wrestrict) on "'" + std::string(...).
+std::string between(char quote, const std::string& text) {
+  std::string result(1, quote);
+  result.append(escaped(text));
+  result.push_back(quote);
+  return result;
+}
+
+/// A name from the file, quoted for a message: 'name'.
+std::string in_quotes(const std::string& text) { return between('\'', text); }
+
+/// A short description of a value for a message: arrays and objects by their size (printing
+/// them costs as much as they hold), strings cut (fuzz_manifest: cutting the printed text
+/// could split a character, which dump() then refused), numbers as they are.
+std::string shown(const json& value) {
+  if (value.is_array()) return "an array of " + std::to_string(value.size()) + " values";
+  if (value.is_object()) return "an object of " + std::to_string(value.size()) + " fields";
+  if (value.is_string()) return between('"', value.get_ref<const std::string&>());
+  return value.dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+/// Deeper nesting than any manifest needs is refused while parsing: the parse itself is
+/// iterative, but what follows (messages, copies) need not be.
+constexpr int kMaxJsonDepth = 64;
+
+/// Thrown by the parser callback, caught in read_manifest.
+struct TooDeep {
+  int depth = 0;
+};
 
 void require_keys(const json& object, const JsonPlace& place,
                   std::initializer_list<std::string_view> allowed) {
@@ -77,7 +118,7 @@ void require_keys(const json& object, const JsonPlace& place,
     if (std::find(allowed.begin(), allowed.end(), item.key()) == allowed.end()) {
       std::string list;
       for (const auto key : allowed) list += (list.empty() ? "" : ", ") + std::string(key);
-      place.format_error("unknown field '" + item.key() + "' (allowed: " + list + ")");
+      place.format_error("unknown field " + in_quotes(item.key()) + " (allowed: " + list + ")");
     }
   }
 }
@@ -108,8 +149,8 @@ double unit_of(const json& value, const JsonPlace& place) {
   const std::string unit = text(value, place);
   try {
     return metres_per_unit(unit);
-  } catch (const InputError& error) {
-    place.input_error(error.what());
+  } catch (const InputError&) {
+    place.input_error("unknown unit " + in_quotes(unit) + " (known: m, cm, mm, um, in, ft)");
   }
 }
 
@@ -194,10 +235,24 @@ Manifest read_manifest(const std::filesystem::path& path) {
   if (!stream) throw IoError("cannot open manifest '" + file + "': " + std::strerror(errno));
   json document;
   try {
+    // The callback sees each array or object open, with the number already open around it.
+    const json::parser_callback_t limit_depth = [](int depth, json::parse_event_t event, json&) {
+      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+          depth + 1 > kMaxJsonDepth)
+        throw TooDeep{depth + 1};
+      return true;
+    };
     // Comments are allowed, so a manifest can explain itself.
-    document = json::parse(stream, nullptr, true, true);
-  } catch (const json::parse_error& error) {
-    throw FormatError(file + ": not valid JSON: " + error.what());
+    document = json::parse(stream, limit_depth, true, true);
+  } catch (const TooDeep& deep) {
+    throw FormatError(file + ": arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
+                      " levels (depth " + std::to_string(deep.depth) + "); a manifest needs 6");
+  } catch (const json::exception& error) {
+    // A syntax error, or a number beyond double's range (out_of_range, found by fuzzing). Its
+    // text quotes the token read last, which can be as long as the file.
+    std::string what = error.what();
+    if (what.size() > 200) what = what.substr(0, 197) + "...";
+    throw FormatError(file + ": not valid JSON: " + what);
   }
   if (stream.bad()) throw IoError("cannot read manifest '" + file + "'");
 
@@ -231,7 +286,7 @@ Manifest read_manifest(const std::filesystem::path& path) {
         part.contains("name") ? text(part["name"], place.field("name")) : part_file.stem().string();
     if (result.name.empty()) place.field("name").format_error("empty part name");
     if (const auto [it, inserted] = names.emplace(result.name, i); !inserted) {
-      place.field("name").input_error("duplicate part name '" + result.name + "' (also parts[" +
+      place.field("name").input_error("duplicate part name " + in_quotes(result.name) + " (also parts[" +
                                       std::to_string(it->second) + "]; give each part a name)");
     }
     if (part.contains("units")) {

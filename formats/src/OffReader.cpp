@@ -31,6 +31,18 @@ bool is_off_keyword(std::string_view keyword) {
   return keyword.empty();
 }
 
+/// The counts must fit in what follows, before they size anything: every vertex and face
+/// takes a line of at least 2 bytes (a token and its newline; the last line needs none).
+void check_counts_fit(const InputFile& file, std::uint64_t vertex_count, std::uint64_t face_count) {
+  constexpr std::uint64_t line_bytes = 2;
+  const std::uint64_t lines = file.bytes_left() / line_bytes + 1;
+  const bool fits = vertex_count <= lines && face_count <= lines - vertex_count;
+  if (!fits)
+    throw FormatError(where_line(file) + "the header announces " + std::to_string(vertex_count) +
+                      " vertices and " + std::to_string(face_count) + " faces, more than the " +
+                      std::to_string(file.bytes_left()) + " bytes after it can hold");
+}
+
 }  // namespace
 
 TriangleSoup read_off(InputFile& file, ReadReport& report) {
@@ -60,6 +72,7 @@ TriangleSoup read_off(InputFile& file, ReadReport& report) {
                         quote_token(std::string(vertices_token) + " " + std::string(faces_token)));
     }
   }
+  check_counts_fit(file, vertex_count, face_count);
   if (vertex_count > max_vertices) {
     throw InputError(where_line(file) + std::to_string(vertex_count) +
                      " vertices are more than a soup can index");

@@ -100,6 +100,14 @@ struct PlyElement {
   std::string name;
   std::uint64_t count = 0;
   std::vector<PlyProperty> properties;
+  /// The fewest bytes a record can take: binary, each scalar and each list's count (an empty
+  /// list); ASCII, a token and a separator per property.
+  std::uint64_t minimal_size(bool ascii) const {
+    std::uint64_t size = 0;
+    for (const auto& property : properties)
+      size += ascii ? 2 : size_of(property.is_list ? property.count_type : property.type);
+    return size;
+  }
   /// Bytes per record when no property is a list, else 0.
   std::size_t fixed_size() const {
     std::size_t size = 0;
@@ -179,6 +187,25 @@ PlyHeader read_header(InputFile& file) {
   }
   if (!have_format) throw FormatError(file.name() + ": the header has no 'format' line");
   return header;
+}
+
+/// Every element's announced records must fit in what follows the header, each at its minimal
+/// size, before anything is sized by a count (a 300-byte file may announce 2^32 faces).
+void check_counts_fit(const InputFile& file, const PlyHeader& header) {
+  const bool ascii = header.encoding == PlyEncoding::ascii;
+  // ASCII: the last token of the file needs no separator.
+  const std::uint64_t available = file.bytes_left() + (ascii ? 1 : 0);
+  std::uint64_t needed = 0;
+  for (const auto& element : header.elements) {
+    const std::uint64_t record = element.minimal_size(ascii);
+    if (record == 0 || element.count == 0) continue;
+    if (element.count > (available - needed) / record)
+      throw FormatError(file.name() + ": element '" + element.name + "' announces " +
+                        std::to_string(element.count) + " records of at least " +
+                        std::to_string(record) + " bytes, but only " + std::to_string(file.bytes_left()) +
+                        " bytes follow the header" + (needed > 0 ? " and the elements before it" : ""));
+    needed += element.count * record;
+  }
 }
 
 /// Where x, y, z and the face corners sit in their elements.
@@ -275,7 +302,13 @@ class BinaryPlyReader {
       throw FormatError(where_element(file_, element.name, index) + "negative list count " +
                         std::to_string(count) + " for '" + property.name + "'");
     }
-    return take(static_cast<std::size_t>(count) * size_of(property.type), element, index);
+    const std::size_t item_size = size_of(property.type);
+    if (static_cast<std::uint64_t>(count) > file_.bytes_left() / item_size)
+      throw FormatError(where_element(file_, element.name, index) + "truncated: list '" + property.name +
+                        "' announces " + std::to_string(count) + " items of " + std::to_string(item_size) +
+                        " bytes, which needs more than the " + std::to_string(file_.bytes_left()) +
+                        " bytes left");
+    return take(static_cast<std::size_t>(count) * item_size, element, index);
   }
 
   void read_vertices(const PlyElement& element) {
@@ -347,6 +380,7 @@ class BinaryPlyReader {
   }
 
   void skip(const PlyElement& element) {
+    if (element.properties.empty()) return;  // records of nothing, however many
     const std::size_t record_size = element.fixed_size();
     if (record_size > 0) {
       // Skip in blocks rather than record by record; report the first record that is missing.
@@ -392,6 +426,7 @@ class AsciiPlyReader {
       : file_(file), tokens_(file), soup_(soup), layout_(layout) {}
 
   void read_element(const PlyElement& element) {
+    if (element.properties.empty()) return;  // records of nothing, however many
     const bool is_vertex = &element == layout_.vertex;
     const bool is_face = &element == layout_.face;
     for (std::uint64_t r = 0; r < element.count; ++r) {
@@ -447,6 +482,11 @@ class AsciiPlyReader {
       throw FormatError(where_line(file_) + element.name + " " + std::to_string(r) +
                         ": bad list count " + quote_token(token) + " for '" + property.name + "'");
     }
+    // Each item is a token and a separator (the file's last one needs none).
+    if (static_cast<std::uint64_t>(count) > tokens_.bytes_left() / 2 + 1)
+      throw FormatError(where_line(file_) + element.name + " " + std::to_string(r) + ": list '" +
+                        property.name + "' announces " + std::to_string(count) + " items, but only " +
+                        std::to_string(tokens_.bytes_left()) + " bytes are left");
     return count;
   }
 
@@ -487,6 +527,7 @@ class AsciiPlyReader {
 TriangleSoup read_ply(InputFile& file, ReadReport& report) {
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);
+  check_counts_fit(file, header);
   SoupBuilder soup(file.name(), report);
   soup.begin_part(file.path().stem().string());
   soup.reserve(layout.vertex->count, layout.face != nullptr ? layout.face->count : 0, file.size());

@@ -117,6 +117,8 @@ class TokenReader {
   }
   /// Drops what is left of the current line.
   void skip_line() { rest_ = {}; }
+  /// Bytes not tokenised yet: the rest of the current line and what the file has left.
+  std::uint64_t bytes_left() const { return rest_.size() + file_.bytes_left(); }
   const InputFile& file() const { return file_; }
 
  private:

@@ -50,8 +50,9 @@ IndexHeader sample_header() {
   header.stored_triangles = 234567890123ULL;
   header.region_count = 77;
   header.max_rounding_distance = 1.5e-7;
-  header.bounds.extend(Vec3{-1.25, 2.5, -3e9});
-  header.bounds.extend(Vec3{4.0, 5e-9, 6.0});
+  // Inside random_mesh's vertices (the reader checks that the coarse mesh covers the model).
+  header.bounds.extend(Vec3{-1.25e8, -0.5, -0.25});
+  header.bounds.extend(Vec3{4.0, 5e-9, 0.125});
   header.source = "scene.glb sha256:0123abcd é";
   // Larger than HDF5's 64 KiB limit for compact attributes.
   header.build_report_json = "{\"pad\":\"" + std::string(200000, 'x') + "\"}";

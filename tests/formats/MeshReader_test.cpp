@@ -466,6 +466,9 @@ TEST(OffReader, ErrorsNameFileLineAndValue) {
   expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "2 of 3 vertices"});
   write_file(path, "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
   expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "1 of 2 faces"});
+  // Counts the file's size cannot hold: every vertex and face takes a line.
+  write_file(path, "OFF\n3 100 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "line 2", "100 faces", "26 bytes"});
   write_file(path, "OFF\nthree 1 0\n");
   expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "line 2", "three"});
   write_file(path, "OFF\n3 1 0\n0 0 0\n1 -nan 0\n0 1 0\n3 0 1 2\n");

@@ -1,0 +1,79 @@
+#pragma once
+// What the index fuzz targets do with a file: everything a reader of an index does, as the
+// runtime and `tetrapage validate` do it: open, the mesh, every table, every shard read
+// (through HDF5's chunk index, then through the located chunks) and decoded by the runtime's
+// Shard::decode with every check, then validate(). Each step must succeed or throw a
+// tetrapage::Error.
+
+#include <algorithm>
+#include <filesystem>
+#include <vector>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/runtime/Shard.h"
+
+namespace tetrapage::fuzz {
+
+/// Each table through the one typed read that accepts it.
+inline void read_tables(const IndexReader& reader) {
+  for (const std::string& name : reader.table_names()) {
+    try {
+      (void)reader.read_table_uint8(name);
+      continue;
+    } catch (const FormatError&) {
+    }
+    try {
+      (void)reader.read_table_uint32(name);
+      continue;
+    } catch (const FormatError&) {
+    }
+    try {
+      (void)reader.read_table_uint64(name);
+      continue;
+    } catch (const FormatError&) {
+    }
+    try {
+      (void)reader.read_table_double(name);
+    } catch (const FormatError&) {
+    }
+  }
+}
+
+inline void read_and_decode_shards(const IndexReader& reader, std::uint32_t shards) {
+  std::vector<std::byte> payload;
+  for (std::uint32_t s = 0; s < shards; ++s) {
+    try {
+      reader.read_shard(s, payload);
+      if (payload.size() != reader.shard_size(s)) __builtin_trap();
+      (void)Shard::decode(payload, "fuzz shard", DecodeChecks::full);
+    } catch (const Error&) {
+    }
+  }
+}
+
+inline void read_whole_index(const std::filesystem::path& path) {
+  try {
+    const IndexReader reader(path);
+    try {
+      (void)reader.read_mesh();
+    } catch (const Error&) {
+    }
+    read_tables(reader);
+    // A bound on the work per input, not on what the reader accepts.
+    const std::uint32_t shards = std::min<std::uint32_t>(reader.shard_count(), 256);
+    read_and_decode_shards(reader, shards);
+    if (shards > 0) {
+      try {
+        (void)reader.shard_chunks(0);  // locates every chunk: page-ins then pread() them
+        (void)reader.stored_shard_size(0);
+      } catch (const Error&) {
+      }
+      read_and_decode_shards(reader, shards);
+    }
+    (void)reader.validate();
+  } catch (const Error&) {
+  }
+}
+
+}  // namespace tetrapage::fuzz
