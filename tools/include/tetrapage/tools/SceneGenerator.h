@@ -82,8 +82,8 @@ struct SceneSummary {
 /// copy draws a cut and keeps the triangles with a corner on or below its plane, and of those
 /// only the largest connected piece (a cut can sever a leg or a knot's arc). The budget counts
 /// the kept triangles, so the total is still within half the smallest mesh of the target (or
-/// the smallest mesh itself for a tiny target). With f = 0 nothing more is drawn: the plan
-/// is the all-closed one of earlier versions.
+/// the smallest mesh itself for a tiny target). With f = 0 nothing more is drawn from the
+/// random stream, so the all-closed plan is the same as without the option.
 /// @throw InputError if triangles is 0 or above max_scene_triangles, or f is not in [0, 1].
 std::vector<PlannedCopy> plan_scene_copies(const MeshLibrary& library, std::uint64_t triangles,
                                            double open_fraction, Random& random);
