@@ -267,14 +267,15 @@ class BucketCopies {
               std::vector<std::uint64_t>& ids, std::vector<std::uint32_t>& parts) const {
     if (soups_) {
       const std::size_t had = ids.size();
-      for (std::size_t i = first; i < last; ++i) ids.push_back(pairs_[i].id);
+      // Copied out first: a reference to a packed member would be misaligned.
+      for (std::size_t i = first; i < last; ++i) ids.push_back(std::uint64_t{pairs_[i].id});
       soups_->gather(std::span<const std::uint64_t>(ids).subspan(had), triangles, parts);
       return;
     }
     for (std::size_t i = first; i < last; ++i) {
       const TriangleRecord& record = records_[order_[i]];
       triangles.push_back(record.triangle);
-      ids.push_back(record.id);
+      ids.push_back(std::uint64_t{record.id});
       parts.push_back(record.part);
     }
   }
