@@ -50,8 +50,10 @@ void run_check_interiors(const InteriorCheckArguments& args) {
   probe.part_of = {0};
   probe.part_names = {"probe"};
   const ReferenceCollider oracle(environment, probe);
-  std::uint64_t closed_components = 0;
-  for (std::uint32_t c = 0; c < index->component_count(); ++c) closed_components += index->component_closed(c);
+  std::vector<std::uint32_t> closed;
+  for (std::uint32_t c = 0; c < index->component_count(); ++c)
+    if (index->component_closed(c)) closed.push_back(c);
+  const std::uint64_t closed_components = closed.size();
   std::uint64_t disagreements = 0;
   std::printf("components: index %u (%llu closed), oracle %zu (%zu closed)\n", index->component_count(),
               (unsigned long long)closed_components, oracle.environment_components(),
@@ -63,9 +65,6 @@ void run_check_interiors(const InteriorCheckArguments& args) {
   }
   // Half the points in the model's box, half in the closed components' boxes, in turn: every
   // closed component is probed, however small.
-  std::vector<std::uint32_t> closed;
-  for (std::uint32_t c = 0; c < index->component_count(); ++c)
-    if (index->component_closed(c)) closed.push_back(c);
   const BoundingBox model_box = index->header().bounds;
   Random random(args.seed);
   std::uint32_t hint = 0;
