@@ -64,7 +64,9 @@ using Kind = EnvironmentKind;
 World make_world(Kind kind, std::uint64_t triangles, std::uint64_t object_triangles, std::size_t steps,
                  std::uint64_t seed, std::size_t region_triangles = 400, double open_fraction = 0) {
   const std::string name = to_string(kind);
-  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "flying" / (name + std::to_string(seed));
+  // One folder per test: ctest runs the tests of this file in parallel.
+  const std::string test_name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "flying" / test_name / (name + std::to_string(seed));
   fs::remove_all(folder);
   fs::create_directories(folder);
   World world;
