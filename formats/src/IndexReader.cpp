@@ -298,6 +298,7 @@ struct IndexReader::Impl {
       format_error("not an HDF5 file (no HDF5 signature in its " + std::to_string(file_bytes) +
                    " bytes); expected a tetrapage index");
     }
+    require_checksummed_superblock();
     file = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
     if (!file) hdf5_format_error("HDF5 cannot open it (damaged or truncated)");
     PropertyListHandle creation(H5Fget_create_plist(file.get()));
@@ -312,9 +313,33 @@ struct IndexReader::Impl {
     length_bytes = length_size;
   }
 
+  /// Superblocks 0 and 1, and the object headers and B-trees that go with them, carry no
+  /// checksums: HDF5 1.10 decodes their damaged bytes unchecked (and can crash doing so), so
+  /// such a file is refused before HDF5 reads it. The writer makes superblock 3.
+  void require_checksummed_superblock() const {
+    static constexpr std::array<unsigned char, 8> signature{0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
+    // HDF5 looks for its signature at 0, 512, 1024, 2048, ... (after a user block).
+    for (std::uint64_t offset = 0; offset + signature.size() < file_bytes; offset = offset == 0 ? 512 : 2 * offset) {
+      std::array<unsigned char, 9> bytes{};
+      if (::pread(descriptor.get(), bytes.data(), bytes.size(), static_cast<off_t>(offset)) !=
+          static_cast<ssize_t>(bytes.size()))
+        break;
+      if (!std::equal(signature.begin(), signature.end(), bytes.begin())) continue;
+      const unsigned version = bytes[8];
+      if (version < 2)
+        format_error("HDF5 superblock version " + std::to_string(version) +
+                     ", whose metadata carries no checksums: written by a tetrapage older than index "
+                     "version " + std::to_string(kIndexVersion) + " or by another program; rebuild the index");
+      return;
+    }
+    format_error("no HDF5 superblock found in its " + std::to_string(file_bytes) + " bytes");
+  }
+
   /// The root attributes; the format name first, so a foreign HDF5 file gets the clearest message.
   void read_header(hid_t g) {
-    if (H5Aexists(g, "format") <= 0)
+    const htri_t has_format = H5Aexists(g, "format");
+    if (has_format < 0) hdf5_format_error("cannot read the root attributes (damaged metadata)");
+    if (has_format == 0)
       format_error("no root attribute 'format': not a tetrapage index (expected format '" +
                    std::string(kIndexFormatName) + "')");
     const std::string format = read_string_attribute(g, "format");

@@ -242,6 +242,10 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   // SEMI: closing the file fails if a handle is still open, so commit() cannot leave data
   // unwritten behind a forgotten handle.
   w.check(H5Pset_fclose_degree(access.get(), H5F_CLOSE_SEMI), "file access properties");
+  // HDF5 1.10's formats: superblock 3, object headers 2 and their chunk indexes carry
+  // checksums that HDF5 verifies before decoding, so a damaged index is refused as such
+  // instead of reaching HDF5's decoders of damaged metadata (docs/RELIABILITY.md).
+  w.check(H5Pset_libver_bounds(access.get(), H5F_LIBVER_V110, H5F_LIBVER_V110), "file access properties");
   // Registered before it exists: a signal arriving as it is created still removes it.
   w.temporary_guard = std::make_unique<TemporaryFileGuard>(w.temporary);
   hid_t file = H5Fcreate(w.temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get());

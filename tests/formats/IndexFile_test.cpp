@@ -616,9 +616,21 @@ TEST(IndexFile, MissingForeignAndWrongVersionFilesAreRejected) {
   expect_error<FormatError>([&] { IndexReader reader(folder / "empty.tpi"); },
                             {"empty.tpi", "not an HDF5 file"});
 
-  // An HDF5 file that is not an index.
+  // An HDF5 file in the default (oldest) format: metadata without checksums is refused before
+  // HDF5 decodes it, whatever it holds.
+  const auto unchecked = folder / "unchecked.h5";
+  H5Fclose(H5Fcreate(unchecked.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+  expect_error<FormatError>([&] { IndexReader reader(unchecked); },
+                            {"unchecked.h5", "superblock version 0", "no checksums", "rebuild"});
+
+  // An HDF5 file with checksummed metadata that is not an index.
   const auto foreign = folder / "foreign.h5";
-  H5Fclose(H5Fcreate(foreign.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+  {
+    const hid_t access = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_libver_bounds(access, H5F_LIBVER_V110, H5F_LIBVER_V110);
+    H5Fclose(H5Fcreate(foreign.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access));
+    H5Pclose(access);
+  }
   expect_error<FormatError>([&] { IndexReader reader(foreign); },
                             {"foreign.h5", "'format'", "not a tetrapage index"});
 

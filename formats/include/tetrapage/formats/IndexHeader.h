@@ -13,7 +13,7 @@ namespace tetrapage {
 /// Value of the root attribute "format" of every tetrapage index.
 inline constexpr std::string_view kIndexFormatName = "tetrapage-index";
 /// The only layout version this build writes and reads; any change to the layout bumps it.
-inline constexpr std::uint32_t kIndexVersion = 4;
+inline constexpr std::uint32_t kIndexVersion = 5;
 
 struct IndexHeader {
   std::uint32_t version = kIndexVersion;
