@@ -386,6 +386,41 @@ struct IndexReader::Impl {
     tet_count = tet_rows;
   }
 
+  /// Links kept in the group's object header, as the writer keeps them: the dense storage of
+  /// another writer (a fractal heap and a B-tree) is refused before HDF5 walks it, since HDF5
+  /// 1.10 crashes cleaning up after a damaged one.
+  void require_compact_links(hid_t group, const char* name) const {
+    H5G_info_t info{};
+    if (H5Gget_info(group, &info) < 0) hdf5_format_error("cannot inspect group '" + std::string(name) + "'");
+    if (info.storage_type != H5G_STORAGE_TYPE_COMPACT)
+      format_error("group '" + std::string(name) + "' keeps its links in " +
+                   (info.storage_type == H5G_STORAGE_TYPE_DENSE ? "dense storage" : "a symbol table") +
+                   ", not in its object header as tetrapage writes them: rebuild the index");
+  }
+
+  /// The root's attributes and the links of the root and its groups where the writer keeps
+  /// them, in object headers; each group is checked before a path through it is followed.
+  void require_compact_storage(hid_t root) const {
+    H5O_info_t info{};
+    if (H5Oget_info2(root, &info, H5O_INFO_HDR | H5O_INFO_NUM_ATTRS) < 0)
+      hdf5_format_error("cannot inspect the root group's object header");
+    constexpr unsigned kAttributeMessage = 0x0C;  // HDF5's message type of a compact attribute
+    if (info.num_attrs > 0 && (info.hdr.mesg.present & (std::uint64_t{1} << kAttributeMessage)) == 0)
+      format_error("the root's " + std::to_string(info.num_attrs) +
+                   " attributes are in dense storage, not in its object header as tetrapage writes them: "
+                   "rebuild the index");
+    require_compact_links(root, "/");
+    for (const char* name : {"mesh", "tables", "shards"}) {
+      if (H5Lexists(root, name, H5P_DEFAULT) <= 0) {
+        detail::take_hdf5_error();
+        continue;  // named as missing where it is needed
+      }
+      GroupHandle group(H5Gopen2(root, name, H5P_DEFAULT));
+      if (!group) hdf5_format_error("cannot open group '/" + std::string(name) + "'");
+      require_compact_links(group.get(), ("/" + std::string(name)).c_str());
+    }
+  }
+
   /// The names under /tables (each is read on demand).
   void list_tables() {
     GroupHandle group(H5Lexists(file.get(), "tables", H5P_DEFAULT) > 0 ? H5Gopen2(file.get(), "tables", H5P_DEFAULT)
@@ -991,6 +1026,7 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
   {
     GroupHandle root(H5Gopen2(r.file.get(), "/", H5P_DEFAULT));
     if (!root) r.hdf5_format_error("cannot open the root group");
+    r.require_compact_storage(root.get());
     r.read_header(root.get());
   }
   r.check_header_values();

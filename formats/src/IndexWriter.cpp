@@ -32,6 +32,9 @@ using detail::PropertyListHandle;
 namespace {
 
 constexpr std::uint32_t kMinChunkBytes = 1024;
+// Links per group and attributes per object kept in the object header (HDF5's limit: 65535).
+constexpr unsigned kMaxCompactLinks = 4096;
+constexpr unsigned kMaxCompactAttributes = 256;
 constexpr std::uint32_t kMaxChunkBytes = 64u << 20;
 // /shards/data is stored as 8-byte little-endian words: the shuffle's element (ChunkCodec.h).
 constexpr std::uint64_t kWordBytes = detail::kShuffleElementBytes;
@@ -183,6 +186,9 @@ struct IndexWriter::Impl {
     if (name.empty() || name == "." || name == ".." || name.find('/') != std::string_view::npos)
       throw InputError("invalid table name '" + std::string(name) + "' for index '" +
                        path.string() + "': it must be non-empty, not '.' or '..', without '/'");
+    if (tables.size() >= kMaxCompactLinks)
+      throw InputError("index '" + path.string() + "' cannot hold more than " + std::to_string(kMaxCompactLinks) +
+                       " tables (table '" + std::string(name) + "')");
     if (tables.contains(name))
       throw InputError("table '" + std::string(name) + "' is written twice to index '" +
                        path.string() + "'");
@@ -248,18 +254,30 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
   w.check(H5Pset_libver_bounds(access.get(), H5F_LIBVER_V110, H5F_LIBVER_V110), "file access properties");
   // Registered before it exists: a signal arriving as it is created still removes it.
   w.temporary_guard = std::make_unique<TemporaryFileGuard>(w.temporary);
-  hid_t file = H5Fcreate(w.temporary.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get());
+  // Links and attributes stay in their (checksummed) object headers: never in the dense
+  // storage of fractal heaps and B-trees, whose damaged-file paths crash HDF5 1.10, and which
+  // the reader therefore refuses.
+  PropertyListHandle creation(w.check_id(H5Pcreate(H5P_FILE_CREATE), "file creation properties"));
+  w.check(H5Pset_link_phase_change(creation.get(), kMaxCompactLinks, kMaxCompactLinks),
+          "file creation properties");
+  w.check(H5Pset_attr_phase_change(creation.get(), kMaxCompactAttributes, kMaxCompactAttributes),
+          "file creation properties");
+  hid_t file = H5Fcreate(w.temporary.c_str(), H5F_ACC_TRUNC, creation.get(), access.get());
   if (file < 0)
     throw IoError("cannot create index '" + w.path.string() + "' (temporary file '" +
                   w.temporary.string() + "'): " + detail::take_hdf5_error());
   w.file = FileHandle(file);
   w.file_created = true;
-  w.mesh_group = GroupHandle(
-      w.check_id(H5Gcreate2(file, "mesh", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "group /mesh"));
-  w.tables_group = GroupHandle(w.check_id(
-      H5Gcreate2(file, "tables", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "group /tables"));
-  w.shards_group = GroupHandle(w.check_id(
-      H5Gcreate2(file, "shards", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), "group /shards"));
+  PropertyListHandle group_creation(w.check_id(H5Pcreate(H5P_GROUP_CREATE), "group creation properties"));
+  w.check(H5Pset_link_phase_change(group_creation.get(), kMaxCompactLinks, kMaxCompactLinks),
+          "group creation properties");
+  const auto create_group = [&](const char* name) {
+    return GroupHandle(w.check_id(H5Gcreate2(file, name, H5P_DEFAULT, group_creation.get(), H5P_DEFAULT),
+                                  std::string("group /") + name));
+  };
+  w.mesh_group = create_group("mesh");
+  w.tables_group = create_group("tables");
+  w.shards_group = create_group("shards");
   const std::array<hsize_t, 1> empty{0};
   // 8-byte words, so that HDF5's shuffle filter puts byte k of every word together.
   const std::array<hsize_t, 1> chunk{options.chunk_bytes / kWordBytes};

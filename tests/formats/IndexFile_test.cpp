@@ -673,6 +673,42 @@ TEST(IndexFile, MissingForeignAndWrongVersionFilesAreRejected) {
                             {"model.tpi", "'version'", "string"});
 }
 
+// Attributes or links moved to HDF5's dense storage (a fractal heap and a B-tree: another
+// writer's file) are refused before HDF5 walks that storage.
+TEST(IndexFile, DenseStorageOfAttributesOrLinksIsRefused) {
+  const auto folder = scratch_folder("dense");
+  const WrittenIndex written = write_sample(folder, 3);
+  const std::string original = test::read_file(written.path);
+  const auto change = [&](const std::function<void(hid_t file)>& edit) {
+    test::write_file(written.path, original);
+    const hid_t file = H5Fopen(written.path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(file, 0);
+    edit(file);
+    H5Fclose(file);
+  };
+  change([](hid_t file) {
+    const hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
+    // More than the writer keeps compact: HDF5 moves them all to dense storage.
+    const hid_t space = H5Screate(H5S_SCALAR);
+    for (int i = 0; i < 300; ++i) {
+      const std::string name = "extra" + std::to_string(i);
+      const hid_t attribute = H5Acreate2(root, name.c_str(), H5T_STD_U8LE, space, H5P_DEFAULT, H5P_DEFAULT);
+      H5Aclose(attribute);
+    }
+    H5Sclose(space);
+    H5Gclose(root);
+  });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); }, {"model.tpi", "dense storage", "rebuild"});
+  change([](hid_t file) {
+    for (int i = 0; i < 5000; ++i)
+      H5Lcreate_soft("/shards/data", file, ("/tables/link" + std::to_string(i)).c_str(), H5P_DEFAULT, H5P_DEFAULT);
+  });
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "'/tables'", "dense storage", "rebuild"});
+  test::write_file(written.path, original);
+  EXPECT_EQ(IndexReader(written.path).read_shard(1), written.shards[1]);
+}
+
 TEST(IndexFile, MissingOrMisshapedDatasetsAreRejected) {
   const auto folder = scratch_folder("datasets");
   const WrittenIndex written = write_sample(folder, 6);
