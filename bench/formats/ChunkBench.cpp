@@ -1,4 +1,4 @@
-// An index's shard payloads, measured (docs/BENCHMARKS.md, "Preprocess, fifth pass", quotes
+// An index's shard payloads, measured (docs/BENCHMARKS.md, "Index size, and the codec", quotes
 // these figures):
 //  1. every Nth payload cut into chunks of 8, 16 and 64 KiB (the last one zero-padded, as the
 //     index stores it), shuffled in 8-byte words or not, each chunk compressed alone with

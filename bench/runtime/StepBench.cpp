@@ -1,6 +1,6 @@
 // Where a flight's time goes, step by step: the index preloaded (everything in memory), the
 // flight replayed --repeat times by one FlyingObject in exact mode, each step timed and sorted
-// by what it did (docs/BENCHMARKS.md, "Runtime, seventeenth stop", quotes these tables):
+// by what it did (docs/BENCHMARKS.md, "Where a step's time goes", quotes these tables):
 //   searched      the box left the searched region: walk, box search, then the shards
 //   no candidate  shards touched, but no triangle survived the box and own-frame tests
 //   phase II      candidates tested exactly, and no contact

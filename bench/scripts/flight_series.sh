@@ -6,7 +6,7 @@
 #   bench/scripts/flight_series.sh [TRIANGLES] [OUT_DIR] [BUDGET_FRACTION]
 #
 # PREPROCESS_FLAGS adds flags to the preprocess (e.g. "--compression none", whose page-ins
-# decompress nothing: docs/BENCHMARKS.md, twenty-first stop).
+# decompress nothing: docs/BENCHMARKS.md, "A page-in, phase by phase").
 #
 # Writes OUT_DIR/series.md (a Markdown table) and the JSON reports it was made from.
 set -euo pipefail

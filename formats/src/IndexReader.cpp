@@ -1,4 +1,5 @@
 #include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/IndexSchema.h"
 
 #include <fcntl.h>
 #include <hdf5.h>
@@ -27,6 +28,8 @@
 #include "tetrapage/formats/SpinThenBlock.h"
 
 namespace tetrapage {
+
+namespace schema = index_schema;
 
 using detail::AttributeHandle;
 using detail::DatasetHandle;
@@ -337,45 +340,52 @@ struct IndexReader::Impl {
 
   /// The root attributes; the format name first, so a foreign HDF5 file gets the clearest message.
   void read_header(hid_t g) {
-    const htri_t has_format = H5Aexists(g, "format");
+    const htri_t has_format = H5Aexists(g, schema::attribute::format);
     if (has_format < 0) hdf5_format_error("cannot read the root attributes (damaged metadata)");
     if (has_format == 0)
       format_error("no root attribute 'format': not a tetrapage index (expected format '" +
                    std::string(kIndexFormatName) + "')");
-    const std::string format = read_string_attribute(g, "format");
+    const std::string format = read_string_attribute(g, schema::attribute::format);
     if (format != kIndexFormatName)
       format_error("root attribute 'format' is '" + format + "', expected '" + std::string(kIndexFormatName) +
                    "': not a tetrapage index");
-    const std::uint64_t version = read_number_attribute<std::uint64_t>(g, "version", 1)[0];
+    const std::uint64_t version =
+        read_number_attribute<std::uint64_t>(g, schema::attribute::version, 1)[0];
     if (version != kIndexVersion)
       format_error("version " + std::to_string(version) + " is not supported (this program reads version " +
                    std::to_string(kIndexVersion) + "): rebuild the index");
     IndexHeader& h = header;
     h.version = static_cast<std::uint32_t>(version);
-    h.precision = read_string_attribute(g, "precision");
-    h.input_triangles = read_number_attribute<std::uint64_t>(g, "input_triangles", 1)[0];
-    h.stored_triangles = read_number_attribute<std::uint64_t>(g, "stored_triangles", 1)[0];
-    h.region_count = read_number_attribute<std::uint64_t>(g, "region_count", 1)[0];
-    h.shard_count = read_number_attribute<std::uint64_t>(g, "shard_count", 1)[0];
-    h.max_rounding_distance = read_number_attribute<double>(g, "max_rounding_distance", 1)[0];
-    const auto bounds = read_number_attribute<double>(g, "bounds", 6);
+    h.precision = read_string_attribute(g, schema::attribute::precision);
+    h.input_triangles =
+        read_number_attribute<std::uint64_t>(g, schema::attribute::input_triangles, 1)[0];
+    h.stored_triangles =
+        read_number_attribute<std::uint64_t>(g, schema::attribute::stored_triangles, 1)[0];
+    h.region_count = read_number_attribute<std::uint64_t>(g, schema::attribute::region_count, 1)[0];
+    h.shard_count = read_number_attribute<std::uint64_t>(g, schema::attribute::shard_count, 1)[0];
+    h.max_rounding_distance =
+        read_number_attribute<double>(g, schema::attribute::max_rounding_distance, 1)[0];
+    const auto bounds = read_number_attribute<double>(g, schema::attribute::bounds, 6);
     h.bounds.lo = {bounds[0], bounds[1], bounds[2]};
     h.bounds.hi = {bounds[3], bounds[4], bounds[5]};
-    h.source = read_string_attribute(g, "source");
-    h.build_report_json = read_string_attribute(g, "build_report");
-    h.created_by = read_string_attribute(g, "created_by");
+    h.source = read_string_attribute(g, schema::attribute::source);
+    h.build_report_json = read_string_attribute(g, schema::attribute::build_report);
+    h.created_by = read_string_attribute(g, schema::attribute::created_by);
   }
 
   /// The shapes of the mesh's datasets (read_mesh reads them).
   void check_mesh_shapes() {
-    DatasetHandle vertices = open_dataset("/mesh/vertices");
-    const auto vertex_rows = check_dataset(vertices.get(), "/mesh/vertices", Element::float64, 3);
-    check_dataset_size(vertices.get(), "/mesh/vertices", Element::float64, vertex_rows, 3);
-    DatasetHandle tets = open_dataset("/mesh/tets");
-    const auto tet_rows = check_dataset(tets.get(), "/mesh/tets", Element::uint32, 4);
-    check_dataset_size(tets.get(), "/mesh/tets", Element::uint32, tet_rows, 4);
-    DatasetHandle neighbours = open_dataset("/mesh/neighbours");
-    const auto neighbour_rows = check_dataset(neighbours.get(), "/mesh/neighbours", Element::uint32, 4);
+    DatasetHandle vertices = open_dataset(schema::dataset::mesh_vertices);
+    const auto vertex_rows =
+        check_dataset(vertices.get(), schema::dataset::mesh_vertices, Element::float64, 3);
+    check_dataset_size(vertices.get(), schema::dataset::mesh_vertices, Element::float64,
+                       vertex_rows, 3);
+    DatasetHandle tets = open_dataset(schema::dataset::mesh_tets);
+    const auto tet_rows = check_dataset(tets.get(), schema::dataset::mesh_tets, Element::uint32, 4);
+    check_dataset_size(tets.get(), schema::dataset::mesh_tets, Element::uint32, tet_rows, 4);
+    DatasetHandle neighbours = open_dataset(schema::dataset::mesh_neighbours);
+    const auto neighbour_rows =
+        check_dataset(neighbours.get(), schema::dataset::mesh_neighbours, Element::uint32, 4);
     if (tet_rows != neighbour_rows)
       format_error("'/mesh/tets' has " + std::to_string(tet_rows) + " rows but '/mesh/neighbours' has " +
                    std::to_string(neighbour_rows));
@@ -410,7 +420,7 @@ struct IndexReader::Impl {
                    " attributes are in dense storage, not in its object header as tetrapage writes them: "
                    "rebuild the index");
     require_compact_links(root, "/");
-    for (const char* name : {"mesh", "tables", "shards"}) {
+    for (const char* name : {schema::group::mesh, schema::group::tables, schema::group::shards}) {
       if (H5Lexists(root, name, H5P_DEFAULT) <= 0) {
         detail::take_hdf5_error();
         continue;  // named as missing where it is needed
@@ -423,8 +433,9 @@ struct IndexReader::Impl {
 
   /// The names under /tables (each is read on demand).
   void list_tables() {
-    GroupHandle group(H5Lexists(file.get(), "tables", H5P_DEFAULT) > 0 ? H5Gopen2(file.get(), "tables", H5P_DEFAULT)
-                                                                      : H5I_INVALID_HID);
+    const char* name = schema::group::tables;
+    GroupHandle group(H5Lexists(file.get(), name, H5P_DEFAULT) > 0 ? H5Gopen2(file.get(), name, H5P_DEFAULT)
+                                                                    : H5I_INVALID_HID);
     if (!group) format_error("group '/tables' is missing");
     hsize_t index = 0;
     const auto collect = [](hid_t, const char* name, const H5L_info_t*, void* names) -> herr_t {
@@ -482,17 +493,21 @@ struct IndexReader::Impl {
   /// checked from their shapes before any is read, and again (as a bound) when one is.
   void check_table_lengths() {
     const std::uint64_t shards = header.shard_count;
-    expected_lengths = {{"shard_tet", shards},         {"shard_kind", shards},
-                        {"shard_triangles", shards},   {"shard_bounds", 6 * shards},
-                        {"tet_shard", tet_count},      {"reference_points", 3 * tet_count},
-                        {"interior_offsets", tet_count + 1}};
-    if (has_table_named("component_part")) {
-      const std::uint64_t components = table_length("component_part");
-      expected_lengths.emplace("component_closed", components);
+    using namespace schema::table;
+    expected_lengths = {{std::string(shard_tet), shards},
+                        {std::string(shard_kind), shards},
+                        {std::string(shard_triangles), shards},
+                        {std::string(shard_bounds), 6 * shards},
+                        {std::string(tet_shard), tet_count},
+                        {std::string(reference_points), 3 * tet_count},
+                        {std::string(interior_offsets), tet_count + 1}};
+    if (has_table_named(schema::table::component_part)) {
+      const std::uint64_t components = table_length(schema::table::component_part);
+      expected_lengths.emplace(schema::table::component_closed, components);
       if (components > file_bytes) format_error("'/tables/component_part' claims " + std::to_string(components) +
                                                 " entries, more than the " + std::to_string(file_bytes) +
                                                 "-byte file can hold");
-      expected_lengths.emplace("component_bounds", 6 * components);
+      expected_lengths.emplace(schema::table::component_bounds, 6 * components);
     }
     for (const auto& [name, expected] : expected_lengths) {
       if (!has_table_named(name)) continue;
@@ -504,17 +519,19 @@ struct IndexReader::Impl {
   }
 
   static std::string length_reason(const std::string& name) {
-    if (name.starts_with("shard_")) return name == "shard_bounds" ? "6 per shard" : "one per shard";
-    if (name.starts_with("component_")) return name == "component_bounds" ? "6 per component" : "one per component";
-    if (name == "reference_points") return "3 per tet";
-    return name == "interior_offsets" ? "one per tet, and one" : "one per tet";
+    if (name.starts_with("shard_"))
+      return name == schema::table::shard_bounds ? "6 per shard" : "one per shard";
+    if (name.starts_with("component_"))
+      return name == schema::table::component_bounds ? "6 per component" : "one per component";
+    if (name == schema::table::reference_points) return "3 per tet";
+    return name == schema::table::interior_offsets ? "one per tet, and one" : "one per tet";
   }
 
   bool has_table_named(std::string_view name) const { return std::binary_search(tables.begin(), tables.end(), name); }
 
   /// A table's length from its shape, without reading it.
-  std::uint64_t table_length(const std::string& name) const {
-    const std::string dataset_name = "/tables/" + name;
+  std::uint64_t table_length(std::string_view name) const {
+    const std::string dataset_name = schema::table_path(name);
     DatasetHandle dataset = open_dataset(dataset_name);
     DataspaceHandle space(H5Dget_space(dataset.get()));
     hsize_t length = 0;
@@ -538,8 +555,8 @@ struct IndexReader::Impl {
           format_error("root attribute 'bounds' [" + number_text(b.lo[a]) + ", " + number_text(b.hi[a]) +
                        "] on axis " + "xyz"[a] + " is not inside the coarse mesh's [" + number_text(mesh_box.lo[a]) +
                        ", " + number_text(mesh_box.hi[a]) + "]");
-    if (!has_table_named("shard_bounds")) return;
-    const auto boxes = read_table<double>("shard_bounds");
+    if (!has_table_named(schema::table::shard_bounds)) return;
+    const auto boxes = read_table<double>(schema::table::shard_bounds);
     for (std::size_t s = 0; 6 * s + 5 < boxes.size(); ++s) {
       const BoundingBox box{{boxes[6 * s], boxes[6 * s + 1], boxes[6 * s + 2]},
                             {boxes[6 * s + 3], boxes[6 * s + 4], boxes[6 * s + 5]}};
@@ -557,7 +574,7 @@ struct IndexReader::Impl {
   }
 
   std::vector<Vec3> mesh_vertices() const {
-    const auto values = read_dataset<double>("/mesh/vertices", 3);
+    const auto values = read_dataset<double>(schema::dataset::mesh_vertices, 3);
     std::vector<Vec3> vertices(values.size() / 3);
     std::memcpy(vertices.data(), values.data(), values.size() * sizeof(double));
     return vertices;
@@ -770,14 +787,14 @@ struct IndexReader::Impl {
     if (!std::binary_search(tables.begin(), tables.end(), name))
       format_error("table '/tables/" + std::string(name) + "' is missing");
     const auto expected = expected_lengths.find(name);
-    if (expected == expected_lengths.end()) return read_dataset<T>("/tables/" + std::string(name), 0);
-    return read_dataset<T>("/tables/" + std::string(name), 0, expected->second, length_reason(expected->first));
+    if (expected == expected_lengths.end()) return read_dataset<T>(schema::table_path(name), 0);
+    return read_dataset<T>(schema::table_path(name), 0, expected->second, length_reason(expected->first));
   }
 
   // ---- shard data -------------------------------------------------------------------------
 
   void check_shard_data_layout() {
-    const std::string name = "/shards/data";
+    const std::string name = schema::dataset::shard_data;
     // 8-byte words (the shuffle filter's element); extents and chunks are counted in bytes.
     const std::uint64_t words = check_dataset(shard_data.get(), name, Element::uint64, 0);
     if (words > file_bytes / kMinStoredChunkBytes * (kMaxChunkBytes / kWordBytes))
@@ -1033,11 +1050,13 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
   r.check_mesh_shapes();
   // Shards: extents and layout.
   const IndexHeader& h = r.header;
-  r.offsets = r.read_dataset<std::uint64_t>("/shards/offsets", 0, h.shard_count, "root attribute 'shard_count'");
-  r.sizes = r.read_dataset<std::uint64_t>("/shards/sizes", 0, h.shard_count, "root attribute 'shard_count'");
+  r.offsets = r.read_dataset<std::uint64_t>(schema::dataset::shard_offsets, 0, h.shard_count,
+                                            "root attribute 'shard_count'");
+  r.sizes = r.read_dataset<std::uint64_t>(schema::dataset::shard_sizes, 0, h.shard_count,
+                                          "root attribute 'shard_count'");
   r.list_tables();
   r.check_table_lengths();
-  r.shard_data = r.open_dataset("/shards/data");
+  r.shard_data = r.open_dataset(schema::dataset::shard_data);
   r.check_shard_data_layout();
   const auto problems = r.extent_problems();
   if (!problems.empty())
@@ -1059,9 +1078,9 @@ std::uint64_t IndexReader::file_bytes() const { return impl_->file_bytes; }
 TetMesh IndexReader::read_mesh() const {
   detail::enter_hdf5();
   const Impl& r = *impl_;
-  const auto vertices = r.read_dataset<double>("/mesh/vertices", 3);
-  const auto tets = r.read_dataset<std::uint32_t>("/mesh/tets", 4);
-  const auto neighbours = r.read_dataset<std::uint32_t>("/mesh/neighbours", 4);
+  const auto vertices = r.read_dataset<double>(schema::dataset::mesh_vertices, 3);
+  const auto tets = r.read_dataset<std::uint32_t>(schema::dataset::mesh_tets, 4);
+  const auto neighbours = r.read_dataset<std::uint32_t>(schema::dataset::mesh_neighbours, 4);
   TetMesh mesh;
   mesh.vertices.resize(vertices.size() / 3);
   std::memcpy(mesh.vertices.data(), vertices.data(), vertices.size() * sizeof(double));
@@ -1228,7 +1247,7 @@ std::vector<std::string> IndexReader::validate(
   }
   for (const auto& name : r.tables) {
     try {
-      const std::string dataset = "/tables/" + name;
+      const std::string dataset = schema::table_path(name);
       DatasetHandle table = r.open_dataset(dataset);
       DatatypeHandle type(H5Dget_type(table.get()));
       bool known = false;

@@ -1,4 +1,5 @@
 #include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/IndexSchema.h"
 
 #include <fcntl.h>
 #include <hdf5.h>
@@ -20,6 +21,8 @@
 #include "tetrapage/formats/TemporaryFiles.h"
 
 namespace tetrapage {
+
+namespace schema = index_schema;
 
 using detail::AttributeHandle;
 using detail::DatasetHandle;
@@ -275,13 +278,14 @@ IndexWriter::IndexWriter(std::filesystem::path path, IndexWriterOptions options)
     return GroupHandle(w.check_id(H5Gcreate2(file, name, H5P_DEFAULT, group_creation.get(), H5P_DEFAULT),
                                   std::string("group /") + name));
   };
-  w.mesh_group = create_group("mesh");
-  w.tables_group = create_group("tables");
-  w.shards_group = create_group("shards");
+  w.mesh_group = create_group(schema::group::mesh);
+  w.tables_group = create_group(schema::group::tables);
+  w.shards_group = create_group(schema::group::shards);
   const std::array<hsize_t, 1> empty{0};
   // 8-byte words, so that HDF5's shuffle filter puts byte k of every word together.
   const std::array<hsize_t, 1> chunk{options.chunk_bytes / kWordBytes};
-  w.shard_data = w.create_dataset(w.shards_group.get(), "data", "dataset /shards/data",
+  w.shard_data = w.create_dataset(file, schema::dataset::shard_data,
+                                  std::string("dataset ") + schema::dataset::shard_data,
                                   H5T_STD_U64LE, empty, chunk, true);
 }
 
@@ -315,14 +319,16 @@ void IndexWriter::write_mesh(const TetMesh& mesh) {
     }
   static_assert(sizeof(Vec3) == 3 * sizeof(double));
   static_assert(sizeof(std::array<std::uint32_t, 4>) == 4 * sizeof(std::uint32_t));
-  const hid_t group = w.mesh_group.get();
-  w.write_array<double>(group, "vertices", "dataset /mesh/vertices",
+  // By absolute path, from the file: the names live in IndexSchema.h.
+  const hid_t group = w.file.get();
+  using namespace schema::dataset;
+  w.write_array<double>(group, mesh_vertices, std::string("dataset ") + mesh_vertices,
                         mesh.vertices.empty() ? nullptr : mesh.vertices.front().data(),
                         mesh.vertices.size(), 3);
-  w.write_array<std::uint32_t>(group, "tets", "dataset /mesh/tets",
+  w.write_array<std::uint32_t>(group, mesh_tets, std::string("dataset ") + mesh_tets,
                                mesh.tets.empty() ? nullptr : mesh.tets.front().data(),
                                mesh.tets.size(), 4);
-  w.write_array<std::uint32_t>(group, "neighbours", "dataset /mesh/neighbours",
+  w.write_array<std::uint32_t>(group, mesh_neighbours, std::string("dataset ") + mesh_neighbours,
                                mesh.neighbours.empty() ? nullptr : mesh.neighbours.front().data(),
                                mesh.neighbours.size(), 4);
   w.mesh_written = true;
@@ -448,28 +454,35 @@ std::uint64_t IndexWriter::commit(const IndexHeader& header) {
                      " shards, but " + std::to_string(w.offsets.size()) + " were appended");
   if (!w.mesh_written) write_mesh(TetMesh{});
 
-  w.write_array<std::uint64_t>(w.shards_group.get(), "offsets", "dataset /shards/offsets",
+  w.write_array<std::uint64_t>(w.file.get(), schema::dataset::shard_offsets,
+                               std::string("dataset ") + schema::dataset::shard_offsets,
                                w.offsets.data(), w.offsets.size(), 0);
-  w.write_array<std::uint64_t>(w.shards_group.get(), "sizes", "dataset /shards/sizes",
+  w.write_array<std::uint64_t>(w.file.get(), schema::dataset::shard_sizes,
+                               std::string("dataset ") + schema::dataset::shard_sizes,
                                w.sizes.data(), w.sizes.size(), 0);
   {
     GroupHandle root(w.check_id(H5Gopen2(w.file.get(), "/", H5P_DEFAULT), "the root group"));
     const hid_t r = root.get();
-    w.write_string_attribute(r, "format", std::string(kIndexFormatName));
-    w.write_number_attribute<std::uint32_t>(r, "version", kIndexVersion);
-    w.write_string_attribute(r, "precision", header.precision);
-    w.write_number_attribute<std::uint64_t>(r, "input_triangles", header.input_triangles);
-    w.write_number_attribute<std::uint64_t>(r, "stored_triangles", header.stored_triangles);
-    w.write_number_attribute<std::uint64_t>(r, "region_count", header.region_count);
-    w.write_number_attribute<std::uint64_t>(r, "shard_count", w.offsets.size());
-    w.write_number_attribute<double>(r, "max_rounding_distance", header.max_rounding_distance);
+    w.write_string_attribute(r, schema::attribute::format, std::string(kIndexFormatName));
+    w.write_number_attribute<std::uint32_t>(r, schema::attribute::version, kIndexVersion);
+    w.write_string_attribute(r, schema::attribute::precision, header.precision);
+    w.write_number_attribute<std::uint64_t>(r, schema::attribute::input_triangles,
+                                            header.input_triangles);
+    w.write_number_attribute<std::uint64_t>(r, schema::attribute::stored_triangles,
+                                            header.stored_triangles);
+    w.write_number_attribute<std::uint64_t>(r, schema::attribute::region_count,
+                                            header.region_count);
+    w.write_number_attribute<std::uint64_t>(r, schema::attribute::shard_count, w.offsets.size());
+    w.write_number_attribute<double>(r, schema::attribute::max_rounding_distance,
+                                     header.max_rounding_distance);
     const std::array<double, 6> bounds{header.bounds.lo[0], header.bounds.lo[1],
                                        header.bounds.lo[2], header.bounds.hi[0],
                                        header.bounds.hi[1], header.bounds.hi[2]};
-    w.write_number_attribute<double>(r, "bounds", std::span<const double>(bounds), false);
-    w.write_string_attribute(r, "source", header.source);
-    w.write_string_attribute(r, "build_report", header.build_report_json);
-    w.write_string_attribute(r, "created_by", created_by_text());
+    w.write_number_attribute<double>(r, schema::attribute::bounds, std::span<const double>(bounds),
+                                     false);
+    w.write_string_attribute(r, schema::attribute::source, header.source);
+    w.write_string_attribute(r, schema::attribute::build_report, header.build_report_json);
+    w.write_string_attribute(r, schema::attribute::created_by, created_by_text());
     if (!root.close()) w.fail("the root group (closing it)");
   }
   if (!w.shard_data.close()) w.fail("dataset /shards/data (closing it)");

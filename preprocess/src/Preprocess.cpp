@@ -1,4 +1,5 @@
 #include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/formats/IndexSchema.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/global_control.h>
@@ -48,6 +49,8 @@
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 
 namespace tetrapage {
+
+namespace schema = index_schema;
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -674,9 +677,9 @@ void write_components(IndexWriter& writer, const std::vector<SurfaceComponent>& 
     bounds.insert(bounds.end(), c.bounds.lo.begin(), c.bounds.lo.end());
     bounds.insert(bounds.end(), c.bounds.hi.begin(), c.bounds.hi.end());
   }
-  writer.write_table("component_part", std::span<const std::uint32_t>(part));
-  writer.write_table("component_closed", std::span<const std::uint8_t>(closed));
-  writer.write_table("component_bounds", std::span<const double>(bounds));
+  writer.write_table(schema::table::component_part, std::span<const std::uint32_t>(part));
+  writer.write_table(schema::table::component_closed, std::span<const std::uint8_t>(closed));
+  writer.write_table(schema::table::component_bounds, std::span<const double>(bounds));
 }
 
 }  // namespace
@@ -1058,16 +1061,20 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   {
     StageClock clock(summary, "write index");
     writer.write_mesh(mesh);
-    writer.write_table("tet_shard", std::span<const std::uint32_t>(tet_shard));
-    writer.write_table("shard_tet", std::span<const std::uint32_t>(shard_tet));
-    writer.write_table("shard_kind", std::span<const std::uint8_t>(shard_kind));
-    writer.write_table("shard_triangles", std::span<const std::uint32_t>(shard_triangles));
-    writer.write_table("shard_bounds", std::span<const double>(shard_bounds));
+    writer.write_table(schema::table::tet_shard, std::span<const std::uint32_t>(tet_shard));
+    writer.write_table(schema::table::shard_tet, std::span<const std::uint32_t>(shard_tet));
+    writer.write_table(schema::table::shard_kind, std::span<const std::uint8_t>(shard_kind));
+    writer.write_table(schema::table::shard_triangles,
+                       std::span<const std::uint32_t>(shard_triangles));
+    writer.write_table(schema::table::shard_bounds, std::span<const double>(shard_bounds));
     write_components(writer, in.components);
     if (interiors.stored) {
-      writer.write_table("reference_points", std::span<const double>(interiors.reference_points));
-      writer.write_table("interior_offsets", std::span<const std::uint64_t>(interiors.offsets));
-      writer.write_table("interior_components", std::span<const std::uint32_t>(interiors.components));
+      writer.write_table(schema::table::reference_points,
+                         std::span<const double>(interiors.reference_points));
+      writer.write_table(schema::table::interior_offsets,
+                         std::span<const std::uint64_t>(interiors.offsets));
+      writer.write_table(schema::table::interior_components,
+                         std::span<const std::uint32_t>(interiors.components));
     }
     IndexHeader header;
     header.precision = summary.precision;

@@ -1,4 +1,5 @@
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/formats/IndexSchema.h"
 
 #include "tetrapage/runtime/BoxSearch.h"
 
@@ -9,27 +10,32 @@
 
 namespace tetrapage {
 
+namespace schema = index_schema;
+
 CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndexOptions options)
     : reader_(path), options_(options) {
   if (options_.memory_budget_bytes == 0) throw InputError("the shard memory budget must be positive");
   mesh_ = reader_.read_mesh();  // checks every vertex and neighbour index
   for (const auto& v : mesh_.vertices) mesh_bounds_.extend(v);
   tet_filter_ = TetBoxFilter(mesh_);
-  tet_shard_ = reader_.read_table_uint32("tet_shard");
+  tet_shard_ = reader_.read_table_uint32(schema::table::tet_shard);
   const std::string where = path.string() + ": ";
   if (tet_shard_.size() != mesh_.tet_count())
-    throw FormatError(where + "/tables/tet_shard has " + std::to_string(tet_shard_.size()) +
-                      " entries for " + std::to_string(mesh_.tet_count()) + " tets");
+    throw FormatError(where + schema::table_path(schema::table::tet_shard) + " has " +
+                      std::to_string(tet_shard_.size()) + " entries for " +
+                      std::to_string(mesh_.tet_count()) + " tets");
   if (mesh_.tet_count() == 0) throw FormatError(where + "the coarse mesh has no tet");
   const std::uint32_t shards = reader_.shard_count();
   for (std::size_t t = 0; t < tet_shard_.size(); ++t)
     if (tet_shard_[t] != TetMesh::no_neighbour && tet_shard_[t] >= shards)
-      throw FormatError(where + "/tables/tet_shard names shard " + std::to_string(tet_shard_[t]) + " for tet " +
-                        std::to_string(t) + ", but there are " + std::to_string(shards) + " shards");
-  const auto bounds = reader_.read_table_double("shard_bounds");
+      throw FormatError(where + schema::table_path(schema::table::tet_shard) + " names shard " +
+                        std::to_string(tet_shard_[t]) + " for tet " + std::to_string(t) +
+                        ", but there are " + std::to_string(shards) + " shards");
+  const auto bounds = reader_.read_table_double(schema::table::shard_bounds);
   if (bounds.size() != 6 * std::size_t(shards))
-    throw FormatError(where + "/tables/shard_bounds has " + std::to_string(bounds.size()) + " values for " +
-                      std::to_string(shards) + " shards (6 each)");
+    throw FormatError(where + schema::table_path(schema::table::shard_bounds) + " has " +
+                      std::to_string(bounds.size()) + " values for " + std::to_string(shards) +
+                      " shards (6 each)");
   shard_bounds_.resize(shards);
   for (std::uint32_t s = 0; s < shards; ++s)
     for (int a = 0; a < 3; ++a) {
@@ -86,47 +92,53 @@ void CollisionIndex::check_budget_fits_shards() const {
 }
 
 void CollisionIndex::read_components(const std::string& where) {
-  component_part_ = reader_.read_table_uint32("component_part");
-  component_closed_ = reader_.read_table_uint8("component_closed");
-  const auto bounds = reader_.read_table_double("component_bounds");
+  component_part_ = reader_.read_table_uint32(schema::table::component_part);
+  component_closed_ = reader_.read_table_uint8(schema::table::component_closed);
+  const auto bounds = reader_.read_table_double(schema::table::component_bounds);
   const std::size_t count = component_part_.size();
   if (component_closed_.size() != count || bounds.size() != 6 * count)
-    throw FormatError(where + "/tables/component_closed and component_bounds hold " +
-                      std::to_string(component_closed_.size()) + " and " + std::to_string(bounds.size()) +
-                      " values for " + std::to_string(count) + " components (1 and 6 each)");
+    throw FormatError(where + schema::table_path(schema::table::component_closed) +
+                      " and component_bounds hold " + std::to_string(component_closed_.size()) +
+                      " and " + std::to_string(bounds.size()) + " values for " +
+                      std::to_string(count) + " components (1 and 6 each)");
   component_bounds_.resize(count);
   for (std::size_t c = 0; c < count; ++c) {
     geometry::Box& box = component_bounds_[c];
     for (int a = 0; a < 3; ++a) box.lo[a] = bounds[6 * c + a], box.hi[a] = bounds[6 * c + 3 + a];
     if (!(box.lo[0] <= box.hi[0] && box.lo[1] <= box.hi[1] && box.lo[2] <= box.hi[2]))
-      throw FormatError(where + "/tables/component_bounds holds an empty or non-finite box for component " +
-                        std::to_string(c));
+      throw FormatError(where + schema::table_path(schema::table::component_bounds) +
+                        " holds an empty or non-finite box for component " + std::to_string(c));
   }
 }
 
 void CollisionIndex::read_interiors(const std::string& where) {
   const auto names = reader_.table_names();
-  const auto has = [&](const char* name) { return std::find(names.begin(), names.end(), name) != names.end(); };
-  if (!has("interior_offsets")) return;  // written without interiors: surfaces only
+  const auto has = [&](std::string_view name) { return std::find(names.begin(), names.end(), name) != names.end(); };
+  if (!has(schema::table::interior_offsets)) return;  // written without interiors: surfaces only
   const std::size_t tets = mesh_.tet_count();
-  const auto points = reader_.read_table_double("reference_points");
-  auto offsets = reader_.read_table_uint64("interior_offsets");
-  interior_components_ = reader_.read_table_uint32("interior_components");
+  const auto points = reader_.read_table_double(schema::table::reference_points);
+  auto offsets = reader_.read_table_uint64(schema::table::interior_offsets);
+  interior_components_ = reader_.read_table_uint32(schema::table::interior_components);
   if (points.size() != 3 * tets)
-    throw FormatError(where + "/tables/reference_points has " + std::to_string(points.size()) + " values for " +
-                      std::to_string(tets) + " tets (3 each)");
+    throw FormatError(where + schema::table_path(schema::table::reference_points) + " has " +
+                      std::to_string(points.size()) + " values for " + std::to_string(tets) +
+                      " tets (3 each)");
   if (offsets.size() != tets + 1 || offsets.front() != 0 || offsets.back() != interior_components_.size())
-    throw FormatError(where + "/tables/interior_offsets does not delimit /tables/interior_components for " +
+    throw FormatError(where + schema::table_path(schema::table::interior_offsets) +
+                      " does not delimit " +
+                      schema::table_path(schema::table::interior_components) + " for " +
                       std::to_string(tets) + " tets");
   for (std::size_t t = 0; t < tets; ++t) {
     if (offsets[t + 1] < offsets[t])
-      throw FormatError(where + "/tables/interior_offsets decreases at tet " + std::to_string(t));
+      throw FormatError(where + schema::table_path(schema::table::interior_offsets) +
+                        " decreases at tet " + std::to_string(t));
     for (std::uint64_t i = offsets[t]; i < offsets[t + 1]; ++i) {
       const std::uint32_t component = interior_components_[i];
       const bool undecided = component == kInteriorUndecided && offsets[t + 1] - offsets[t] == 1;
       if (!undecided && !component_closed(component))
-        throw FormatError(where + "/tables/interior_components names component " + std::to_string(component) +
-                          " for tet " + std::to_string(t) + ", which is not a closed component");
+        throw FormatError(where + schema::table_path(schema::table::interior_components) +
+                          " names component " + std::to_string(component) + " for tet " +
+                          std::to_string(t) + ", which is not a closed component");
     }
   }
   reference_points_.resize(tets);
@@ -135,7 +147,8 @@ void CollisionIndex::read_interiors(const std::string& where) {
     // A NaN point is stored for an undecided tet only; any other must lie in its tet.
     const bool finite = std::isfinite(points[3 * t]) && std::isfinite(points[3 * t + 1]) && std::isfinite(points[3 * t + 2]);
     if (!finite && !(offsets[t + 1] - offsets[t] == 1 && interior_components_[offsets[t]] == kInteriorUndecided))
-      throw FormatError(where + "/tables/reference_points holds a non-finite point for tet " + std::to_string(t));
+      throw FormatError(where + schema::table_path(schema::table::reference_points) +
+                        " holds a non-finite point for tet " + std::to_string(t));
   }
   interior_offsets_ = std::move(offsets);
 }

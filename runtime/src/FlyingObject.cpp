@@ -322,7 +322,7 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     // The region's shards that the box does not meet yet but would within four more steps of
     // its last motion: load them in the background now rather than synchronously then. (All
     // the region's shards were loaded two to three times over for those the flights then
-    // used, and the useless loads evicted useful ones: docs/BENCHMARKS.md, eighteenth stop.)
+    // used, and the useless loads evicted useful ones: docs/history/benchmarks-to-2026-11-26.md.)
     constexpr double kHintSteps = 4;
     geometry::Box ahead = region;
     if (previous_valid_) {

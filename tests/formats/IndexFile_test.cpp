@@ -673,19 +673,23 @@ TEST(IndexFile, MissingForeignAndWrongVersionFilesAreRejected) {
                             {"model.tpi", "'version'", "string"});
 }
 
+/// Writes `original` back to `path`, then opens it with HDF5 and lets `edit` change it.
+void edit_copy(const std::filesystem::path& path, const std::string& original,
+               const std::function<void(hid_t file)>& edit) {
+  test::write_file(path, original);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  edit(file);
+  H5Fclose(file);
+}
+
 // Attributes or links moved to HDF5's dense storage (a fractal heap and a B-tree: another
 // writer's file) are refused before HDF5 walks that storage.
 TEST(IndexFile, DenseStorageOfAttributesOrLinksIsRefused) {
   const auto folder = scratch_folder("dense");
   const WrittenIndex written = write_sample(folder, 3);
   const std::string original = test::read_file(written.path);
-  const auto change = [&](const std::function<void(hid_t file)>& edit) {
-    test::write_file(written.path, original);
-    const hid_t file = H5Fopen(written.path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    ASSERT_GE(file, 0);
-    edit(file);
-    H5Fclose(file);
-  };
+  const auto change = [&](const std::function<void(hid_t file)>& edit) { edit_copy(written.path, original, edit); };
   change([](hid_t file) {
     const hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
     // More than the writer keeps compact: HDF5 moves them all to dense storage.
@@ -713,12 +717,7 @@ TEST(IndexFile, MissingOrMisshapedDatasetsAreRejected) {
   const auto folder = scratch_folder("datasets");
   const WrittenIndex written = write_sample(folder, 6);
   const std::string original = test::read_file(written.path);
-  const auto edit = [&](const std::function<void(hid_t file)>& change) {
-    test::write_file(written.path, original);
-    const hid_t file = H5Fopen(written.path.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
-    change(file);
-    H5Fclose(file);
-  };
+  const auto edit = [&](const std::function<void(hid_t file)>& change) { edit_copy(written.path, original, change); };
   edit([](hid_t file) { H5Ldelete(file, "/shards/sizes", H5P_DEFAULT); });
   expect_error<FormatError>([&] { IndexReader reader(written.path); },
                             {"model.tpi", "'/shards/sizes' is missing"});

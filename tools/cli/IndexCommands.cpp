@@ -10,23 +10,26 @@
 #include <thread>
 
 #include "Commands.h"
-#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/IndexSchema.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/Progress.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/Progress.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
 #include "tetrapage/tools/IndexAudit.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/StabbingNumbers.h"
 
 namespace tetrapage::cli {
+
+namespace schema = index_schema;
 namespace {
 
 struct PreprocessArguments {
@@ -78,8 +81,8 @@ struct InteriorFigures {
 // The connected components (their part and closedness) and what the interiors tables hold
 // (preprocess --interiors): tets inside a closed component, undecided tets.
 InteriorFigures component_figures(const IndexReader& reader, std::size_t tets) {
-  const auto closed = reader.read_table_uint8("component_closed");
-  const auto part = reader.read_table_uint32("component_part");
+  const auto closed = reader.read_table_uint8(schema::table::component_closed);
+  const auto part = reader.read_table_uint32(schema::table::component_part);
   std::uint64_t closed_count = 0, parts = 0;
   for (const auto c : closed) closed_count += c != 0;
   for (const auto p : part) parts = std::max<std::uint64_t>(parts, std::uint64_t(p) + 1);
@@ -91,12 +94,12 @@ InteriorFigures component_figures(const IndexReader& reader, std::size_t tets) {
   nlohmann::json json{{"components", closed.size()}, {"closed_components", closed_count},
                       {"open_components", closed.size() - closed_count}};
   const auto names = reader.table_names();
-  if (std::find(names.begin(), names.end(), "interior_offsets") == names.end()) {
+  if (std::find(names.begin(), names.end(), schema::table::interior_offsets) == names.end()) {
     json["interiors"] = {{"stored", false}};
     return {text + "\ninteriors: not stored (objects inside obstacles go unseen)", json};
   }
-  const auto offsets = reader.read_table_uint64("interior_offsets");
-  const auto inside_of = reader.read_table_uint32("interior_components");
+  const auto offsets = reader.read_table_uint64(schema::table::interior_offsets);
+  const auto inside_of = reader.read_table_uint32(schema::table::interior_components);
   std::uint64_t inside = 0, undecided = 0;
   for (std::size_t t = 0; t + 1 < offsets.size() && t < tets; ++t) {
     if (offsets[t + 1] == offsets[t]) continue;
@@ -114,8 +117,8 @@ void run_inspect(const InspectArguments& args) {
   const IndexReader reader(args.index);
   const IndexHeader& header = reader.header();
   const TetMesh mesh = reader.read_mesh();
-  const auto shard_kind = reader.read_table_uint8("shard_kind");
-  const auto shard_triangles = reader.read_table_uint32("shard_triangles");
+  const auto shard_kind = reader.read_table_uint8(schema::table::shard_kind);
+  const auto shard_triangles = reader.read_table_uint32(schema::table::shard_triangles);
   std::uint64_t decoded = 0, stored = 0, kinds[2] = {0, 0}, kind_bytes[2] = {0, 0};
   std::uint32_t largest = 0, most_triangles = 0;
   for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
@@ -231,10 +234,10 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
       if (!back) problem("tets " + std::to_string(t) + " and " + std::to_string(n) + " are not mutual neighbours");
     }
   }
-  const auto tet_shard = reader.read_table_uint32("tet_shard");
-  const auto shard_tet = reader.read_table_uint32("shard_tet");
-  const auto shard_triangles = reader.read_table_uint32("shard_triangles");
-  const auto shard_bounds = reader.read_table_double("shard_bounds");
+  const auto tet_shard = reader.read_table_uint32(schema::table::tet_shard);
+  const auto shard_tet = reader.read_table_uint32(schema::table::shard_tet);
+  const auto shard_triangles = reader.read_table_uint32(schema::table::shard_triangles);
+  const auto shard_bounds = reader.read_table_double(schema::table::shard_bounds);
   if (tet_shard.size() != mesh.tet_count()) problem("tet_shard has " + std::to_string(tet_shard.size()) + " entries");
   if (shard_tet.size() != reader.shard_count() || shard_triangles.size() != reader.shard_count() ||
       shard_bounds.size() != 6 * std::size_t(reader.shard_count()))
@@ -261,8 +264,8 @@ std::vector<std::string> validate_index(const IndexReader& reader) {
   // Interiors: the runtime's checks at open (all four tables, consistent), and every reference
   // point strictly inside its tet (the crossings are counted within the tet).
   const auto names = reader.table_names();
-  if (std::find(names.begin(), names.end(), "interior_offsets") != names.end()) {
-    const auto points = reader.read_table_double("reference_points");
+  if (std::find(names.begin(), names.end(), schema::table::interior_offsets) != names.end()) {
+    const auto points = reader.read_table_double(schema::table::reference_points);
     for (std::size_t t = 0; t < mesh.tet_count() && 3 * t + 2 < points.size(); ++t) {
       const geometry::Point p{points[3 * t], points[3 * t + 1], points[3 * t + 2]};
       if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) continue;  // undecided

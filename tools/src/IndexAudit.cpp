@@ -1,4 +1,5 @@
 #include "tetrapage/tools/IndexAudit.h"
+#include "tetrapage/formats/IndexSchema.h"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <tbb/parallel_for.h>
@@ -16,6 +17,8 @@
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {
+
+namespace schema = index_schema;
 namespace {
 
 using Epeck = CGAL::Exact_predicates_exact_constructions_kernel;
@@ -196,7 +199,7 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
 void audit_binning(const IndexReader& index, std::span<const InputPiece> model,
                    std::span<const std::uint32_t> tets, AuditFindings& findings, Progress& progress) {
   const TetMesh mesh = index.read_mesh();
-  const auto tet_shard = index.read_table_uint32("tet_shard");
+  const auto tet_shard = index.read_table_uint32(schema::table::tet_shard);
   const StoredIds stored = [&](std::uint32_t tet) {
     std::vector<std::uint64_t> ids;
     const std::uint32_t shard = tet < tet_shard.size() ? tet_shard[tet] : TetMesh::no_neighbour;

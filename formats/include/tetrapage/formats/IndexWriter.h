@@ -25,7 +25,7 @@ enum class ChunkCompression : std::uint8_t {
   lz4,
   /// The payload as it is (only a shard's zero padding compressed): about a third more bytes
   /// on disk, but a page-in's read from the page cache skips LZ4 and the unshuffle, a third of
-  /// its time (docs/BENCHMARKS.md, twenty-first stop).
+  /// its time (docs/BENCHMARKS.md, "A page-in, phase by phase").
   none,
 };
 

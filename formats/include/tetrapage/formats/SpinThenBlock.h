@@ -2,7 +2,7 @@
 /// @file SpinThenBlock.h
 /// Waiting that polls before it sleeps. On a virtual machine a thread's sleep and its wake-up
 /// cost about 25 us each way (a condition variable's round trip between two threads took
-/// 50-60 us on the 2-core VM of docs/BENCHMARKS.md, polling 0.8 us): longer than the critical
+/// 50-60 us on a 2-core VM, polling 0.8 us: BM_HandOff, docs/BENCHMARKS.md): longer than the critical
 /// sections and page-ins that the index reader's and the shard cache's threads wait for.
 
 #include <chrono>

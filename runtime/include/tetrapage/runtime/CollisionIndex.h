@@ -30,7 +30,7 @@ struct CollisionIndexOptions {
   /// With prefetch, also hint the shards of the next region along the motion when an object
   /// searches a new region: a walk and a box search on the querying thread, for loads that a
   /// turning object rarely uses. Off by default: on the 10M scene's flights with the index in
-  /// the page cache it cost more than it saved (docs/BENCHMARKS.md); where page-ins wait for a
+  /// the page cache it cost more than it saved (docs/history/benchmarks-to-2026-11-26.md); where page-ins wait for a
   /// disk it may pay.
   bool prefetch_ahead = false;
   std::size_t prefetch_threads = 1;

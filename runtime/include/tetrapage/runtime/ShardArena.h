@@ -4,7 +4,8 @@
 ///
 /// A paged flight fills an empty budget: each decoded shard would otherwise land on pages the
 /// process never touched, and the flying thread would take the page faults (about five a
-/// page-in, a fifth of its cost on the 10M scene: docs/BENCHMARKS.md, eighteenth stop). The
+/// page-in, a fifth of its cost on the 10M scene: docs/BENCHMARKS.md, "The runtime's paging
+/// options, and the process's memory"). The
 /// arena reserves one range of address space, keeps the next few MiB past its frontier
 /// populated from a background thread (madvise MADV_POPULATE_WRITE), and recycles freed blocks
 /// by size class (eight classes per doubling, so a block wastes at most an eighth), as a
