@@ -433,9 +433,9 @@ struct IndexReader::Impl {
 
   /// The names under /tables (each is read on demand).
   void list_tables() {
-    const char* name = schema::group::tables;
-    GroupHandle group(H5Lexists(file.get(), name, H5P_DEFAULT) > 0 ? H5Gopen2(file.get(), name, H5P_DEFAULT)
-                                                                    : H5I_INVALID_HID);
+    const char* group_name = schema::group::tables;
+    GroupHandle group(H5Lexists(file.get(), group_name, H5P_DEFAULT) > 0 ? H5Gopen2(file.get(), group_name, H5P_DEFAULT)
+                                                                          : H5I_INVALID_HID);
     if (!group) format_error("group '/tables' is missing");
     hsize_t index = 0;
     const auto collect = [](hid_t, const char* name, const H5L_info_t*, void* names) -> herr_t {
