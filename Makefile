@@ -54,7 +54,8 @@ sanitize-threads: configure
 	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=asan -DTETRAPAGE_WERROR=$(WERROR) \
 	  -DTETRAPAGE_BUILD_BENCH=OFF $(CMAKE_FLAGS)
 	cmake --build $(BUILD)-asan --target runtime_threads_tests -j $(JOBS)
-	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 ./tests/runtime/runtime_threads_tests
+	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	  ./tests/runtime/runtime_threads_tests
 
 # The whole suite under AddressSanitizer + UBSan, and the threaded runtime tests under
 # ThreadSanitizer (docs/RELIABILITY.md): about an hour on two cores, so run before each
@@ -64,7 +65,8 @@ sanitize: configure
 	cmake -S . -B $(BUILD)-asan -DCMAKE_BUILD_TYPE=asan -DTETRAPAGE_WERROR=$(WERROR) \
 	  -DTETRAPAGE_BUILD_BENCH=OFF $(CMAKE_FLAGS)
 	cmake --build $(BUILD)-asan -j $(JOBS)
-	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j $(JOBS) --timeout 3600
+	cd $(BUILD)-asan && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	  ctest --output-on-failure -j $(JOBS) --timeout 3600
 	cmake -S . -B $(BUILD)-tsan -DCMAKE_BUILD_TYPE=tsan -DTETRAPAGE_WERROR=$(WERROR) \
 	  -DTETRAPAGE_BUILD_BENCH=OFF $(CMAKE_FLAGS)
 	cmake --build $(BUILD)-tsan --target runtime_threads_tests -j $(JOBS)

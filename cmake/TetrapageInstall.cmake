@@ -67,12 +67,15 @@ if(TETRAPAGE_BUILD_TESTS AND NOT TEST capi_example)
             -P ${capi_tests_source}/CApiExample.cmake)
   set_tests_properties(capi_example PROPERTIES FIXTURES_REQUIRED capi_index TIMEOUT 300)
   # Installs the whole build tree into a temporary prefix: it needs every installed target built.
+  # The consumer links the installed static libraries with the build type's linker flags (a
+  # sanitizer build's libraries need its runtime).
+  string(TOUPPER "${CMAKE_BUILD_TYPE}" build_type)
   add_test(NAME capi_install
     COMMAND ${CMAKE_COMMAND} -DBUILD_DIR=${PROJECT_BINARY_DIR}
             -DWORK=${PROJECT_BINARY_DIR}/tests/runtime/tmp/capi-install
             -DCONSUMER=${capi_tests_source}/install_consumer -DINDEX=${capi_work}/environment.tpi
             -DGENERATOR=${CMAKE_GENERATOR} -DC_COMPILER=${CMAKE_C_COMPILER}
-            -DCXX_COMPILER=${CMAKE_CXX_COMPILER}
+            -DCXX_COMPILER=${CMAKE_CXX_COMPILER} "-DLINKER_FLAGS=${CMAKE_EXE_LINKER_FLAGS_${build_type}}"
             -P ${capi_tests_source}/CApiInstall.cmake)
   set_tests_properties(capi_install PROPERTIES FIXTURES_REQUIRED capi_index LABELS install TIMEOUT 600)
 endif()
