@@ -339,7 +339,7 @@ std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter
     if (filtered.size() != chunk_bytes)
       return "uncompressed chunk holds " + std::to_string(filtered.size()) + " bytes, expected " +
              std::to_string(chunk_bytes);
-    std::memcpy(target.data(), filtered.data(), target.size());
+    if (!target.empty()) std::memcpy(target.data(), filtered.data(), target.size());
   } else if (std::string problem = decode_lz4_frame(filtered, target, chunk_bytes); !problem.empty()) {
     return problem;
   }
@@ -349,7 +349,7 @@ std::string decode_chunk(std::span<const std::byte> stored, std::uint32_t filter
     } else {
       whole.resize(chunk_bytes);
       unshuffle_bytes(target, whole);
-      std::memcpy(out.data(), whole.data(), out.size());
+      if (!out.empty()) std::memcpy(out.data(), whole.data(), out.size());
     }
   }
   return {};

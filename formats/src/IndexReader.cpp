@@ -576,7 +576,7 @@ struct IndexReader::Impl {
   std::vector<Vec3> mesh_vertices() const {
     const auto values = read_dataset<double>(schema::dataset::mesh_vertices, 3);
     std::vector<Vec3> vertices(values.size() / 3);
-    std::memcpy(vertices.data(), values.data(), values.size() * sizeof(double));
+    if (!values.empty()) std::memcpy(vertices.data(), values.data(), values.size() * sizeof(double));
     return vertices;
   }
 

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <mutex>
@@ -187,9 +188,20 @@ tetrapage_status guarded(const char* function, Body&& body) noexcept {
   }
 }
 
-tetrapage::geometry::Accuracy to_accuracy(tetrapage_accuracy accuracy, double parameter) {
+/// The int a C caller passed as an enum, read without loading it as the C++ enum: any int may
+/// arrive, and loading one outside the enumerators' range is undefined behaviour in C++.
+template <class Enum>
+int caller_value(Enum value) {
+  static_assert(sizeof(Enum) == sizeof(int));
+  int raw = 0;
+  std::memcpy(&raw, &value, sizeof raw);
+  return raw;
+}
+
+tetrapage::geometry::Accuracy to_accuracy(tetrapage_accuracy accuracy_enum, double parameter) {
   using tetrapage::geometry::Accuracy;
   const bool epsilon_valid = std::isfinite(parameter) && parameter >= 0;
+  const int accuracy = caller_value(accuracy_enum);
   switch (accuracy) {
     case TETRAPAGE_ACCURACY_EXACT:
       return Accuracy::exact();
@@ -203,7 +215,7 @@ tetrapage::geometry::Accuracy to_accuracy(tetrapage_accuracy accuracy, double pa
     case TETRAPAGE_ACCURACY_CLEARANCE:
       return Accuracy::within(parameter);
   }
-  throw tetrapage::InputError("unknown accuracy " + std::to_string(int(accuracy)));
+  throw tetrapage::InputError("unknown accuracy " + std::to_string(accuracy));
 }
 
 tetrapage::TriangleSoup object_soup(const double* vertices, std::size_t vertex_count,
@@ -236,7 +248,7 @@ extern "C" {
 const char* tetrapage_last_error(void) { return last_error_message.c_str(); }
 
 const char* tetrapage_status_string(tetrapage_status status) {
-  switch (status) {
+  switch (caller_value(status)) {
     case TETRAPAGE_OK: return "ok";
     case TETRAPAGE_ERROR_IO: return "I/O error";
     case TETRAPAGE_ERROR_FORMAT: return "format error";
@@ -366,16 +378,16 @@ tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double p
     require(collides, "collides");
     tetrapage::QueryOptions options;
     options.accuracy = to_accuracy(accuracy, parameter);
-    switch (shape) {
+    switch (caller_value(shape)) {
       case TETRAPAGE_SHAPE_MESH: options.shape = tetrapage::ObjectShape::mesh; break;
       case TETRAPAGE_SHAPE_HULL: options.shape = tetrapage::ObjectShape::hull; break;
       case TETRAPAGE_SHAPE_BOX: options.shape = tetrapage::ObjectShape::box; break;
-      default: throw tetrapage::InputError("unknown object shape " + std::to_string(int(shape)));
+      default: throw tetrapage::InputError("unknown object shape " + std::to_string(caller_value(shape)));
     }
-    switch (motion) {
+    switch (caller_value(motion)) {
       case TETRAPAGE_MOTION_DISCRETE: options.motion = tetrapage::Motion::discrete; break;
       case TETRAPAGE_MOTION_SWEPT: options.motion = tetrapage::Motion::swept; break;
-      default: throw tetrapage::InputError("unknown motion " + std::to_string(int(motion)));
+      default: throw tetrapage::InputError("unknown motion " + std::to_string(caller_value(motion)));
     }
     options.mode = all_contacts ? tetrapage::QueryMode::all_contacts : tetrapage::QueryMode::first_hit;
     tetrapage::Pose placed;
