@@ -31,6 +31,18 @@ namespace tetrapage {
 
 namespace schema = index_schema;
 
+namespace {
+
+/// A dataset's values into rows of as many values (Vec3, tets): memcpy, but never from the
+/// null data of an empty vector (undefined behaviour even for 0 bytes).
+template <class Value, class Row>
+void copy_rows(const std::vector<Value>& values, std::vector<Row>& rows) {
+  static_assert(sizeof(Row) % sizeof(Value) == 0);
+  if (!values.empty()) std::memcpy(rows.data(), values.data(), values.size() * sizeof(Value));
+}
+
+}  // namespace
+
 using detail::AttributeHandle;
 using detail::DatasetHandle;
 using detail::DataspaceHandle;
@@ -576,7 +588,7 @@ struct IndexReader::Impl {
   std::vector<Vec3> mesh_vertices() const {
     const auto values = read_dataset<double>(schema::dataset::mesh_vertices, 3);
     std::vector<Vec3> vertices(values.size() / 3);
-    if (!values.empty()) std::memcpy(vertices.data(), values.data(), values.size() * sizeof(double));
+    copy_rows(values, vertices);
     return vertices;
   }
 
@@ -1083,11 +1095,11 @@ TetMesh IndexReader::read_mesh() const {
   const auto neighbours = r.read_dataset<std::uint32_t>(schema::dataset::mesh_neighbours, 4);
   TetMesh mesh;
   mesh.vertices.resize(vertices.size() / 3);
-  std::memcpy(mesh.vertices.data(), vertices.data(), vertices.size() * sizeof(double));
+  copy_rows(vertices, mesh.vertices);
   mesh.tets.resize(tets.size() / 4);
-  std::memcpy(mesh.tets.data(), tets.data(), tets.size() * sizeof(std::uint32_t));
+  copy_rows(tets, mesh.tets);
   mesh.neighbours.resize(neighbours.size() / 4);
-  std::memcpy(mesh.neighbours.data(), neighbours.data(), neighbours.size() * sizeof(std::uint32_t));
+  copy_rows(neighbours, mesh.neighbours);
   if (mesh.neighbours.size() != mesh.tets.size())
     r.format_error("'/mesh/tets' has " + std::to_string(mesh.tets.size()) +
                    " rows but '/mesh/neighbours' has " + std::to_string(mesh.neighbours.size()));

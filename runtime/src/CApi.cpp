@@ -190,18 +190,19 @@ tetrapage_status guarded(const char* function, Body&& body) noexcept {
 
 /// The int a C caller passed as an enum, read without loading it as the C++ enum: any int may
 /// arrive, and loading one outside the enumerators' range is undefined behaviour in C++.
+/// (Even copying it is such a load, so the enum is taken by reference.)
 template <class Enum>
-int caller_value(Enum value) {
+int caller_value(const Enum& value) {
   static_assert(sizeof(Enum) == sizeof(int));
   int raw = 0;
   std::memcpy(&raw, &value, sizeof raw);
   return raw;
 }
 
-tetrapage::geometry::Accuracy to_accuracy(tetrapage_accuracy accuracy_enum, double parameter) {
+/// `accuracy`: a tetrapage_accuracy read by caller_value.
+tetrapage::geometry::Accuracy to_accuracy(int accuracy, double parameter) {
   using tetrapage::geometry::Accuracy;
   const bool epsilon_valid = std::isfinite(parameter) && parameter >= 0;
-  const int accuracy = caller_value(accuracy_enum);
   switch (accuracy) {
     case TETRAPAGE_ACCURACY_EXACT:
       return Accuracy::exact();
@@ -359,35 +360,29 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
   });
 }
 
-tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
-                                 tetrapage_accuracy accuracy, double parameter, int all_contacts,
-                                 int* collides) {
-  return tetrapage_query_shaped(object, pose, accuracy, parameter, TETRAPAGE_SHAPE_MESH,
-                                TETRAPAGE_MOTION_DISCRETE, all_contacts, collides);
-}
-
-tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double pose[7],
-                                        tetrapage_accuracy accuracy, double parameter,
-                                        tetrapage_object_shape shape, tetrapage_motion motion,
-                                        int all_contacts, int* collides) {
+// The query with the caller's enums as ints (caller_value): forwarding an enum from one C
+// entry point to the other would load it.
+static tetrapage_status query_as_ints(const char* function, tetrapage_object* object, const double pose[7],
+                                      int accuracy, double parameter, int shape, int motion, int all_contacts,
+                                      int* collides) {
   if (collides) *collides = 0;
-  return guarded(__func__, [&] {
+  return guarded(function, [&] {
     const auto state = object_state(object);
     state->has_result = false;  // a failed query leaves no contact behind
     require(pose, "pose");
     require(collides, "collides");
     tetrapage::QueryOptions options;
     options.accuracy = to_accuracy(accuracy, parameter);
-    switch (caller_value(shape)) {
+    switch (shape) {
       case TETRAPAGE_SHAPE_MESH: options.shape = tetrapage::ObjectShape::mesh; break;
       case TETRAPAGE_SHAPE_HULL: options.shape = tetrapage::ObjectShape::hull; break;
       case TETRAPAGE_SHAPE_BOX: options.shape = tetrapage::ObjectShape::box; break;
-      default: throw tetrapage::InputError("unknown object shape " + std::to_string(caller_value(shape)));
+      default: throw tetrapage::InputError("unknown object shape " + std::to_string(shape));
     }
-    switch (caller_value(motion)) {
+    switch (motion) {
       case TETRAPAGE_MOTION_DISCRETE: options.motion = tetrapage::Motion::discrete; break;
       case TETRAPAGE_MOTION_SWEPT: options.motion = tetrapage::Motion::swept; break;
-      default: throw tetrapage::InputError("unknown motion " + std::to_string(caller_value(motion)));
+      default: throw tetrapage::InputError("unknown motion " + std::to_string(motion));
     }
     options.mode = all_contacts ? tetrapage::QueryMode::all_contacts : tetrapage::QueryMode::first_hit;
     tetrapage::Pose placed;
@@ -397,6 +392,21 @@ tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double p
     state->has_result = true;
     *collides = state->result.collides ? 1 : 0;
   });
+}
+
+tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
+                                 tetrapage_accuracy accuracy, double parameter, int all_contacts,
+                                 int* collides) {
+  return query_as_ints(__func__, object, pose, caller_value(accuracy), parameter, TETRAPAGE_SHAPE_MESH,
+                       TETRAPAGE_MOTION_DISCRETE, all_contacts, collides);
+}
+
+tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double pose[7],
+                                        tetrapage_accuracy accuracy, double parameter,
+                                        tetrapage_object_shape shape, tetrapage_motion motion,
+                                        int all_contacts, int* collides) {
+  return query_as_ints(__func__, object, pose, caller_value(accuracy), parameter, caller_value(shape),
+                       caller_value(motion), all_contacts, collides);
 }
 
 tetrapage_status tetrapage_contact_count(const tetrapage_object* object, size_t* count) {
