@@ -307,12 +307,6 @@ struct IndexReader::Impl {
     file_bytes = static_cast<std::uint64_t>(status.st_size);
     modified = status.st_mtim;
 
-    const htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
-    if (is_hdf5 <= 0) {
-      detail::take_hdf5_error();
-      format_error("not an HDF5 file (no HDF5 signature in its " + std::to_string(file_bytes) +
-                   " bytes); expected a tetrapage index");
-    }
     require_checksummed_superblock();
     file = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
     if (!file) hdf5_format_error("HDF5 cannot open it (damaged or truncated)");
@@ -330,7 +324,8 @@ struct IndexReader::Impl {
 
   /// Superblocks 0 and 1, and the object headers and B-trees that go with them, carry no
   /// checksums: HDF5 1.10 decodes their damaged bytes unchecked (and can crash doing so), so
-  /// such a file is refused before HDF5 reads it. The writer makes superblock 3.
+  /// such a file is refused before HDF5 reads it. The writer makes superblock 3. A file
+  /// without HDF5's signature is refused here too.
   void require_checksummed_superblock() const {
     static constexpr std::array<unsigned char, 8> signature{0x89, 'H', 'D', 'F', '\r', '\n', 0x1a, '\n'};
     // HDF5 looks for its signature at 0, 512, 1024, 2048, ... (after a user block).
@@ -347,7 +342,8 @@ struct IndexReader::Impl {
                      "version " + std::to_string(kIndexVersion) + " or by another program; rebuild the index");
       return;
     }
-    format_error("no HDF5 superblock found in its " + std::to_string(file_bytes) + " bytes");
+    format_error("not an HDF5 file (no HDF5 signature in its " + std::to_string(file_bytes) +
+                 " bytes); expected a tetrapage index");
   }
 
   /// The root attributes; the format name first, so a foreign HDF5 file gets the clearest message.

@@ -359,15 +359,13 @@ struct LoadedSoup {
 // Coordinates beyond kMaxCoordinateMagnitude overflow the coarse mesh's enlarged box and the
 // exact predicates' products: refused, naming the file and the value.
 void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& piece) {
-  for (const Vec3& v : soup.vertices)
-    for (const double x : v)
-      if (std::fabs(x) > kMaxCoordinateMagnitude) {
-        char value[64];
-        std::snprintf(value, sizeof value, "%g", x);
-        const std::string file = piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
-        throw InputError(file + ": a vertex coordinate of " + value +
-                         " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
-      }
+  const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup);
+  if (!beyond.found) return;
+  char value[64];
+  std::snprintf(value, sizeof value, "%g", beyond.value);
+  const std::string file = piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
+  throw InputError(file + ": a vertex coordinate of " + value +
+                   " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
 }
 
 LoadedSoup load_soup(const InputPiece& piece) {

@@ -102,16 +102,14 @@ bool zero_area(const TriangleSoup& soup, std::size_t t) {
 // and some triangle with an area (a wholly degenerate object has no hull, normal or inside,
 // and its queries would fail later on NaN points).
 void check_placeable(const TriangleSoup& soup) {
-  for (std::size_t v = 0; v < soup.vertices.size(); ++v)
-    for (int a = 0; a < 3; ++a)
-      if (std::fabs(soup.vertices[v][a]) > kMaxCoordinateMagnitude) {
-        char text[200];
-        std::snprintf(text, sizeof text,
-                      "object: vertex %zu has coordinate %c = %g, beyond %g in magnitude: placing it "
-                      "by a pose could overflow",
-                      v, "xyz"[a], soup.vertices[v][a], kMaxCoordinateMagnitude);
-        throw InputError(text);
-      }
+  if (const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup); beyond.found) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "object: vertex %zu has coordinate %c = %g, beyond %g in magnitude: placing it "
+                  "by a pose could overflow",
+                  beyond.vertex, "xyz"[beyond.axis], beyond.value, kMaxCoordinateMagnitude);
+    throw InputError(text);
+  }
   for (std::size_t t = 0; t < soup.triangle_count(); ++t)
     if (!zero_area(soup, t)) return;
   throw InputError("object: all " + std::to_string(soup.triangle_count()) +

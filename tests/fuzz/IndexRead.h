@@ -6,6 +6,7 @@
 // tetrapage::Error.
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
 #include <vector>
 
@@ -17,27 +18,20 @@ namespace tetrapage::fuzz {
 
 /// Each table through the one typed read that accepts it.
 inline void read_tables(const IndexReader& reader) {
-  for (const std::string& name : reader.table_names()) {
-    try {
-      (void)reader.read_table_uint8(name);
-      continue;
-    } catch (const FormatError&) {
+  using Read = void (*)(const IndexReader&, const std::string&);
+  static constexpr std::array<Read, 4> reads{
+      [](const IndexReader& r, const std::string& name) { (void)r.read_table_uint8(name); },
+      [](const IndexReader& r, const std::string& name) { (void)r.read_table_uint32(name); },
+      [](const IndexReader& r, const std::string& name) { (void)r.read_table_uint64(name); },
+      [](const IndexReader& r, const std::string& name) { (void)r.read_table_double(name); }};
+  for (const std::string& name : reader.table_names())
+    for (const Read read : reads) {
+      try {
+        read(reader, name);
+        break;
+      } catch (const FormatError&) {
+      }
     }
-    try {
-      (void)reader.read_table_uint32(name);
-      continue;
-    } catch (const FormatError&) {
-    }
-    try {
-      (void)reader.read_table_uint64(name);
-      continue;
-    } catch (const FormatError&) {
-    }
-    try {
-      (void)reader.read_table_double(name);
-    } catch (const FormatError&) {
-    }
-  }
 }
 
 inline void read_and_decode_shards(const IndexReader& reader, std::uint32_t shards) {

@@ -4,6 +4,8 @@
 /// A pose maps the object's own coordinates x to R(q) x + t, q a unit quaternion.
 
 #include <array>
+#include <cmath>
+#include <cstddef>
 #include <filesystem>
 #include <span>
 #include <vector>
@@ -16,6 +18,22 @@ namespace tetrapage {
 /// R(q) x + t then stays far from overflow (under 3e300), and so do the differences and
 /// extents computed from placed coordinates.
 inline constexpr double kMaxCoordinateMagnitude = 1e300;
+
+/// The first vertex coordinate of `soup` beyond kMaxCoordinateMagnitude (NaN is not), as
+/// vertex, axis and value; `found` is false if there is none. Objects and environments both
+/// refuse such a soup: its placed or enlarged boxes would overflow.
+struct CoordinateBeyondLimit {
+  bool found = false;
+  std::size_t vertex = 0;
+  int axis = 0;
+  double value = 0;
+};
+inline CoordinateBeyondLimit find_coordinate_beyond_limit(const TriangleSoup& soup) {
+  for (std::size_t v = 0; v < soup.vertices.size(); ++v)
+    for (int a = 0; a < 3; ++a)
+      if (std::fabs(soup.vertices[v][a]) > kMaxCoordinateMagnitude) return {true, v, a, soup.vertices[v][a]};
+  return {};
+}
 
 struct Pose {
   Vec3 translation{0.0, 0.0, 0.0};
