@@ -37,6 +37,10 @@
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Pose.h"
 #include "tetrapage/formats/Progress.h"
+#include "MortonGrid.h"
+#include "OrderedPipeline.h"
+#include "SpillPath.h"
+#include "TriangleRecord.h"
 #include "tetrapage/preprocess/CoarseMesh.h"
 #include "tetrapage/preprocess/RayParity.h"
 #include "tetrapage/preprocess/RecordSpill.h"
@@ -54,14 +58,6 @@ namespace schema = index_schema;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// One triangle on its way through the pipeline (88 bytes).
-struct TriangleRecord {
-  geometry::Triangle triangle;
-  std::uint64_t id;    // position in the input order, over all parts
-  std::uint32_t part;  // part id over all inputs
-  std::uint32_t tet;   // after binning: the tet this copy belongs to
-};
 
 // Runs one stage, recording its time and peak resident memory.
 class StageClock {
@@ -81,74 +77,6 @@ class StageClock {
   Clock::time_point start_;
 };
 
-// Runs produce(i) for i = 0 .. count - 1 on all threads, at most `in_flight` at once, and
-// consume(result) on one thread at a time in the order of i: the shape of the ingest, the
-// in-memory binning and the shard stage (work in parallel, results appended in order).
-// Results wait in slots of our own, and only their numbers pass through TBB: TBB does not
-// destroy the items it holds between filters when an exception cancels the pipeline (every
-// result in flight leaked when a write failed). At most `in_flight` tokens live and they are
-// consumed in order, so slot i mod in_flight is empty again before token i + in_flight starts.
-template <class Produce, class Consume>
-void produce_in_parallel_consume_in_order(std::size_t count, std::size_t in_flight, Produce&& produce,
-                                          Consume&& consume) {
-  using Result = std::invoke_result_t<Produce&, std::size_t>;
-  in_flight = std::max<std::size_t>(in_flight, 1);
-  std::vector<std::optional<Result>> slots(in_flight);
-  std::size_t next = 0;
-  tbb::parallel_pipeline(
-      in_flight,
-      tbb::make_filter<void, std::size_t>(tbb::filter_mode::serial_in_order,
-                                          [&](tbb::flow_control& control) -> std::size_t {
-                                            if (next == count) control.stop();
-                                            return next++;
-                                          }) &
-          tbb::make_filter<std::size_t, std::size_t>(tbb::filter_mode::parallel,
-                                                     [&](std::size_t i) {
-                                                       slots[i % in_flight].emplace(produce(i));
-                                                       return i;
-                                                     }) &
-          tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, [&](std::size_t i) {
-            std::optional<Result>& slot = slots[i % in_flight];
-            consume(*slot);
-            slot.reset();
-          }));
-}
-
-// Spreads a 21-bit integer's bits three apart (for Morton codes).
-std::uint64_t spread_bits(std::uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
-// Morton codes of points in a box, 21 bits an axis. The scales are taken once: three
-// divisions a point were a sixtieth of the preprocess's CPU (binning codes every triangle).
-class MortonGrid {
- public:
-  explicit MortonGrid(const BoundingBox& box) : lo_(box.lo) {
-    for (int axis = 0; axis < 3; ++axis) {
-      const double side = box.hi[axis] - box.lo[axis];
-      scale_[axis] = side > 0 ? double((1 << 21) - 1) / side : 0.0;
-    }
-  }
-  std::uint64_t code(const Vec3& p) const {
-    std::uint64_t code = 0;
-    for (int axis = 0; axis < 3; ++axis) {
-      const double cell = std::clamp((p[axis] - lo_[axis]) * scale_[axis], 0.0, double((1 << 21) - 1));
-      code |= spread_bits(std::uint64_t(cell)) << axis;
-    }
-    return code;
-  }
-
- private:
-  Vec3 lo_;
-  std::array<double, 3> scale_;
-};
-
 // Sorts words by their high 32 bits, stably (three passes of a counting sort, 11 bits each).
 void sort_by_high_word(std::vector<std::uint64_t>& words, std::vector<std::uint64_t>& scratch) {
   scratch.resize(words.size());
@@ -159,15 +87,6 @@ void sort_by_high_word(std::vector<std::uint64_t>& words, std::vector<std::uint6
     for (const std::uint64_t w : words) scratch[start[(w >> shift) & 0x7ff]++] = w;
     words.swap(scratch);
   }
-}
-
-Vec3 centroid(const geometry::Triangle& t) {
-  return {(t[0][0] + t[1][0] + t[2][0]) / 3, (t[0][1] + t[1][1] + t[2][1]) / 3,
-          (t[0][2] + t[1][2] + t[2][2]) / 3};
-}
-
-std::filesystem::path spill_path(const std::filesystem::path& folder, const std::string& what) {
-  return folder / (".tetrapage-spill-" + std::to_string(::getpid()) + "-" + what);
 }
 
 // The binned copies of one bucket: records in a spill file or, while the ingested soups are
@@ -468,21 +387,6 @@ void ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOp
   summary.parts = in.part_names.size();
   summary.components = in.components.size();
   if (in.seen == 0) throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
-}
-
-// The in-memory soups cut into tasks of at most kTaskTriangles consecutive triangles of one
-// piece, for the passes that visit every triangle on all threads.
-struct InMemoryTask {
-  std::size_t piece, first, count;
-};
-constexpr std::size_t kTaskTriangles = std::size_t(1) << 15;
-
-std::vector<InMemoryTask> in_memory_tasks(const SoupSpill<TriangleRecord>& soups) {
-  std::vector<InMemoryTask> tasks;
-  for (std::size_t p = 0; p < soups.piece_count(); ++p)
-    for (std::size_t first = 0; first < soups.piece_size(p); first += kTaskTriangles)
-      tasks.push_back({p, first, std::min(kTaskTriangles, soups.piece_size(p) - first)});
-  return tasks;
 }
 
 // The interiors: each tet's reference point classified against the closed components, as CSR
