@@ -38,8 +38,9 @@ struct BucketPlan {
   std::size_t bucket_count = 1;
 };
 
-BucketPlan plan_buckets(const IngestedModel& model, const TetMesh& mesh, const MortonGrid& mesh_grid,
-                        std::span<const std::uint32_t> tet_order, const PreprocessOptions& options);
+BucketPlan plan_buckets(const IngestedModel& model, const TetMesh& mesh,
+                        const MortonGrid& mesh_grid, std::span<const std::uint32_t> tet_order,
+                        const PreprocessOptions& options);
 
 // The binned copies of one bucket: records in a spill file or, while the ingested soups are
 // held in memory, only (id, tet) pairs, 12 bytes instead of 88.
@@ -64,7 +65,9 @@ class BucketCopies {
   /// through positions was a cache miss each); the records, 88 bytes, are read through positions.
   std::vector<std::size_t> order_by_tet(std::span<const std::uint32_t> rank);
   /// The tet of the i-th copy in order_by_tet's order.
-  std::uint32_t tet(std::size_t i) const { return soups_ ? pairs_[i].tet : records_[order_[i]].tet; }
+  std::uint32_t tet(std::size_t i) const {
+    return soups_ ? pairs_[i].tet : records_[order_[i]].tet;
+  }
   /// Appends the triangles, ids and parts of copies [first, last) of order_by_tet's order.
   void gather(std::size_t first, std::size_t last, std::vector<geometry::Triangle>& triangles,
               std::vector<std::uint64_t>& ids, std::vector<std::uint32_t>& parts) const;
@@ -102,7 +105,8 @@ class CopyBucket {
 
 /// The plan's buckets, empty: each spills to a file in `spill_folder` when the soups are
 /// spilled, else keeps (id, tet) pairs in memory.
-std::vector<CopyBucket> make_buckets(std::size_t bucket_count, const std::filesystem::path& spill_folder,
+std::vector<CopyBucket> make_buckets(std::size_t bucket_count,
+                                     const std::filesystem::path& spill_folder,
                                      const SoupSpill<TriangleRecord>& soups);
 
 }  // namespace tetrapage

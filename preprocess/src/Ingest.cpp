@@ -37,9 +37,11 @@ void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& pie
   if (!beyond.found) return;
   char value[64];
   std::snprintf(value, sizeof value, "%g", beyond.value);
-  const std::string file = piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
-  throw InputError(file + ": a vertex coordinate of " + value +
-                   " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
+  const std::string file =
+      piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
+  throw InputError(
+      file + ": a vertex coordinate of " + value +
+      " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
 }
 
 LoadedSoup load_soup(const InputPiece& piece) {
@@ -56,7 +58,8 @@ LoadedSoup load_soup(const InputPiece& piece) {
   soup.part_of = std::move(found.component_of);
   loaded.components = std::move(found.components);
   loaded.centroids.resize(soup.triangle_count());
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t) loaded.centroids[t] = centroid(soup.corners(t));
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
+    loaded.centroids[t] = centroid(soup.corners(t));
   return loaded;
 }
 
@@ -66,7 +69,8 @@ LoadedSoup load_soup(const InputPiece& piece) {
 // times their files' bytes, stay within an eighth of the budget. (A loaded soup holds double
 // vertices, indices and a double centroid a triangle: by arithmetic about 2.6 times a binary
 // PLY of float vertices, less for double ones; not measured for every reader.)
-std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memory_bytes, std::size_t threads) {
+std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memory_bytes,
+                         std::size_t threads) {
   std::uint64_t largest = 0;
   for (const InputPiece& job : jobs) {
     std::error_code error;
@@ -76,17 +80,21 @@ std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memo
     }
     const ManifestPart& part = job.manifest->parts[job.part];
     const std::uint64_t bytes = std::filesystem::file_size(part.file, error);
-    if (!error) largest = std::max<std::uint64_t>(largest, bytes * std::max<std::size_t>(part.instances.size(), 1));
+    if (!error)
+      largest =
+          std::max<std::uint64_t>(largest, bytes * std::max<std::size_t>(part.instances.size(), 1));
   }
   const std::size_t fewest = threads + 1, most = 4 * threads;
   if (largest == 0) return fewest;
-  return std::clamp<std::size_t>(std::size_t(memory_bytes / 8 / (4 * largest)), fewest, std::max(fewest, most));
+  return std::clamp<std::size_t>(std::size_t(memory_bytes / 8 / (4 * largest)), fewest,
+                                 std::max(fewest, most));
 }
 
 }  // namespace
 
-IngestedModel ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
-                     const std::filesystem::path& spill_folder, PreprocessSummary& summary) {
+IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
+                     const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                     PreprocessSummary& summary) {
   IngestedModel model;
   const std::uint64_t held_limit = options.memory_bytes / 4;
   // At most 2M centroids, at least 2^16: a site stands for the mean of hundreds of sampled
@@ -105,7 +113,8 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs, const Pre
     summary.files_read += loaded.files_read;
     const auto part_offset = std::uint32_t(model.part_names.size());
     for (const auto& name : loaded.soup.part_names) model.part_names.push_back(name);
-    if (loaded.soup.part_names.empty()) model.part_names.push_back("part" + std::to_string(part_offset));
+    if (loaded.soup.part_names.empty())
+      model.part_names.push_back("part" + std::to_string(part_offset));
     if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
       throw InputError("the inputs hold more than 2^32 - 2 connected components");
     const auto component_offset = std::uint32_t(model.components.size());
@@ -121,7 +130,8 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs, const Pre
       if (model.sample.size() < sample_capacity) {
         model.sample.push_back(loaded.centroids[t]);
       } else {
-        const std::uint64_t slot = std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(random);
+        const std::uint64_t slot =
+            std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(random);
         if (slot < sample_capacity) model.sample[slot] = loaded.centroids[t];
       }
     }
@@ -132,10 +142,11 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs, const Pre
   // Parsing, edge parity, bounds and centroids run on all threads, a few soups at once; the
   // soups are appended in input order on one.
   Progress progress("reading parts", jobs.size(), options.progress);
-  const std::size_t in_flight =
-      ingest_depth(jobs, options.memory_bytes, std::size_t(tbb::this_task_arena::max_concurrency()));
+  const std::size_t in_flight = ingest_depth(jobs, options.memory_bytes,
+                                             std::size_t(tbb::this_task_arena::max_concurrency()));
   produce_in_parallel_consume_in_order(
-      jobs.size(), in_flight, [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); },
+      jobs.size(), in_flight,
+      [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         add_soup(*loaded);
         progress.advance();
@@ -144,7 +155,8 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs, const Pre
   summary.triangles_read = model.triangle_count;
   summary.parts = model.part_names.size();
   summary.components = model.components.size();
-  if (model.triangle_count == 0) throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
+  if (model.triangle_count == 0)
+    throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
   return model;
 }
 

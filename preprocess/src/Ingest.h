@@ -32,7 +32,8 @@ struct IngestedModel {
 /// the threads), spilling the soups beyond a quarter of the budget (`spill_folder`).
 /// @throw InputError when the inputs hold no triangle, more than 2^32 - 2 components, or a
 /// coordinate beyond 1e300; the readers' errors as they throw them.
-IngestedModel ingest(const std::vector<std::filesystem::path>& inputs, const PreprocessOptions& options,
-                     const std::filesystem::path& spill_folder, PreprocessSummary& summary);
+IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
+                     const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                     PreprocessSummary& summary);
 
 }  // namespace tetrapage

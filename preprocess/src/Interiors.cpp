@@ -21,23 +21,29 @@ namespace {
 
 // A tet whose inside could not be decided: the runtime would answer "unknown" there, and
 // containment could be missed, so the preprocess stops unless the user accepts it.
-[[noreturn]] void throw_undecided(const IngestedModel& model, const TetMesh& mesh, std::uint32_t tet, std::uint32_t component) {
+[[noreturn]] void throw_undecided(const IngestedModel& model, const TetMesh& mesh,
+                                  std::uint32_t tet, std::uint32_t component) {
   const auto c = mesh.corners(tet);
   char corner[128];
-  std::snprintf(corner, sizeof corner, "(first corner %.9g, %.9g, %.9g)", c[0][0], c[0][1], c[0][2]);
+  std::snprintf(corner, sizeof corner, "(first corner %.9g, %.9g, %.9g)", c[0][0], c[0][1],
+                c[0][2]);
   const std::string where = "tet " + std::to_string(tet) + " " + corner;
   if (component == kInteriorUndecided)
-    throw InputError("interiors: " + where + " has no point strictly inside it to classify; pass "
-                     "--accept-undecided to store it as undecided (containment there is then unknown)");
-  throw InputError("interiors: every reference point tried in " + where + " lies on the surface of closed component " +
-                   std::to_string(component) + " of part '" + model.part_names[model.components[component].part] +
-                   "'; pass --accept-undecided to store the tet as undecided (containment there is then unknown)");
+    throw InputError(
+        "interiors: " + where +
+        " has no point strictly inside it to classify; pass "
+        "--accept-undecided to store it as undecided (containment there is then unknown)");
+  throw InputError("interiors: every reference point tried in " + where +
+                   " lies on the surface of closed component " + std::to_string(component) +
+                   " of part '" + model.part_names[model.components[component].part] +
+                   "'; pass --accept-undecided to store the tet as undecided (containment there is "
+                   "then unknown)");
 }
 
 }  // namespace
 
-Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh, const PreprocessOptions& options,
-                             PreprocessSummary& summary) {
+Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh,
+                             const PreprocessOptions& options, PreprocessSummary& summary) {
   Interiors result;
   const std::size_t components = model.components.size();
   std::vector<bool> closed(components);
@@ -63,8 +69,8 @@ Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh, const Pr
       result.reference_points[3 * t + a] =
           reference ? (*reference)[a] : std::numeric_limits<double>::quiet_NaN();
   });
-  // A pass classifies against as many components as its (point, component) pairs allow: a quarter of the
-  // budget (RayParity holds 29 bytes per pair, the plan as much again).
+  // A pass classifies against as many components as its (point, component) pairs allow: a quarter
+  // of the budget (RayParity holds 29 bytes per pair, the plan as much again).
   const std::uint64_t pairs_per_pass =
       options.interior_pairs_per_pass != 0
           ? options.interior_pairs_per_pass
@@ -118,24 +124,27 @@ Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh, const Pr
                             for (std::size_t k = range.begin(); k < range.end(); ++k) {
                               const InMemoryTask& task = tasks[k];
                               for (std::size_t t = task.first; t < task.first + task.count; ++t) {
-                                const std::uint32_t component = model.soups.piece_part(task.piece, t);
+                                const std::uint32_t component =
+                                    model.soups.piece_part(task.piece, t);
                                 if (parity.wanted(component))
-                                  parity.add_triangle(component, model.soups.piece_record(task.piece, t).triangle);
+                                  parity.add_triangle(
+                                      component, model.soups.piece_record(task.piece, t).triangle);
                               }
                               const std::lock_guard lock(progress_mutex);
                               progress.advance(task.count);
                             }
                           });
       } else {
-        model.soups.for_each_block(std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
-          tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 2048),
-                            [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t i = range.begin(); i < range.end(); ++i)
-                                if (parity.wanted(block[i].part))
-                                  parity.add_triangle(block[i].part, block[i].triangle);
-                            });
-          progress.advance(block.size());
-        });
+        model.soups.for_each_block(
+            std::size_t(1) << 16, [&](std::span<const TriangleRecord> block) {
+              tbb::parallel_for(tbb::blocked_range<std::size_t>(0, block.size(), 2048),
+                                [&](const tbb::blocked_range<std::size_t>& range) {
+                                  for (std::size_t i = range.begin(); i < range.end(); ++i)
+                                    if (parity.wanted(block[i].part))
+                                      parity.add_triangle(block[i].part, block[i].triangle);
+                                });
+              progress.advance(block.size());
+            });
       }
       parity.for_each_answer([&](std::uint32_t t, std::uint32_t p, bool odd, bool on_surface) {
         if (on_surface)
@@ -179,7 +188,8 @@ Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh, const Pr
   result.offsets.push_back(0);
   for (std::size_t t = 0; t < tet_count; ++t) {
     if (!has_point[t] || undecided[t] != 0) {
-      if (!options.accept_undecided) throw_undecided(model, mesh, std::uint32_t(t), on_component[t]);
+      if (!options.accept_undecided)
+        throw_undecided(model, mesh, std::uint32_t(t), on_component[t]);
       result.components.push_back(kInteriorUndecided);
       ++summary.interior_undecided;
     } else {

@@ -19,16 +19,16 @@ constexpr std::uint32_t kInteriorUndecided = 0xffffffffu;
 // tables by tet (see docs/FORMAT.md), exactly, by vertical ray parity (RayParity.h) over one
 // stream of the records per pass.
 struct Interiors {
-  std::vector<double> reference_points;  // 3 per tet; NaN for a tet without one
-  std::vector<std::uint64_t> offsets;    // tet_count + 1
-  std::vector<std::uint32_t> components; // kInteriorUndecided marks an undecided tet
+  std::vector<double> reference_points;   // 3 per tet; NaN for a tet without one
+  std::vector<std::uint64_t> offsets;     // tet_count + 1
+  std::vector<std::uint32_t> components;  // kInteriorUndecided marks an undecided tet
   bool stored = false;
 };
 
 /// Classifies every tet's reference point when options.interiors asks for it and some
 /// component is closed (else `stored` stays false); counts the closed components in `summary`.
 /// @throw InputError for an undecided tet, unless options.accept_undecided.
-Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh, const PreprocessOptions& options,
-                             PreprocessSummary& summary);
+Interiors classify_interiors(IngestedModel& model, const TetMesh& mesh,
+                             const PreprocessOptions& options, PreprocessSummary& summary);
 
 }  // namespace tetrapage

@@ -35,7 +35,8 @@ class MortonGrid {
   std::uint64_t code(const Vec3& p) const {
     std::uint64_t code = 0;
     for (int axis = 0; axis < 3; ++axis) {
-      const double cell = std::clamp((p[axis] - lo_[axis]) * scale_[axis], 0.0, double((1 << 21) - 1));
+      const double cell =
+          std::clamp((p[axis] - lo_[axis]) * scale_[axis], 0.0, double((1 << 21) - 1));
       code |= spread_bits(std::uint64_t(cell)) << axis;
     }
     return code;

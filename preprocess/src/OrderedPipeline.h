@@ -21,8 +21,8 @@ namespace tetrapage {
 // result in flight leaked when a write failed). At most `in_flight` tokens live and they are
 // consumed in order, so slot i mod in_flight is empty again before token i + in_flight starts.
 template <class Produce, class Consume>
-void produce_in_parallel_consume_in_order(std::size_t count, std::size_t in_flight, Produce&& produce,
-                                          Consume&& consume) {
+void produce_in_parallel_consume_in_order(std::size_t count, std::size_t in_flight,
+                                          Produce&& produce, Consume&& consume) {
   using Result = std::invoke_result_t<Produce&, std::size_t>;
   in_flight = std::max<std::size_t>(in_flight, 1);
   std::vector<std::optional<Result>> slots(in_flight);
@@ -39,11 +39,12 @@ void produce_in_parallel_consume_in_order(std::size_t count, std::size_t in_flig
                                                        slots[i % in_flight].emplace(produce(i));
                                                        return i;
                                                      }) &
-          tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order, [&](std::size_t i) {
-            std::optional<Result>& slot = slots[i % in_flight];
-            consume(*slot);
-            slot.reset();
-          }));
+          tbb::make_filter<std::size_t, void>(tbb::filter_mode::serial_in_order,
+                                              [&](std::size_t i) {
+                                                std::optional<Result>& slot = slots[i % in_flight];
+                                                consume(*slot);
+                                                slot.reset();
+                                              }));
 }
 
 }  // namespace tetrapage

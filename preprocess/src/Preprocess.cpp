@@ -33,7 +33,8 @@ using Clock = std::chrono::steady_clock;
 // Runs one stage, recording its time and peak resident memory.
 class StageClock {
  public:
-  StageClock(PreprocessSummary& summary, std::string name) : summary_(summary), name_(std::move(name)) {
+  StageClock(PreprocessSummary& summary, std::string name)
+      : summary_(summary), name_(std::move(name)) {
     reset_peak_resident();
     start_ = Clock::now();
   }
@@ -64,7 +65,8 @@ auto run_stage(PreprocessSummary& summary, std::string name, Stage&& stage) {
 }
 
 // The header's source: a line per input (source_line).
-std::string index_source(const std::vector<std::filesystem::path>& inputs, const std::filesystem::path& output) {
+std::string index_source(const std::vector<std::filesystem::path>& inputs,
+                         const std::filesystem::path& output) {
   std::string source;
   for (const auto& input : inputs) {
     if (!source.empty()) source += '\n';
@@ -78,8 +80,8 @@ std::string index_source(const std::vector<std::filesystem::path>& inputs, const
 std::string source_line(const std::filesystem::path& input, const std::filesystem::path& index) {
   std::error_code error;
   const std::filesystem::path absolute = std::filesystem::absolute(input, error);
-  std::filesystem::path from_index =
-      std::filesystem::relative(absolute, std::filesystem::absolute(index, error).parent_path(), error);
+  std::filesystem::path from_index = std::filesystem::relative(
+      absolute, std::filesystem::absolute(index, error).parent_path(), error);
   if (error || from_index.empty()) from_index = absolute;
   return from_index.string() + "\t" + absolute.string();
 }
@@ -106,7 +108,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
     throw InputError("--memory " + format_byte_size(options.memory_bytes) +
                      " is below the 16 MiB the pipeline needs to work");
   const auto start = Clock::now();
-  const unsigned threads = options.threads == 0 ? unsigned(tbb::info::default_concurrency()) : options.threads;
+  const unsigned threads =
+      options.threads == 0 ? unsigned(tbb::info::default_concurrency()) : options.threads;
   tbb::global_control thread_limit(tbb::global_control::max_allowed_parallelism, threads);
 
   PreprocessSummary summary;
@@ -116,9 +119,9 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   summary.resident_at_start_bytes = resident_bytes();
   summary.precision = std::string(to_string(options.precision));
   summary.compression = std::string(to_string(options.compression));
-  const std::filesystem::path spill_folder =
-      !options.spill_folder.empty() ? options.spill_folder
-                                    : std::filesystem::absolute(output).parent_path();
+  const std::filesystem::path spill_folder = !options.spill_folder.empty()
+                                                 ? options.spill_folder
+                                                 : std::filesystem::absolute(output).parent_path();
 
   // The writer's temporary file is removed if anything below throws.
   IndexWriter writer(output, {.compression = options.compression});
@@ -126,15 +129,16 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   // The stages of docs/ARCHITECTURE.md, in order.
   IngestedModel model =
       run_stage(summary, "ingest", [&] { return ingest(inputs, options, spill_folder, summary); });
-  const ModelCoarseMesh coarse =
-      run_stage(summary, "coarse mesh", [&] { return build_model_coarse_mesh(model, options, summary); });
+  const ModelCoarseMesh coarse = run_stage(
+      summary, "coarse mesh", [&] { return build_model_coarse_mesh(model, options, summary); });
   const TetMesh& mesh = coarse.mesh;
   const MortonGrid mesh_grid(coarse.covered);
-  const Interiors interiors =
-      run_stage(summary, "interiors", [&] { return classify_interiors(model, mesh, options, summary); });
+  const Interiors interiors = run_stage(
+      summary, "interiors", [&] { return classify_interiors(model, mesh, options, summary); });
   const TetOrder tets = order_tets(mesh, mesh_grid);
-  const BucketPlan plan =
-      run_stage(summary, "buckets", [&] { return plan_buckets(model, mesh, mesh_grid, tets.order, options); });
+  const BucketPlan plan = run_stage(summary, "buckets", [&] {
+    return plan_buckets(model, mesh, mesh_grid, tets.order, options);
+  });
   summary.buckets = plan.bucket_count;
   std::vector<Vec3>().swap(model.sample);
 
@@ -143,12 +147,14 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   // what the soups take at the usual 1.2-1.4 copies a triangle.
   std::vector<CopyBucket> buckets = make_buckets(plan.bucket_count, spill_folder, model.soups);
   summary.spilled = model.soups.spilled();
-  run_stage(summary, "binning", [&] { bin_triangles(model, mesh, plan.bucket_of, buckets, options, summary); });
+  run_stage(summary, "binning",
+            [&] { bin_triangles(model, mesh, plan.bucket_of, buckets, options, summary); });
   const ShardTables shards = run_stage(summary, "shards", [&] {
     return build_shards(buckets, tets.rank, mesh.tet_count(), model, writer, options, summary);
   });
   run_stage(summary, "write index", [&] {
-    write_index(writer, mesh, shards, model, interiors, index_source(inputs, output), start, summary);
+    write_index(writer, mesh, shards, model, interiors, index_source(inputs, output), start,
+                summary);
   });
 
   summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
@@ -195,57 +201,67 @@ std::string PreprocessSummary::to_json() const {
   j["triangles_per_second"] = seconds > 0 ? double(triangles_read) / seconds : 0.0;
   j["peak_rss_bytes"] = peak_resident_bytes;
   j["resident_at_start_bytes"] = resident_at_start_bytes;
-  j["budget_exceeded_bytes"] = peak_resident_bytes > memory_budget_bytes ? peak_resident_bytes - memory_budget_bytes : 0;
+  j["budget_exceeded_bytes"] =
+      peak_resident_bytes > memory_budget_bytes ? peak_resident_bytes - memory_budget_bytes : 0;
   auto& stage_list = j["stages"] = nlohmann::ordered_json::array();
   for (const auto& stage : stages)
-    stage_list.push_back({{"name", stage.name}, {"seconds", stage.seconds}, {"peak_rss_bytes", stage.peak_resident_bytes}});
+    stage_list.push_back({{"name", stage.name},
+                          {"seconds", stage.seconds},
+                          {"peak_rss_bytes", stage.peak_resident_bytes}});
   return j.dump(2);
 }
 
 std::string PreprocessSummary::to_text() const {
   std::ostringstream text;
   char line[256];
-  std::snprintf(line, sizeof line, "triangles read %llu (degenerate dropped %llu) from %llu files, %llu parts\n",
+  std::snprintf(line, sizeof line,
+                "triangles read %llu (degenerate dropped %llu) from %llu files, %llu parts\n",
                 (unsigned long long)triangles_read, (unsigned long long)degenerate_dropped,
                 (unsigned long long)files_read, (unsigned long long)parts);
   text << line;
-  std::snprintf(line, sizeof line,
-                "regions %llu (empty %llu; %llu triangles per region asked), shards: grid %llu, rtree %llu; "
-                "duplication factor %.3f\n",
-                (unsigned long long)regions, (unsigned long long)empty_regions, (unsigned long long)region_triangles,
-                (unsigned long long)grid_shards, (unsigned long long)rtree_shards, duplication_factor);
+  std::snprintf(
+      line, sizeof line,
+      "regions %llu (empty %llu; %llu triangles per region asked), shards: grid %llu, rtree %llu; "
+      "duplication factor %.3f\n",
+      (unsigned long long)regions, (unsigned long long)empty_regions,
+      (unsigned long long)region_triangles, (unsigned long long)grid_shards,
+      (unsigned long long)rtree_shards, duplication_factor);
   text << line;
   std::snprintf(line, sizeof line, "index %s: %s (%.1f B/triangle, chunks %s), shards decoded %s\n",
                 output.string().c_str(), format_byte_size(bytes_written).c_str(),
-                triangles_read ? double(bytes_written) / double(triangles_read) : 0.0, compression.c_str(),
-                format_byte_size(shard_payload_bytes).c_str());
-  text << line << storage_statement(precision, max_rounding_distance) << "; "
-       << float_shards << " of " << (grid_shards + rtree_shards) << " shards in 4-byte floats\n";
-  std::snprintf(line, sizeof line,
-                "components %llu (closed %llu, open %llu); interiors %s (%llu tets inside, %llu undecided)\n",
-                (unsigned long long)components, (unsigned long long)closed_components,
-                (unsigned long long)(components - closed_components), interiors.c_str(), (unsigned long long)interior_tets,
-                (unsigned long long)interior_undecided);
+                triangles_read ? double(bytes_written) / double(triangles_read) : 0.0,
+                compression.c_str(), format_byte_size(shard_payload_bytes).c_str());
+  text << line << storage_statement(precision, max_rounding_distance) << "; " << float_shards
+       << " of " << (grid_shards + rtree_shards) << " shards in 4-byte floats\n";
+  std::snprintf(
+      line, sizeof line,
+      "components %llu (closed %llu, open %llu); interiors %s (%llu tets inside, %llu undecided)\n",
+      (unsigned long long)components, (unsigned long long)closed_components,
+      (unsigned long long)(components - closed_components), interiors.c_str(),
+      (unsigned long long)interior_tets, (unsigned long long)interior_undecided);
   text << line;
   if (stale_temporaries_removed > 0)
-    text << "removed " << stale_temporaries_removed << " temporary index file(s) left beside the output by killed runs\n";
+    text << "removed " << stale_temporaries_removed
+         << " temporary index file(s) left beside the output by killed runs\n";
   for (const auto& stage : stages) {
-    std::snprintf(line, sizeof line, "  %-12s %8.2f s  peak RSS %s\n", stage.name.c_str(), stage.seconds,
-                  format_byte_size(stage.peak_resident_bytes).c_str());
+    std::snprintf(line, sizeof line, "  %-12s %8.2f s  peak RSS %s\n", stage.name.c_str(),
+                  stage.seconds, format_byte_size(stage.peak_resident_bytes).c_str());
     text << line;
   }
-  std::snprintf(line, sizeof line, "total %.2f s (%.2f M triangles/s), peak RSS %s against --memory %s%s\n", seconds,
+  std::snprintf(line, sizeof line,
+                "total %.2f s (%.2f M triangles/s), peak RSS %s against --memory %s%s\n", seconds,
                 seconds > 0 ? double(triangles_read) / seconds / 1e6 : 0.0,
-                format_byte_size(peak_resident_bytes).c_str(), format_byte_size(memory_budget_bytes).c_str(),
-                spilled ? " (spilled to disk)" : "");
+                format_byte_size(peak_resident_bytes).c_str(),
+                format_byte_size(memory_budget_bytes).c_str(), spilled ? " (spilled to disk)" : "");
   text << line;
   if (peak_resident_bytes > memory_budget_bytes) {
     // --memory bounds the stages' data; the process itself and the file being read come on top.
-    std::snprintf(line, sizeof line,
-                  "budget exceeded by %s: the process held %s before any work (libraries, threads), and "
-                  "each input file's soup is held whole while it is read\n",
-                  format_byte_size(peak_resident_bytes - memory_budget_bytes).c_str(),
-                  format_byte_size(resident_at_start_bytes).c_str());
+    std::snprintf(
+        line, sizeof line,
+        "budget exceeded by %s: the process held %s before any work (libraries, threads), and "
+        "each input file's soup is held whole while it is read\n",
+        format_byte_size(peak_resident_bytes - memory_budget_bytes).c_str(),
+        format_byte_size(resident_at_start_bytes).c_str());
     text << line;
   }
   return text.str();

@@ -21,7 +21,8 @@ struct ShardTables {
   std::vector<std::uint32_t> tet_shard;  ///< per tet; TetMesh::no_neighbour: no shard
   std::vector<std::uint32_t> shard_tet, shard_triangles;
   std::vector<std::uint8_t> shard_kind;
-  std::vector<double> shard_bounds;  ///< 6 per shard: lo xyz, hi xyz, enclosing the stored triangles
+  std::vector<double>
+      shard_bounds;  ///< 6 per shard: lo xyz, hi xyz, enclosing the stored triangles
 };
 
 /// Empties the buckets one at a time into shards (a tet's shard holds its copies; `tet_rank`:

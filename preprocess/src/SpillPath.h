@@ -10,7 +10,8 @@
 
 namespace tetrapage {
 
-inline std::filesystem::path spill_path(const std::filesystem::path& folder, const std::string& what) {
+inline std::filesystem::path spill_path(const std::filesystem::path& folder,
+                                        const std::string& what) {
   return folder / (".tetrapage-spill-" + std::to_string(::getpid()) + "-" + what);
 }
 

@@ -52,27 +52,30 @@ void prepare_planes(const TetMesh& mesh, std::uint32_t tet, BinningScratch& scra
 
 }  // namespace
 
-void bin_triangle(const TetMesh& mesh, const geometry::Triangle& triangle,
-                  BinningScratch& scratch, std::vector<std::uint32_t>& tets) {
+void bin_triangle(const TetMesh& mesh, const geometry::Triangle& triangle, BinningScratch& scratch,
+                  std::vector<std::uint32_t>& tets) {
   if (scratch.hint >= mesh.tet_count()) scratch.hint = 0;
   // A tet holding the first corner: the last triangle's, as a rule (triangles come in Morton
   // order), else the walk's. The last tet's face planes are kept: a corner's test against them
   // is four dot products in the common case, a walk dozens of predicates.
   std::uint32_t start = scratch.hint;
   prepare_planes(mesh, start, scratch);
-  Side corner0 = scratch.orientation == geometry::Sign::zero ? Side::outside : side_of(scratch, triangle[0]);
+  Side corner0 =
+      scratch.orientation == geometry::Sign::zero ? Side::outside : side_of(scratch, triangle[0]);
   if (corner0 == Side::outside) {
     const WalkResult located = locate_point(mesh, scratch.hint, triangle[0]);
     if (located.tet == TetMesh::no_neighbour) {
       char text[160];
-      std::snprintf(text, sizeof text, "triangle vertex (%.17g, %.17g, %.17g) lies outside the coarse mesh",
+      std::snprintf(text, sizeof text,
+                    "triangle vertex (%.17g, %.17g, %.17g) lies outside the coarse mesh",
                     triangle[0][0], triangle[0][1], triangle[0][2]);
       throw InputError(text);
     }
     start = located.tet;
     scratch.hint = start;
     prepare_planes(mesh, start, scratch);
-    corner0 = located.location.position == geometry::TetrahedronPosition::inside ? Side::inside : Side::boundary;
+    corner0 = located.location.position == geometry::TetrahedronPosition::inside ? Side::inside
+                                                                                 : Side::boundary;
   }
   // Most triangles lie strictly inside one tet: all three corners in its open interior put the
   // whole triangle there (the tet is convex), and the closed neighbours meet it only on their
@@ -104,12 +107,12 @@ void bin_triangle(const TetMesh& mesh, const geometry::Triangle& triangle,
     tets.push_back(tet);
     for (const std::uint32_t neighbour : mesh.neighbours[tet]) {
       if (neighbour == TetMesh::no_neighbour) continue;
-      if (std::find(queue.begin(), queue.end(), neighbour) == queue.end()) queue.push_back(neighbour);
+      if (std::find(queue.begin(), queue.end(), neighbour) == queue.end())
+        queue.push_back(neighbour);
     }
   }
   std::sort(tets.begin() + std::ptrdiff_t(first), tets.end());
 }
-
 
 namespace {
 
@@ -131,7 +134,8 @@ void sort_by_high_word(std::vector<std::uint64_t>& words, std::vector<std::uint6
 // Only the order of the work changes (binning is exact whatever the order): the top 32
 // bits of the code (10-11 per axis) and the triangle's index in one word, sorted by a
 // radix sort (a comparison sort of (code, index) pairs took a tenth of binning's CPU).
-std::uint64_t morton_word(const MortonGrid& model_grid, const TriangleRecord& record, std::size_t i) {
+std::uint64_t morton_word(const MortonGrid& model_grid, const TriangleRecord& record,
+                          std::size_t i) {
   return (model_grid.code(centroid(record.triangle)) >> 31 << 32) | std::uint64_t(i);
 }
 
@@ -154,9 +158,10 @@ using BinningThreadStates = tbb::enumerable_thread_specific<BinningThreadState>;
 // counting sort by tet keeps (sorting each tet's pairs by id was 2 % of the 10M CPU).
 // Binning block by block (a block per soup, 745 at 10M) made both threads wait at every
 // block's end while one built the next block and appended the last one's copies.
-void bin_in_memory_soups(const SoupSpill<TriangleRecord>& soups, const TetMesh& mesh, const MortonGrid& model_grid,
-                         std::span<const std::uint32_t> bucket_of, std::span<CopyBucket> buckets,
-                         BinningThreadStates& states, Progress& progress) {
+void bin_in_memory_soups(const SoupSpill<TriangleRecord>& soups, const TetMesh& mesh,
+                         const MortonGrid& model_grid, std::span<const std::uint32_t> bucket_of,
+                         std::span<CopyBucket> buckets, BinningThreadStates& states,
+                         Progress& progress) {
   const std::size_t bucket_count = buckets.size();
   const std::vector<InMemoryTask> tasks = in_memory_tasks(soups);
   struct TaskPairs {
@@ -206,11 +211,12 @@ void bin_in_memory_soups(const SoupSpill<TriangleRecord>& soups, const TetMesh& 
 
 // Soups spilled: blocks read back from the spill file, each binned by all threads, the
 // copies as records.
-void bin_spilled_soups(SoupSpill<TriangleRecord>& soups, const TetMesh& mesh, const MortonGrid& model_grid,
-                       std::span<const std::uint32_t> bucket_of, std::span<CopyBucket> buckets,
-                       std::uint64_t memory_bytes, BinningThreadStates& states, Progress& progress) {
-  const std::size_t block_records = std::clamp<std::size_t>(memory_bytes / 12 / sizeof(TriangleRecord),
-                                                            1024, 0xffff'ffffu);  // indices in 32 bits
+void bin_spilled_soups(SoupSpill<TriangleRecord>& soups, const TetMesh& mesh,
+                       const MortonGrid& model_grid, std::span<const std::uint32_t> bucket_of,
+                       std::span<CopyBucket> buckets, std::uint64_t memory_bytes,
+                       BinningThreadStates& states, Progress& progress) {
+  const std::size_t block_records = std::clamp<std::size_t>(
+      memory_bytes / 12 / sizeof(TriangleRecord), 1024, 0xffff'ffffu);  // indices in 32 bits
   std::vector<std::uint64_t> binning_order, radix_scratch;
   soups.for_each_block(block_records, [&](std::span<const TriangleRecord> block) {
     binning_order.resize(block.size());
@@ -246,8 +252,9 @@ void bin_spilled_soups(SoupSpill<TriangleRecord>& soups, const TetMesh& mesh, co
 
 }  // namespace
 
-void bin_triangles(IngestedModel& model, const TetMesh& mesh, std::span<const std::uint32_t> bucket_of,
-                   std::span<CopyBucket> buckets, const PreprocessOptions& options, PreprocessSummary& summary) {
+void bin_triangles(IngestedModel& model, const TetMesh& mesh,
+                   std::span<const std::uint32_t> bucket_of, std::span<CopyBucket> buckets,
+                   const PreprocessOptions& options, PreprocessSummary& summary) {
   // The copies as the buckets keep them: (id, tet) pairs while the soups are in memory (a
   // record of 88 bytes made and then read back for each copy was a serial tenth of binning),
   // else records for the spill files.
@@ -262,7 +269,8 @@ void bin_triangles(IngestedModel& model, const TetMesh& mesh, std::span<const st
   if (pairs)
     bin_in_memory_soups(model.soups, mesh, model_grid, bucket_of, buckets, states, progress);
   else
-    bin_spilled_soups(model.soups, mesh, model_grid, bucket_of, buckets, options.memory_bytes, states, progress);
+    bin_spilled_soups(model.soups, mesh, model_grid, bucket_of, buckets, options.memory_bytes,
+                      states, progress);
   progress.finish();
   for (auto& s : states) summary.exact_tet_tests += s.scratch.tet_tests;
   // The soups go now, unless the buckets make their copies' records from them.

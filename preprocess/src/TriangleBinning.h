@@ -18,7 +18,8 @@ namespace tetrapage {
 /// while the soups are in memory, records while they are spilled; the spilled soups are then
 /// cleared (in memory, the shard stage still gathers its triangles from them).
 /// @throw InputError when a triangle's first vertex lies outside the mesh.
-void bin_triangles(IngestedModel& model, const TetMesh& mesh, std::span<const std::uint32_t> bucket_of,
-                   std::span<CopyBucket> buckets, const PreprocessOptions& options, PreprocessSummary& summary);
+void bin_triangles(IngestedModel& model, const TetMesh& mesh,
+                   std::span<const std::uint32_t> bucket_of, std::span<CopyBucket> buckets,
+                   const PreprocessOptions& options, PreprocessSummary& summary);
 
 }  // namespace tetrapage

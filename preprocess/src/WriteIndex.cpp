@@ -34,20 +34,24 @@ void write_shard_tables(IndexWriter& writer, const ShardTables& shards) {
   writer.write_table(schema::table::tet_shard, std::span<const std::uint32_t>(shards.tet_shard));
   writer.write_table(schema::table::shard_tet, std::span<const std::uint32_t>(shards.shard_tet));
   writer.write_table(schema::table::shard_kind, std::span<const std::uint8_t>(shards.shard_kind));
-  writer.write_table(schema::table::shard_triangles, std::span<const std::uint32_t>(shards.shard_triangles));
+  writer.write_table(schema::table::shard_triangles,
+                     std::span<const std::uint32_t>(shards.shard_triangles));
   writer.write_table(schema::table::shard_bounds, std::span<const double>(shards.shard_bounds));
 }
 
 void write_interiors(IndexWriter& writer, const Interiors& interiors) {
-  writer.write_table(schema::table::reference_points, std::span<const double>(interiors.reference_points));
-  writer.write_table(schema::table::interior_offsets, std::span<const std::uint64_t>(interiors.offsets));
-  writer.write_table(schema::table::interior_components, std::span<const std::uint32_t>(interiors.components));
+  writer.write_table(schema::table::reference_points,
+                     std::span<const double>(interiors.reference_points));
+  writer.write_table(schema::table::interior_offsets,
+                     std::span<const std::uint64_t>(interiors.offsets));
+  writer.write_table(schema::table::interior_components,
+                     std::span<const std::uint32_t>(interiors.components));
 }
 
 }  // namespace
 
-void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& shards, const IngestedModel& model,
-                 const Interiors& interiors, const std::string& source,
+void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& shards,
+                 const IngestedModel& model, const Interiors& interiors, const std::string& source,
                  std::chrono::steady_clock::time_point start, PreprocessSummary& summary) {
   writer.write_mesh(mesh);
   write_shard_tables(writer, shards);

@@ -17,8 +17,8 @@ namespace tetrapage {
 
 /// `source`: the inputs' source lines (source_line), one a line. The header's build report
 /// is the summary so far, its seconds counted from `start`; summary.bytes_written is set.
-void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& shards, const IngestedModel& model,
-                 const Interiors& interiors, const std::string& source,
+void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& shards,
+                 const IngestedModel& model, const Interiors& interiors, const std::string& source,
                  std::chrono::steady_clock::time_point start, PreprocessSummary& summary);
 
 }  // namespace tetrapage
