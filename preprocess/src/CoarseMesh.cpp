@@ -11,6 +11,7 @@
 #include <cmath>
 #include <string>
 
+#include "CoarseMesh.h"
 #include "tetrapage/formats/Error.h"
 
 namespace tetrapage {
@@ -18,8 +19,9 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using VertexBase = CGAL::Triangulation_vertex_base_with_info_3<std::uint32_t, Kernel>;
-using CellBase = CGAL::Triangulation_cell_base_with_info_3<
-    std::uint32_t, Kernel, CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
+using CellBase =
+    CGAL::Triangulation_cell_base_with_info_3<std::uint32_t, Kernel,
+                                              CGAL::Delaunay_triangulation_cell_base_3<Kernel>>;
 using DataStructure = CGAL::Triangulation_data_structure_3<VertexBase, CellBase>;
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel, DataStructure>;
 
@@ -100,7 +102,8 @@ TetMesh build_coarse_mesh(std::span<const Vec3> sites) {
   Delaunay delaunay(points.begin(), points.end());
   if (delaunay.dimension() < 3)
     throw InputError("coarse mesh: the " + std::to_string(sites.size()) +
-                     " sites span no volume (dimension " + std::to_string(delaunay.dimension()) + ")");
+                     " sites span no volume (dimension " + std::to_string(delaunay.dimension()) +
+                     ")");
 
   TetMesh mesh;
   // Renumber vertices densely (duplicate sites were merged by CGAL) in site order.
@@ -128,6 +131,24 @@ TetMesh build_coarse_mesh(std::span<const Vec3> sites) {
     }
   }
   return mesh;
+}
+
+ModelCoarseMesh build_model_coarse_mesh(IngestedModel& model, const PreprocessOptions& options,
+                                        PreprocessSummary& summary) {
+  // The sample stands for all triangles: scale the leaf size to its share.
+  const double share = double(model.sample.size()) / double(model.triangle_count);
+  summary.region_triangles = options.region_triangles != 0
+                                 ? options.region_triangles
+                                 : auto_region_triangles(model.triangle_count);
+  SamplingOptions sampling;
+  sampling.leaf_triangles =
+      std::max<std::size_t>(1, std::size_t(std::llround(double(summary.region_triangles) * share)));
+  // Reorders the sample (the buckets' estimate takes any every-stride-th of it).
+  const std::vector<Vec3> sites = sample_sites(model.sample, model.bounds, sampling);
+  summary.sites = sites.size();
+  ModelCoarseMesh coarse{build_coarse_mesh(sites), enlarged_bounds(model.bounds, sampling.margin)};
+  summary.regions = coarse.mesh.tet_count();
+  return coarse;
 }
 
 }  // namespace tetrapage

@@ -1,15 +1,22 @@
 #include "tetrapage/preprocess/ShardBuilder.h"
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <string>
 
+#include "OrderedPipeline.h"
+#include "ShardBuilder.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Progress.h"
+#include "tetrapage/preprocess/ShardCostModel.h"
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
@@ -119,9 +126,9 @@ struct StoredGeometry {
   StoredPrecision precision = StoredPrecision::float64;  ///< float32 or float64
   bool rounds = false;  ///< float32 on a fixed-point step (--precision float), not lossless
   Frame frame;
-  std::vector<Point> relative;                      ///< per distinct vertex, first-seen order
+  std::vector<Point> relative;                        ///< per distinct vertex, first-seen order
   std::vector<std::array<std::uint32_t, 3>> corners;  ///< per triangle
-  std::vector<Triangle> triangles;                  ///< absolute stored coordinates
+  std::vector<Triangle> triangles;                    ///< absolute stored coordinates
   double max_rounding_distance = 0;
 };
 
@@ -160,7 +167,7 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
           r[k] = double(float(std::nearbyint(r[k] / g.frame.step) * g.frame.step));
         else if (g.precision == StoredPrecision::float32)
           r[k] = double(float(r[k]));  // exact: the frame was checked to be lossless
-        r[k] += 0.0;  // one key for 0 and -0
+        r[k] += 0.0;                   // one key for 0 and -0
       }
       Point stored;
       double squared = 0;
@@ -196,7 +203,7 @@ StoredGeometry store(std::span<const Triangle> input, StoredPrecision precision)
 // Grid
 
 std::array<std::uint32_t, 3> grid_cells_for(const Box& bounds, std::size_t triangles,
-                                           double cells_per_triangle) {
+                                            double cells_per_triangle) {
   const double target = std::max(1.0, cells_per_triangle * double(triangles));
   const Point size = bounds.size();
   std::array<bool, 3> active{};
@@ -236,8 +243,8 @@ GridShape grid_shape(const Box& bounds, std::array<std::uint32_t, 3> cells) {
   shape.lo = bounds.lo;
   for (int k = 0; k < 3; ++k) {
     const double extent = bounds.hi[k] - bounds.lo[k];
-    double h = extent > 0 ? extent / cells[k]
-                          : std::max(std::fabs(bounds.lo[k]) * 0x1p-40, 0x1p-900);
+    double h =
+        extent > 0 ? extent / cells[k] : std::max(std::fabs(bounds.lo[k]) * 0x1p-40, 0x1p-900);
     // Grow the cell until the last boundary, rounded as queries round it, holds every vertex.
     for (int i = 0; shard_format::grid_boundary(shape.lo[k], h, cells[k]) < bounds.hi[k]; ++i) {
       if (i > 200) throw std::logic_error("grid extent does not converge");
@@ -269,8 +276,8 @@ GridIndex build_grid(const std::vector<Triangle>& triangles, const Box& bounds,
     const Box box = geometry::box_of(triangles[t]);
     std::array<std::uint32_t, 3> first{}, last{};
     for (int k = 0; k < 3; ++k)
-      if (!shard_format::grid_cell_range(s.lo[k], s.cell_size[k], cells[k], box.lo[k],
-                                         box.hi[k], first[k], last[k]))
+      if (!shard_format::grid_cell_range(s.lo[k], s.cell_size[k], cells[k], box.lo[k], box.hi[k],
+                                         first[k], last[k]))
         throw std::logic_error("a stored triangle lies outside its grid");
     const bool single = first == last;
     for (std::uint32_t z = first[2]; z <= last[2]; ++z)
@@ -280,8 +287,7 @@ GridIndex build_grid(const std::vector<Triangle>& triangles, const Box& bounds,
           cell.lo = {boundary(0, x), boundary(1, y), boundary(2, z)};
           cell.hi = {boundary(0, x + 1), boundary(1, y + 1), boundary(2, z + 1)};
           if (single || geometry::triangle_intersects_box(triangles[t], cell))
-            pairs.emplace_back(std::uint32_t((std::uint64_t(z) * cells[1] + y) * cells[0] + x),
-                               t);
+            pairs.emplace_back(std::uint32_t((std::uint64_t(z) * cells[1] + y) * cells[0] + x), t);
         }
   }
   if (pairs.size() >= std::numeric_limits<std::uint32_t>::max())
@@ -407,7 +413,8 @@ class RtreeBuilder {
     Box spread;
     for (std::uint32_t i = begin; i < end; ++i) spread.extend(centres_[order_[i]]);
     const Point size = spread.size();
-    const int axis = size[0] >= size[1] ? (size[0] >= size[2] ? 0 : 2) : (size[1] >= size[2] ? 1 : 2);
+    const int axis =
+        size[0] >= size[1] ? (size[0] >= size[2] ? 0 : 2) : (size[1] >= size[2] ? 1 : 2);
     // The cut needs no more than the centres' order along the axis: the centre in float and
     // the triangle number in one integer, whose selection is a third of the time of
     // (double centre, triangle) records with a comparison function.
@@ -424,9 +431,9 @@ class RtreeBuilder {
 
   const std::vector<Box>& boxes_;
   std::uint32_t leaf_size_, fanout_;
-  std::vector<Point> centres_;         ///< per triangle
-  std::vector<std::uint32_t> order_;   ///< the triangles, in tree order once built
-  std::vector<std::uint64_t> keys_;    ///< a cut's scratch
+  std::vector<Point> centres_;        ///< per triangle
+  std::vector<std::uint32_t> order_;  ///< the triangles, in tree order once built
+  std::vector<std::uint64_t> keys_;   ///< a cut's scratch
   std::vector<RtreeNode> nodes_;
 };
 
@@ -493,8 +500,8 @@ struct StoredRegion::Tables {
   ShardTriangles region;
   StoredPrecision precision;
   StoredGeometry g;
-  Box bounds;                 ///< of the stored triangles
-  std::vector<Box> boxes;     ///< per triangle, relative (stored) coordinates
+  Box bounds;                               ///< of the stored triangles
+  std::vector<Box> boxes;                   ///< per triangle, relative (stored) coordinates
   std::vector<std::uint32_t> palette;       ///< the distinct part ids, sorted
   std::vector<std::uint32_t> part_indices;  ///< per triangle, into palette
   std::uint64_t id_base = 0;
@@ -530,9 +537,13 @@ StoredRegion::~StoredRegion() = default;
 StoredRegion::StoredRegion(StoredRegion&&) noexcept = default;
 StoredRegion& StoredRegion::operator=(StoredRegion&&) noexcept = default;
 
-double StoredRegion::max_rounding_distance() const { return tables_->g.max_rounding_distance; }
+double StoredRegion::max_rounding_distance() const {
+  return tables_->g.max_rounding_distance;
+}
 
-std::span<const Triangle> StoredRegion::stored_triangles() const { return tables_->g.triangles; }
+std::span<const Triangle> StoredRegion::stored_triangles() const {
+  return tables_->g.triangles;
+}
 
 BuiltShard build_shard(const ShardTriangles& region, ShardKind kind, StoredPrecision precision,
                        const ShardLayout& layout) {
@@ -605,13 +616,11 @@ BuiltShard StoredRegion::build(ShardKind kind, const ShardLayout& layout) const 
   std::vector<std::byte>& out = built.payload;
   {  // one allocation: appends then never move the payload
     const std::size_t real = precision == StoredPrecision::float32 ? 4 : 8;
-    const std::size_t structure = kind == ShardKind::grid
-                                      ? 4 * grid.cell_offsets.size()
-                                      : nodes.size() * (6 * real + 8);
+    const std::size_t structure =
+        kind == ShardKind::grid ? 4 * grid.cell_offsets.size() : nodes.size() * (6 * real + 8);
     out.reserve(sf::kHeaderBytes + 3 * real * vertex_count +
-                std::size_t(n) * (3 * index_bytes + id_bytes + part_bytes) +
-                4 * palette.size() + structure + reference_bytes * grid.references.size() +
-                8 * 8);
+                std::size_t(n) * (3 * index_bytes + id_bytes + part_bytes) + 4 * palette.size() +
+                structure + reference_bytes * grid.references.size() + 8 * 8);
   }
   out.assign(sf::kHeaderBytes, std::byte{0});
   PayloadWriter w(out);
@@ -626,9 +635,8 @@ BuiltShard StoredRegion::build(ShardKind kind, const ShardLayout& layout) const 
   w.put<std::uint32_t>(12, vertex_count);
   w.put<std::uint32_t>(16, n);
   w.put<std::uint32_t>(20, std::uint32_t(palette.size()));
-  w.put<std::uint32_t>(24, kind == ShardKind::grid
-                               ? std::uint32_t(grid.cell_offsets.size() - 1)
-                               : std::uint32_t(nodes.size()));
+  w.put<std::uint32_t>(24, kind == ShardKind::grid ? std::uint32_t(grid.cell_offsets.size() - 1)
+                                                   : std::uint32_t(nodes.size()));
   w.put<std::uint32_t>(28, std::uint32_t(grid.references.size()));
   w.put<std::uint64_t>(32, id_base);
   for (int k = 0; k < 3; ++k) {
@@ -702,6 +710,124 @@ BuiltShard StoredRegion::build(ShardKind kind, const ShardLayout& layout) const 
   }
   begin_section();  // end
   return built;
+}
+
+namespace {
+
+// One shard built and compressed, waiting for its turn to be appended.
+struct ReadyShard {
+  BuiltShard built;  // its payload freed once encoded
+  std::uint64_t payload_bytes = 0;
+  EncodedShard encoded;
+  BoundingBox bounds;
+  std::uint32_t tet = 0;
+};
+
+// The extent of the queries the cost model prices: the option, else a twentieth of the
+// model's largest side.
+double query_extent_for(const PreprocessOptions& options, const BoundingBox& model_bounds) {
+  if (options.query_extent > 0) return options.query_extent;
+  const Vec3 size = model_bounds.size();
+  return 0.05 * std::max({size[0], size[1], size[2]});
+}
+
+// The shard of copies [first, last) (one tet's) of a bucket: the kind asked, or the cost
+// model's choice, built and encoded with the writer's options.
+std::shared_ptr<ReadyShard> build_encoded_shard(const BucketCopies& copies, std::size_t first,
+                                                std::size_t last, double query_extent,
+                                                const ShardCostModel& cost_model,
+                                                const PreprocessOptions& options,
+                                                const IndexWriterOptions& writer_options) {
+  auto ready = std::make_shared<ReadyShard>();
+  std::vector<geometry::Triangle> triangles;
+  std::vector<std::uint64_t> ids;
+  std::vector<std::uint32_t> parts;
+  triangles.reserve(last - first);
+  ids.reserve(last - first);
+  parts.reserve(last - first);
+  copies.gather(first, last, triangles, ids, parts);
+  for (const geometry::Triangle& t : triangles)
+    for (const auto& p : t) ready->bounds.extend(p);
+  ready->tet = copies.tet(first);
+  const ShardTriangles region{triangles, ids, parts};
+  if (options.shard == ShardChoice::automatic) {
+    ShardCostReport costs =
+        estimate_shard_costs(region, query_extent, options.precision, cost_model);
+    ready->built =
+        std::move(costs.chosen == ShardKind::grid ? costs.grid.built : costs.rtree.built);
+  } else {
+    ready->built =
+        build_shard(region, options.shard == ShardChoice::grid ? ShardKind::grid : ShardKind::rtree,
+                    options.precision);
+  }
+  ready->encoded = encode_shard(ready->built.payload, writer_options);
+  ready->payload_bytes = ready->built.payload.size();
+  std::vector<std::byte>().swap(ready->built.payload);
+  return ready;
+}
+
+// Appends a ready shard to the index, its rows to the tables and its figures to the summary.
+void append_shard(const ReadyShard& ready, IndexWriter& writer, ShardTables& tables,
+                  PreprocessSummary& summary) {
+  const BuiltShard& built = ready.built;
+  // Stored vertices lie within the shard's rounding distance of the input
+  // ones: grow the input box by it (and a few ulps) so the runtime can skip
+  // shards unread.
+  BoundingBox bounds = ready.bounds;
+  for (int a = 0; a < 3; ++a) {
+    const double grow = built.max_rounding_distance +
+                        0x1p-50 * std::max(std::fabs(bounds.lo[a]), std::fabs(bounds.hi[a]));
+    bounds.lo[a] -= grow;
+    bounds.hi[a] += grow;
+  }
+  tables.shard_bounds.insert(tables.shard_bounds.end(), {bounds.lo[0], bounds.lo[1], bounds.lo[2],
+                                                         bounds.hi[0], bounds.hi[1], bounds.hi[2]});
+  const std::uint32_t shard = writer.append_encoded_shard(ready.encoded);
+  tables.tet_shard[ready.tet] = shard;
+  tables.shard_tet.push_back(ready.tet);
+  tables.shard_kind.push_back(std::uint8_t(built.kind));
+  tables.shard_triangles.push_back(built.triangle_count);
+  summary.stored_triangles += built.triangle_count;
+  summary.shard_payload_bytes += ready.payload_bytes;
+  summary.max_rounding_distance =
+      std::max(summary.max_rounding_distance, built.max_rounding_distance);
+  (built.kind == ShardKind::grid ? summary.grid_shards : summary.rtree_shards) += 1;
+  summary.float_shards += built.precision == StoredPrecision::float32;
+}
+
+}  // namespace
+
+ShardTables build_shards(std::span<CopyBucket> buckets, std::span<const std::uint32_t> tet_rank,
+                         std::size_t tet_count, IngestedModel& model, IndexWriter& writer,
+                         const PreprocessOptions& options, PreprocessSummary& summary) {
+  ShardTables tables;
+  tables.tet_shard.assign(tet_count, TetMesh::no_neighbour);
+  const double query_extent = query_extent_for(options, model.bounds);
+  summary.query_extent = query_extent;
+  const ShardCostModel cost_model;
+  Progress progress("building shards", tet_count, options.progress);
+  for (auto& bucket : buckets) {
+    BucketCopies copies = bucket.take();
+    // The copies in (tet rank, id) order: each tet's then lie side by side.
+    const std::vector<std::size_t> group_start = copies.order_by_tet(tet_rank);
+    // Built and compressed on all threads, appended in order on one while the others build
+    // on: a pipeline with a few shards in flight (the bucket's shards are never all held).
+    produce_in_parallel_consume_in_order(
+        group_start.size() - 1, 4 * std::size_t(tbb::this_task_arena::max_concurrency()),
+        [&](std::size_t g) {
+          return build_encoded_shard(copies, group_start[g], group_start[g + 1], query_extent,
+                                     cost_model, options, writer.options());
+        },
+        [&](const std::shared_ptr<ReadyShard>& ready) {
+          append_shard(*ready, writer, tables, summary);
+          progress.advance();
+        });
+  }
+  progress.finish();
+  model.soups.clear();
+  summary.empty_regions = tet_count - tables.shard_tet.size();
+  summary.duplication_factor = double(summary.stored_triangles) / double(model.triangle_count);
+  return tables;
 }
 
 }  // namespace tetrapage

@@ -1,0 +1,163 @@
+#include "Ingest.h"
+
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <random>
+
+#include "Interiors.h"
+#include "OrderedPipeline.h"
+#include "SpillPath.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/Progress.h"
+
+namespace tetrapage {
+namespace {
+
+// One input soup (a manifest's part, or a mesh file) with what can be computed off the
+// ingest's serial path: centroids, and its surfaces' connected components (its part_of then
+// holds each triangle's component, numbered within the soup).
+struct LoadedSoup {
+  std::uint64_t degenerate_dropped = 0;
+  std::uint64_t files_read = 0;
+  TriangleSoup soup;
+  std::vector<Vec3> centroids;  // per triangle
+  std::vector<SurfaceComponent> components;
+};
+
+// Coordinates beyond kMaxCoordinateMagnitude overflow the coarse mesh's enlarged box and the
+// exact predicates' products: refused, naming the file and the value.
+void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& piece) {
+  const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup);
+  if (!beyond.found) return;
+  char value[64];
+  std::snprintf(value, sizeof value, "%g", beyond.value);
+  const std::string file =
+      piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
+  throw InputError(
+      file + ": a vertex coordinate of " + value +
+      " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
+}
+
+LoadedSoup load_soup(const InputPiece& piece) {
+  LoadedSoup loaded;
+  std::vector<ReadReport> reports;
+  loaded.soup = load_input_piece(piece, &reports);
+  for (const auto& report : reports) {
+    loaded.degenerate_dropped += report.degenerate_dropped;
+    ++loaded.files_read;
+  }
+  TriangleSoup& soup = loaded.soup;
+  check_coordinate_magnitudes(soup, piece);
+  SurfaceComponents found = find_surface_components(soup);
+  soup.part_of = std::move(found.component_of);
+  loaded.components = std::move(found.components);
+  loaded.centroids.resize(soup.triangle_count());
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
+    loaded.centroids[t] = centroid(soup.corners(t));
+  return loaded;
+}
+
+// How many soups the ingest's pipeline may hold at once. One more than the threads left both
+// threads idle whenever the in-order append waited for a slow file; four times the threads
+// took the 10M ingest from 0.91 to 0.72 s. Bounded so that the soups in flight, taken at 4
+// times their files' bytes, stay within an eighth of the budget. (A loaded soup holds double
+// vertices, indices and a double centroid a triangle: by arithmetic about 2.6 times a binary
+// PLY of float vertices, less for double ones; not measured for every reader.)
+std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memory_bytes,
+                         std::size_t threads) {
+  std::uint64_t largest = 0;
+  for (const InputPiece& job : jobs) {
+    std::error_code error;
+    if (!job.manifest) {
+      largest = std::max<std::uint64_t>(largest, std::filesystem::file_size(job.input, error));
+      continue;
+    }
+    const ManifestPart& part = job.manifest->parts[job.part];
+    const std::uint64_t bytes = std::filesystem::file_size(part.file, error);
+    if (!error)
+      largest =
+          std::max<std::uint64_t>(largest, bytes * std::max<std::size_t>(part.instances.size(), 1));
+  }
+  const std::size_t fewest = threads + 1, most = 4 * threads;
+  if (largest == 0) return fewest;
+  return std::clamp<std::size_t>(std::size_t(memory_bytes / 8 / (4 * largest)), fewest,
+                                 std::max(fewest, most));
+}
+
+}  // namespace
+
+IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
+                     const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                     PreprocessSummary& summary) {
+  IngestedModel model;
+  const std::uint64_t held_limit = options.memory_bytes / 4;
+  // At most 2M centroids, at least 2^16: a site stands for the mean of hundreds of sampled
+  // centroids at the default region size. A cap of 4M gave the 10M scene the same regions
+  // (26,081 against 26,071), duplication (1.2623 against 1.2630) and flights in memory (six
+  // objects, four runs each, within their noise) at twice the coarse mesh's time; 1M began to
+  // show in the flights (the tetrahedron's 7 % slower; docs/BENCHMARKS.md).
+  const std::size_t sample_capacity = std::size_t(
+      std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 21));
+  model.sample.reserve(std::min<std::size_t>(sample_capacity, 1 << 16));
+  std::mt19937_64 random(0x7e7a9a9e);
+
+  // In input order (ids, part numbers and the sample do not depend on the threads).
+  auto add_soup = [&](LoadedSoup& loaded) {
+    summary.degenerate_dropped += loaded.degenerate_dropped;
+    summary.files_read += loaded.files_read;
+    const auto part_offset = std::uint32_t(model.part_names.size());
+    for (const auto& name : loaded.soup.part_names) model.part_names.push_back(name);
+    if (loaded.soup.part_names.empty())
+      model.part_names.push_back("part" + std::to_string(part_offset));
+    if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
+      throw InputError("the inputs hold more than 2^32 - 2 connected components");
+    const auto component_offset = std::uint32_t(model.components.size());
+    for (SurfaceComponent& c : loaded.components) {
+      c.part += part_offset;
+      model.bounds.extend(c.bounds);
+      model.components.push_back(c);
+    }
+    model.soups.append(loaded.soup, component_offset);
+    if (!model.soups.spilled() && (model.soups.held_bytes() > held_limit || options.force_spill))
+      model.soups.spill_to(spill_path(spill_folder, "triangles"));
+    for (std::size_t t = 0; t < loaded.centroids.size(); ++t, ++model.triangle_count) {
+      if (model.sample.size() < sample_capacity) {
+        model.sample.push_back(loaded.centroids[t]);
+      } else {
+        const std::uint64_t slot =
+            std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(random);
+        if (slot < sample_capacity) model.sample[slot] = loaded.centroids[t];
+      }
+    }
+  };
+
+  // One part file at a time per thread: the ingest never holds the assembly.
+  const std::vector<InputPiece> jobs = input_pieces(inputs);
+  // Parsing, edge parity, bounds and centroids run on all threads, a few soups at once; the
+  // soups are appended in input order on one.
+  Progress progress("reading parts", jobs.size(), options.progress);
+  const std::size_t in_flight = ingest_depth(jobs, options.memory_bytes,
+                                             std::size_t(tbb::this_task_arena::max_concurrency()));
+  produce_in_parallel_consume_in_order(
+      jobs.size(), in_flight,
+      [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); },
+      [&](const std::shared_ptr<LoadedSoup>& loaded) {
+        add_soup(*loaded);
+        progress.advance();
+      });
+  progress.finish();
+  summary.triangles_read = model.triangle_count;
+  summary.parts = model.part_names.size();
+  summary.components = model.components.size();
+  if (model.triangle_count == 0)
+    throw InputError("the inputs hold no triangle (after dropping degenerate ones)");
+  return model;
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,75 @@
+#include "WriteIndex.h"
+
+#include <span>
+#include <vector>
+
+#include "tetrapage/formats/IndexHeader.h"
+#include "tetrapage/formats/IndexSchema.h"
+
+namespace tetrapage {
+namespace {
+
+namespace schema = index_schema;
+
+// The components table (docs/FORMAT.md): each component's part, closedness and box.
+void write_components(IndexWriter& writer, const std::vector<SurfaceComponent>& components) {
+  std::vector<std::uint32_t> part;
+  std::vector<std::uint8_t> closed;
+  std::vector<double> bounds;
+  part.reserve(components.size());
+  closed.reserve(components.size());
+  bounds.reserve(6 * components.size());
+  for (const SurfaceComponent& c : components) {
+    part.push_back(c.part);
+    closed.push_back(c.closed ? 1 : 0);
+    bounds.insert(bounds.end(), c.bounds.lo.begin(), c.bounds.lo.end());
+    bounds.insert(bounds.end(), c.bounds.hi.begin(), c.bounds.hi.end());
+  }
+  writer.write_table(schema::table::component_part, std::span<const std::uint32_t>(part));
+  writer.write_table(schema::table::component_closed, std::span<const std::uint8_t>(closed));
+  writer.write_table(schema::table::component_bounds, std::span<const double>(bounds));
+}
+
+void write_shard_tables(IndexWriter& writer, const ShardTables& shards) {
+  writer.write_table(schema::table::tet_shard, std::span<const std::uint32_t>(shards.tet_shard));
+  writer.write_table(schema::table::shard_tet, std::span<const std::uint32_t>(shards.shard_tet));
+  writer.write_table(schema::table::shard_kind, std::span<const std::uint8_t>(shards.shard_kind));
+  writer.write_table(schema::table::shard_triangles,
+                     std::span<const std::uint32_t>(shards.shard_triangles));
+  writer.write_table(schema::table::shard_bounds, std::span<const double>(shards.shard_bounds));
+}
+
+void write_interiors(IndexWriter& writer, const Interiors& interiors) {
+  writer.write_table(schema::table::reference_points,
+                     std::span<const double>(interiors.reference_points));
+  writer.write_table(schema::table::interior_offsets,
+                     std::span<const std::uint64_t>(interiors.offsets));
+  writer.write_table(schema::table::interior_components,
+                     std::span<const std::uint32_t>(interiors.components));
+}
+
+}  // namespace
+
+void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& shards,
+                 const IngestedModel& model, const Interiors& interiors, const std::string& source,
+                 std::chrono::steady_clock::time_point start, PreprocessSummary& summary) {
+  writer.write_mesh(mesh);
+  write_shard_tables(writer, shards);
+  write_components(writer, model.components);
+  if (interiors.stored) write_interiors(writer, interiors);
+  IndexHeader header;
+  header.precision = summary.precision;
+  header.input_triangles = model.triangle_count;
+  header.stored_triangles = summary.stored_triangles;
+  header.region_count = mesh.tet_count();
+  header.shard_count = shards.shard_tet.size();
+  header.max_rounding_distance = summary.max_rounding_distance;
+  header.bounds = model.bounds;
+  header.source = source;
+  header.created_by = "tetrapage preprocess";
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  header.build_report_json = summary.to_json();
+  summary.bytes_written = writer.commit(header);
+}
+
+}  // namespace tetrapage
