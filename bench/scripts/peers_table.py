@@ -103,7 +103,7 @@ def main():
         text += open(args.preamble).read().rstrip("\n") + "\n\n"
     text += "\n".join(rows) + "\n\n" + "\n".join(ratios) + "\n"
     if args.summary and in_memory:
-        text += (f"\nOver {len(in_memory)} cells: tetrapage in memory / best peer, steps/s: geometric mean "
+        text += (f"\nOver {len(in_memory)} cell{'s' if len(in_memory) > 1 else ''}: tetrapage in memory / best peer, steps/s: geometric mean "
                  f"**{geometric_mean(in_memory):.2f}x** (min {min(in_memory):.2f}x, max {max(in_memory):.2f}x); "
                  f"{sum(r < 1.0 for r in in_memory)} cells below 1.0x, {sum(r < 2.0 for r in in_memory)} below 2.0x "
                  f"(issue 5's target: at least 2x). p99: geometric mean {geometric_mean(p99s):.2f}x "
