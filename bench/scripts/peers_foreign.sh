@@ -17,7 +17,7 @@
 #            triangle count (the package holds the same model in many formats); native formats
 #            linked, the others converted to .ply; ASSIMP_TRIANGLES triangles in all
 # Objects (OBJECTS, triangle counts): 4 is the tetrahedron; a count listed in OBJECT_MESHES is
-# that CGAL mesh of MESH_DIR as is (320 sphere, 3290 elk: closed, self-intersecting, 14859
+# that CGAL mesh of MESH_DIR as is (320 sphere and 3290 elk, closed; 14859
 # lion: open); the generator fails the run if it made anything else. Other counts: whatever
 # `generate object` picks.
 # Flights: STEPS poses, seed 1, answered by the oracle (`generate flight --answers`). Index:
