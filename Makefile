@@ -10,14 +10,14 @@ DEMO_DIR  ?= out/demo
 
 # Exactly the Debian packages the project needs.
 DEB_PACKAGES := cmake make g++ pkg-config \
-  libeigen3-dev libcgal-dev libcgal-demo libgmp-dev libmpfr-dev libboost-dev \
+  libeigen3-dev libcgal-dev libcgal-demo assimp-testmodels libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
   libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev libdeflate-dev liblz4-dev hdf5-filter-plugin time python3
 
 # What `make fuzz` needs besides: clang and its libFuzzer and sanitizer runtimes.
 FUZZ_PACKAGES := clang-14 libclang-rt-14-dev
 
-.PHONY: deps fuzz-deps configure build test sanitize sanitize-threads fuzz demo bench bench-study bench-peers bench-accuracy bench-scale clean format
+.PHONY: deps fuzz-deps configure build test sanitize sanitize-threads fuzz demo bench bench-study bench-peers bench-peers-demo bench-accuracy bench-scale clean format
 
 # $(call install_missing,NAME,PACKAGES): installs those not present (sudo only when not root).
 define install_missing
@@ -114,7 +114,7 @@ bench: build
 	  $(BUILD)/bench/tetrapage_bench_$$b --benchmark_out=$(BUILD)/bench-results/$$b.json \
 	    --benchmark_out_format=json || exit 1; \
 	done
-	$(MAKE) --no-print-directory bench-study bench-accuracy bench-peers bench-scale
+	$(MAKE) --no-print-directory bench-study bench-accuracy bench-peers bench-peers-demo bench-scale
 
 # The study's flight benchmark: its environment groups x its six objects, the four methods, the
 # hybrid (in memory and paged under 1 MiB) and the peers; tables and plots for docs/BENCHMARKS.md.
@@ -129,9 +129,18 @@ SCALE_SIZES ?= 1000000 10000000 50000000 100000000
 bench-scale: build
 	TETRAPAGE=$(TETRAPAGE) TERRAIN=10000000 bench/scripts/scale_series.sh $(BUILD)/bench-results/scale $(SCALE_SIZES)
 
-# FCL, CGAL's AABB tree and tetrapage (in memory, and paged under 8 MiB) on the demo's scene,
-# the study's object sizes, 10,000-pose flights, 3 repetitions (docs/BENCHMARKS.md, "Peers").
+# FCL, CGAL's AABB tree and tetrapage (in memory, and paged under 10 % of the index) on data
+# the project did not generate (issue 25): CGAL's meshes in 1M and 5M scenes, the 1201 x 1201
+# terrain, a scene of Debian's assimp-testmodels, x the tetrahedron, CGAL's sphere, elk and lion;
+# 10,000-pose flights, median of 5 passes; peers.md in $(BUILD)/bench-results/peers-foreign,
+# whose generated data the next run reuses. STEPS, REPEATS, ENVS, OBJECTS, SCENE_SIZES, ... shrink
+# it (bench/scripts/peers_foreign.sh).
 bench-peers: build
+	BUILD=$(BUILD) bench/scripts/peers_foreign.sh $(BUILD)/bench-results/peers-foreign
+
+# The same harness on the demo's scene, the study's object sizes, 10,000-pose flights, paged under
+# 8 MiB, 3 repetitions (docs/BENCHMARKS.md, "Peers").
+bench-peers-demo: build
 	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
 	BUILD=$(BUILD) bench/scripts/peers_series.sh $(DEMO_DIR) $(BUILD)/bench-results/peers 8M 3
 

@@ -2,8 +2,8 @@
 # The peer comparison of issue 5: one scene and its index, the study's object sizes, a
 # 10,000-step billiard flight each with the oracle's answers, replayed by tetrapage_bench_peers
 # through FCL, CGAL's AABB tree and tetrapage (in memory, and paged under BUDGET), REPEATS times.
-# Writes OUT/peers.md: per object size and collider, the median of each timing over the
-# repetitions (and the spread of steps/s), next to the answers' disagreements.
+# Writes OUT/peers.md (peers_table.py): per object size and collider, the median of each timing
+# over the repetitions (and the spread of steps/s), next to the answers' disagreements.
 #
 #   bench/scripts/peers_series.sh SCENE_DIR OUT_DIR [BUDGET] [REPEATS] [SIZES]
 #
@@ -35,41 +35,6 @@ for SIZE in $SIZES; do
   done
 done
 
-python3 - "$OUT" "$REPEATS" "$SIZES" <<'PY'
-import json, statistics, sys
-out, repeats, sizes = sys.argv[1], int(sys.argv[2]), [int(s) for s in sys.argv[3].split()]
-rows = ["| object | collider | build s | build RSS MiB | structures MiB | peak RSS MiB | steps/s (min-max) | p50 us | p95 us | p99 us | max us | collisions | FN / FP vs oracle | FN / FP vs exact, same question |",
-        "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-ratios = ["| object | tetrapage in memory / best peer: steps/s | p99 | best peer | paged / in memory: steps/s |",
-          "|---:|---:|---:|---|---:|"]
-def text(d, key):
-    if key not in d: return "-"
-    return f"{d[key]['false_negatives']} / {d[key]['false_positives']}"
-for size in sizes:
-    reports = [json.load(open(f"{out}/peers{size}-{r}.json")) for r in range(1, repeats + 1)]
-    names = [run["collider"] for run in reports[0]["runs"]]
-    median = {}
-    for i, name in enumerate(names):
-        runs = [rep["runs"][i] for rep in reports]
-        med = lambda f: statistics.median(f(run) for run in runs)
-        rates = [run["steps_per_second"] for run in runs]
-        median[name] = {"rate": med(lambda r: r["steps_per_second"]), "p99": med(lambda r: r["latency_us"]["p99"])}
-        answers = {(r["collisions"], text(r["disagreements"], "oracle"), text(r["disagreements"], "same_question")) for r in runs}
-        collisions, oracle, same = sorted(answers)[0] if len(answers) == 1 else ("varies", "varies", "varies")
-        structures = med(lambda r: r['structure_bytes'])
-        structures = f"{structures / 2**20:.1f}" if structures > 0 else "-"
-        rows.append(f"| {size} | {name} | {med(lambda r: r['build_seconds']):.2f} | {med(lambda r: r['build_rss_growth_bytes']) / 2**20:.1f} | {structures} | "
-                    f"{med(lambda r: r['peak_rss_bytes']) / 2**20:.1f} | {statistics.median(rates):.0f} ({min(rates):.0f}-{max(rates):.0f}) | "
-                    f"{med(lambda r: r['latency_us']['p50']):.1f} | {med(lambda r: r['latency_us']['p95']):.1f} | "
-                    f"{med(lambda r: r['latency_us']['p99']):.1f} | {med(lambda r: r['latency_us']['max']):.0f} | "
-                    f"{collisions} | {oracle} | {same} |")
-    peers = [n for n in names if not n.startswith("tetrapage")]
-    best = max(peers, key=lambda n: median[n]["rate"])
-    if "tetrapage" in median:
-        paged = f"{median['tetrapage-paged']['rate'] / median['tetrapage']['rate']:.2f}x" if "tetrapage-paged" in median else "-"
-        ratios.append(f"| {size} | {median['tetrapage']['rate'] / median[best]['rate']:.2f}x | "
-                      f"{median['tetrapage']['p99'] / median[best]['p99']:.2f}x | {best} | {paged} |")
-text_out = "\n".join(rows) + "\n\n" + "\n".join(ratios) + "\n"
-open(f"{out}/peers.md", "w").write(text_out)
-print(text_out)
-PY
+cells=()
+for SIZE in $SIZES; do cells+=(--cell "$OUT/peers$SIZE" "$SIZE"); done
+python3 "$(dirname "$0")/peers_table.py" "$OUT/peers.md" --repeats "$REPEATS" "${cells[@]}"
