@@ -45,12 +45,36 @@ struct MeshInstance {
   Matrix transform;
 };
 
-void collect_instances(const aiNode* node, const Matrix& parent,
+// Nodes deeper than this are taken for a hostile file (real scene graphs are a few dozen deep).
+constexpr std::size_t kMaxNodeDepth = 1024;
+
+// Every node with meshes and its transform, depth first, without recursion (a file may nest
+// nodes deeply). An importer may leave null children (Assimp 5.2's RAW importer does).
+void collect_instances(const std::string& file, const aiNode* root, const Matrix& identity,
                        std::vector<MeshInstance>& instances) {
-  const Matrix transform = multiply(parent, to_matrix(node->mTransformation));
-  if (node->mNumMeshes > 0) instances.push_back({node, transform});
-  for (unsigned c = 0; c < node->mNumChildren; ++c)
-    collect_instances(node->mChildren[c], transform, instances);
+  struct Pending {
+    const aiNode* node;
+    Matrix parent;
+    std::size_t depth;
+  };
+  std::vector<Pending> pending{{root, identity, 0}};
+  while (!pending.empty()) {
+    const Pending next = pending.back();
+    pending.pop_back();
+    // Its meshes would be lost without a word: refuse the file instead.
+    if (next.node == nullptr)
+      throw FormatError(file + ": Assimp's scene has a missing node (a null child at depth " +
+                        std::to_string(next.depth) + "): its meshes cannot be placed");
+    if (next.depth > kMaxNodeDepth)
+      throw InputError(file + ": the scene's nodes nest deeper than " +
+                       std::to_string(kMaxNodeDepth));
+    const Matrix transform = multiply(next.parent, to_matrix(next.node->mTransformation));
+    if (next.node->mNumMeshes > 0) instances.push_back({next.node, transform});
+    if (next.node->mChildren == nullptr) continue;
+    // Reversed, so that children come out in the file's order.
+    for (unsigned c = next.node->mNumChildren; c-- > 0;)
+      pending.push_back({next.node->mChildren[c], transform, next.depth + 1});
+  }
 }
 
 }  // namespace
@@ -76,7 +100,7 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
   }
   std::vector<MeshInstance> instances;
   const Matrix identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-  collect_instances(scene->mRootNode, identity, instances);
+  collect_instances(path.string(), scene->mRootNode, identity, instances);
 
   const std::string stem = path.stem().string();
   SoupBuilder soup(path.string(), report);
@@ -96,7 +120,15 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
     used_names.insert(name);
     soup.begin_part(name);
     for (unsigned m = 0; m < node->mNumMeshes; ++m) {
+      // An importer's scene is input too: a mesh it names must exist and hold its arrays.
+      if (node->mMeshes == nullptr || node->mMeshes[m] >= scene->mNumMeshes)
+        throw FormatError(path.string() + ": node '" + node->mName.C_Str() +
+                          "' names a mesh the scene lacks");
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
+      if (mesh == nullptr || (mesh->mNumVertices > 0 && mesh->mVertices == nullptr) ||
+          (mesh->mNumFaces > 0 && mesh->mFaces == nullptr))
+        throw FormatError(path.string() + ": mesh " + std::to_string(node->mMeshes[m]) +
+                          " of node '" + node->mName.C_Str() + "' has no vertex or face array");
       if (soup.vertex_count() + mesh->mNumVertices > max_vertices) {
         throw InputError(path.string() + ": more vertices than a soup can index");
       }
@@ -111,6 +143,8 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
       for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
         const aiFace& face = mesh->mFaces[f];
         if (face.mNumIndices < 3) continue;  // points and lines bound no surface
+        if (face.mIndices == nullptr)
+          throw FormatError(where + " face " + std::to_string(f) + ": no vertex indices");
         corners.clear();
         for (unsigned k = 0; k < face.mNumIndices; ++k) {
           if (face.mIndices[k] >= mesh->mNumVertices) {

@@ -568,6 +568,21 @@ TEST(MeshReader, MissingFileAndUnknownExtension) {
   EXPECT_EQ(mesh_format_from_path("a/b.3ds"), MeshFormat::assimp_other);
 }
 
+TEST(AssimpReader, RawGroupsAreReadWholeOrRefused) {
+  // Assimp 5.2's RAW importer leaves a null child in its scene graph for files of several
+  // groups: the reader crashed on it. Now each group's triangles are read, or the file is
+  // refused by name; never a crash, never a group lost in silence.
+  const auto path = scratch_folder("raw_groups") / "two.raw";
+  write_file(path, "first\n0 0 0 1 0 0 0 1 0\nsecond\n0 0 1 1 0 1 0 1 1\n");
+  try {
+    const TriangleSoup soup = read_mesh(path);
+    EXPECT_EQ(soup.triangle_count(), 2u);
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("missing node"), std::string::npos) << e.what();
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // glTF through Assimp
 
