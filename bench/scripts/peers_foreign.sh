@@ -237,7 +237,7 @@ for R in $(seq 1 "$REPEATS"); do
       P="$OUT/runs/$name-object$N-$R"
       t0=$SECONDS
       "$BENCH" "$D/model.ply" "$OUT/objects/object$N.ply" "$F.csv" "$F.answers.csv" "$D/model.tpi" \
-        --memory "$budget" --colliders="$COLLIDERS" --report "$P.json" > "$P.md" 2> "$P.log" ||
+        --memory "$budget" --colliders="$COLLIDERS" --warmup --prefetch --report "$P.json" > "$P.md" 2> "$P.log" ||
         { tail -5 "$P.log" >&2; die "$name x object $N, pass $R: tetrapage_bench_peers failed ($P.log)"; }
       ratio=$(json "$P.json" '"%.2fx the best peer (%s)" % (d["ratios"]["in_memory_over_best_peer_steps_per_second"], d["ratios"]["best_peer"]) if "best_peer" in d["ratios"] else "no ratio"')
       say "pass $R/$REPEATS, cell $cell/$cells ($name x object $N): $((SECONDS - t0)) s, tetrapage in memory $ratio (load average $(loadavg))"
@@ -260,7 +260,8 @@ commit=$(git -C "$SCRIPTS" rev-parse --short HEAD 2> /dev/null || echo unknown)
   echo "- load average (1, 5, 15 min) at start: $load_start; at end: $load_end"
   echo "- $STEPS-pose billiard flights (seed 1) with the oracle's answers; $REPEATS passes over every cell," \
     "figures are medians over the passes; colliders $COLLIDERS, each single-threaded in a process of its own," \
-    "no warm-up pass; tetrapage-paged under 10 % of the index file's bytes, from an empty shard cache, no prefetch thread"
+    "the in-memory colliders timed on a second pass over the flight (warm); tetrapage-paged under 10 % of the index" \
+    "file's bytes, from an empty shard cache, with its prefetch thread (a second thread)"
   echo
   echo "Environments:"
   echo
