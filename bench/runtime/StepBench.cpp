@@ -34,14 +34,13 @@ namespace {
 using namespace tetrapage;
 using Clock = std::chrono::steady_clock;
 
-enum Kind : std::size_t { searched, no_candidate, phase_two, candidates, collides, no_shard, certified, kind_count };
-constexpr std::array<const char*, kind_count> kKindNames{"searched", "no candidate", "phase II", "candidates",
-                                                         "collides", "no shard",     "certified"};
+enum Kind : std::size_t { searched, no_candidate, phase_two, candidates, collides, no_shard, kind_count };
+constexpr std::array<const char*, kind_count> kKindNames{"searched",   "no candidate", "phase II",
+                                                         "candidates", "collides",     "no shard"};
 
 Kind kind_of(const QueryResult& result) {
   const StepCounters& c = result.counters;
   if (result.collides) return collides;
-  if (c.certified) return certified;
   if (c.searched) return searched;
   if (c.shards_touched == 0) return no_shard;
   if (c.candidates == 0) return no_candidate;

@@ -7,7 +7,6 @@
 #include <span>
 #include <tuple>
 
-#include "ClearanceCertificate.h"
 #include "ConvexHull.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/MeshWalk.h"
@@ -54,9 +53,6 @@ Vec3 centre_in_mesh_box(const geometry::Box& box, const CollisionIndex& index) {
 // inside the object's hull than this cannot reach the hull of the placed hull vertices.
 constexpr double kPlacementReach = 0x1p-36;
 
-// A step that proves a clearance proves about this many steps' recent motion.
-constexpr double kStepsCovered = 1.25;
-
 }  // namespace
 
 /// The solid standing for the object in one step: a box, or a convex hull as triangles (CGAL's
@@ -74,11 +70,6 @@ struct FlyingObject::Solid {
   std::vector<std::array<std::size_t, 3>> hull_faces;
 };
 
-struct FlyingObject::Coherence {
-  PlacedBall now, previous;  ///< this step's and the previous step's placed ball
-  ClearanceCertificate certificate;
-};
-
 FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
     : FlyingObject(std::move(index), std::make_shared<const ObjectModel>(std::move(object))) {}
 
@@ -88,7 +79,6 @@ FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, std::sha
   if (!model_) throw InputError("a flying object needs an object model");
   world_.resize(model_->mesh.vertices.size());
   world_step_.assign(model_->mesh.vertices.size(), ~std::uint64_t{0});
-  coherence_ = std::make_unique<Coherence>();
 }
 
 void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
@@ -204,7 +194,6 @@ void FlyingObject::place(const Pose& pose) {
   // matrix up to rounding.
   rotation_ = rotation_matrix(pose.rotation);
   translation_ = pose.translation;
-  coherence_->now = placed_ball(*model_, unit_quaternion(pose.rotation), rotation_, translation_);
   ++step_;
 }
 
@@ -417,7 +406,6 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       object.previous_rotation_ = object.rotation_;
       object.previous_translation_ = object.translation_;
       object.previous_box_ = object.current_box_;
-      object.coherence_->previous = object.coherence_->now;
     }
   } remember{*this};
   // The object as a solid (hull or box, or swept between the poses), or as its mesh.
@@ -426,32 +414,17 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // The phase I box covers both poses of a swept step.
   if (swept) box.extend(previous_box_);
   // Environment triangles within the accuracy's reach of the object count: grow the box.
-  const double accuracy_reach =
-      geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
+  const double reach = geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
   if (solid_query)
-    box = accuracy_reach > 0 ? geometry::inflated(box, accuracy_reach) : box;  // covers the solid box's own growth
-  else if (accuracy_reach > 0)
-    for (int a = 0; a < 3; ++a) box.lo[a] -= accuracy_reach, box.hi[a] += accuracy_reach;
+    box = reach > 0 ? geometry::inflated(box, reach) : box;  // covers the solid box's own growth
+  else if (reach > 0)
+    for (int a = 0; a < 3; ++a) box.lo[a] -= reach, box.hi[a] += reach;
   result.world_box = box;
   if (free_box_valid_ && strictly_inside(box, free_box_)) {
     // (The free box lies in the mesh's box: the object is not outside the model.)
     counters.in_free_box = true;
     return;
   }
-  // Every object point lies closer to where it lay at an earlier free step than that step's
-  // proven clearance: free (the certificate is only proven for this question, ClearanceCertificate.h).
-  const double to_prove = clearance_to_prove(options);
-  if (to_prove > 0 && coherence_->certificate.covers(*model_, coherence_->now) &&
-      geometry::boxes_overlap(box, index.mesh_bounds())) {
-    counters.certified = true;
-    return;
-  }
-  // A step that proves a clearance looks at every triangle within it: phase I's box and every
-  // pruning shape grow by it, and phase II measures the distances of the pairs it meets that
-  // do not touch (reach only prunes in the exact question).
-  const double reach = accuracy_reach + to_prove;
-  double clearance = to_prove;
-  if (to_prove > 0) box = geometry::inflated(box, to_prove);
   // The clock's reads were 6 % of the time of a flight of free steps (perf): one reading ends a
   // phase and starts the next.
   Clock::time_point phase_start = Clock::now();
@@ -476,13 +449,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
 
   // Most steps far from obstacles find a box around them that holds no triangle, and then
   // need no phase I; the next steps inside it need nothing else.
-  if (step_in_new_free_box(box, result)) {
-    if (!result.collides && clearance > 0) {
-      coherence_->certificate.keep(coherence_->now, clearance);
-      counters.proven_clearance = clearance;
-    }
-    return;
-  }
+  if (step_in_new_free_box(box, result)) return;
 
   // Phase I and II over the region's shards whose bounds meet the box.
   const bool all = options.mode == QueryMode::all_contacts;
@@ -621,20 +588,6 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // are the input's coordinates, the same in every shard (rounded float copies each round to
   // their own shard's frame, so each is tested).
   met_triangles_.clear();
-  // A pair apart lowers the clearance to the pair's proven distance. A clearance below one
-  // step's motion would cover no step: it is given up (the grown margins then only cost time).
-  auto prove_apart = [&](const geometry::Triangle& environment, const geometry::Triangle& placed) {
-    const geometry::Box e = geometry::box_of(environment), p = geometry::box_of(placed);
-    double gap = 0;
-    for (int a = 0; a < 3; ++a) {
-      const double g = std::max({e.lo[a] - p.hi[a], p.lo[a] - e.hi[a], 0.0});
-      gap += g * g;
-    }
-    // (The boxes' gap only skips the exact bound; a relative margin covers its rounding.)
-    if (gap > clearance * clearance * (1 + 0x1p-20)) return;
-    clearance = std::min(clearance, geometry::triangle_distance(environment, placed).lower_bound);
-    if (clearance < to_prove / kStepsCovered) clearance = 0;  // covers no step
-  };
   auto test_shard = [&](const Shard& shard) {
     const bool same_copies = index.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
     auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
@@ -652,9 +605,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       double magnitude = model_->radius;
       for (const auto& p : environment)
         for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
-      // (A step proving a clearance looks no farther than the clearance it still holds: it only
-      // falls.)
-      const double grow = accuracy_reach + clearance + magnitude * 0x1p-40;
+      const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
       if ((own_frame && (!geometry::boxes_overlap(query, model_->box) || beyond_hull(query))) ||
           (ball_prunes && geometry::triangle_outside_ball(framed, model_->ball_centre, model_->ball_radius + grow)) ||
@@ -699,11 +650,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       };
       model_->bvh.for_each_in_box(query, near_plane, [&](std::uint32_t object_triangle) {
         ++counters.triangle_tests;
-        const geometry::Triangle placed = world_triangle(object_triangle);
-        if (!geometry::triangles_collide(environment, placed, options.accuracy)) {
-          if (clearance > 0) prove_apart(environment, placed);
-          return true;
-        }
+        if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;
         result.collides = true;
         if (all || result.contacts.empty())
           result.contacts.push_back(contact_with(index, shard, local, object_triangle));
@@ -778,20 +725,6 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   counters.test_seconds =
       std::max(0.0, std::chrono::duration<double>(loop_end - loop_start).count() - counters.shard_seconds);
   if (!result.collides) check_containment(box, result, loop_end);
-  if (!result.collides && clearance > 0) {
-    coherence_->certificate.keep(coherence_->now, clearance);
-    counters.proven_clearance = clearance;
-  }
-}
-
-double FlyingObject::clearance_to_prove(const QueryOptions& options) const {
-  // A certificate answers the exact question about the mesh at one pose; it pays when it
-  // covers a few steps of the recent motion (it is looked for on steps that run phase I).
-  if (options.shape != ObjectShape::mesh || options.motion != Motion::discrete ||
-      options.accuracy.mode != geometry::AccuracyMode::exact || !previous_valid_)
-    return 0;
-  const double step = motion_bound(*model_, coherence_->previous, coherence_->now);
-  return std::min(kStepsCovered * step, model_->ball_radius);
 }
 
 bool FlyingObject::step_in_new_free_box(const geometry::Box& box, QueryResult& result) {

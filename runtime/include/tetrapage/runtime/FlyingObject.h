@@ -108,13 +108,6 @@ struct StepCounters {
   /// or the object inside an obstacle.
   bool found_free_box = false;
   double free_box_seconds = 0;  ///< looking for a new free box (found or not)
-  /// No object point lay as far from where it was at an earlier free step as that step's
-  /// proven clearance: the step is free, and nothing else ran (not even the free box's test).
-  bool certified = false;
-  /// This step proved a clearance (a lower bound on the object's distance to the environment)
-  /// for the steps after it; 0 when it proved none. Such a step runs phase I over the box grown
-  /// by a few steps' motion, so its candidates count the triangles in that larger box.
-  double proven_clearance = 0;
 };
 
 /// A collision without touching surfaces: one closed body holds the other.
@@ -208,10 +201,6 @@ class FlyingObject {
   // The solid that stands for the object in this step (shape hull or box, or swept), built on
   // the first candidate that needs it; does an environment triangle collide with it?
   struct Solid;
-  struct Coherence;
-  // The clearance a free step would prove, for the question `options` asks: a few steps'
-  // motion (0: the step proves none).
-  double clearance_to_prove(const QueryOptions& options) const;
   void build_solid(const QueryOptions& options, Solid& solid);
   static bool solid_collides(const Solid& solid, const geometry::Triangle& environment,
                              const geometry::Accuracy& accuracy, double reach);
@@ -232,7 +221,6 @@ class FlyingObject {
   geometry::Box previous_box_;
   geometry::Box current_box_;  ///< this query's world box, before the accuracy's growth
   std::unique_ptr<Solid> solid_;  ///< per-step scratch
-  std::unique_ptr<Coherence> coherence_;  ///< the placed ball now and before, the clearance proven
   /// Per step: the hull's pruning planes placed in the world (n.x <= offset holds the object).
   std::vector<std::pair<Vec3, double>> world_planes_;
   TriangleIdSet met_triangles_;  ///< the triangles phase I has met this step
