@@ -27,8 +27,8 @@ Contact contact_with(const CollisionIndex& index, const Shard& shard, std::uint3
   const std::uint32_t component = shard.component_id(local);
   return {index.component_part(component), shard.triangle_id(local), object_triangle, component};
 }
-using hull::Kernel;
 using hull::hull_of;
+using hull::Kernel;
 using hull::to_point;
 
 // Every point of `inner` lies in the interior of `outer`.
@@ -44,7 +44,8 @@ double seconds_since(Clock::time_point start) {
 // The box's centre, clamped into the coarse mesh's box: where a walk for the box aims.
 Vec3 centre_in_mesh_box(const geometry::Box& box, const CollisionIndex& index) {
   Vec3 centre = box.center();
-  for (int a = 0; a < 3; ++a) centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
+  for (int a = 0; a < 3; ++a)
+    centre[a] = std::clamp(centre[a], index.mesh_bounds().lo[a], index.mesh_bounds().hi[a]);
   return centre;
 }
 
@@ -73,7 +74,8 @@ struct FlyingObject::Solid {
 FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
     : FlyingObject(std::move(index), std::make_shared<const ObjectModel>(std::move(object))) {}
 
-FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, std::shared_ptr<const ObjectModel> model)
+FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index,
+                           std::shared_ptr<const ObjectModel> model)
     : index_(std::move(index)), model_(std::move(model)) {
   if (!index_) throw InputError("a flying object needs an index");
   if (!model_) throw InputError("a flying object needs an object model");
@@ -106,7 +108,9 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
   solid.points.clear();
   auto add_pose = [&](bool current) {
     auto add = [&](std::uint32_t v) {
-      const Vec3 p = current ? world_vertex(v) : apply_pose(previous_rotation_, previous_translation_, model_->mesh.vertices[v]);
+      const Vec3 p =
+          current ? world_vertex(v)
+                  : apply_pose(previous_rotation_, previous_translation_, model_->mesh.vertices[v]);
       solid.points.emplace_back(p[0], p[1], p[2]);
     };
     for (const auto v : candidates.on_hull) add(v);
@@ -127,7 +131,8 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
                            to_point(solid.hull_points[f[2]])});
   if (solid.faces.empty()) {
     // Fewer than four points, or no hull: the placed triangles stand for themselves.
-    for (std::uint32_t t = 0; t < model_->mesh.triangle_count(); ++t) solid.faces.push_back(world_triangle(t));
+    for (std::uint32_t t = 0; t < model_->mesh.triangle_count(); ++t)
+      solid.faces.push_back(world_triangle(t));
   } else {
     // CGAL orients every facet the same way: the first vertex off facet 0 names the inside.
     const auto& f = solid.faces[0];
@@ -148,7 +153,8 @@ void FlyingObject::build_solid(const QueryOptions& options, Solid& solid) {
 
 bool FlyingObject::solid_collides(const Solid& solid, const geometry::Triangle& environment,
                                   const geometry::Accuracy& accuracy, double reach) {
-  if (solid.kind == Solid::Kind::box) return geometry::triangle_collides_with_box(environment, solid.box, accuracy);
+  if (solid.kind == Solid::Kind::box)
+    return geometry::triangle_collides_with_box(environment, solid.box, accuracy);
   geometry::Box near = geometry::box_of(environment);
   if (reach > 0) near = geometry::inflated(near, reach);
   if (!geometry::boxes_overlap(near, solid.box)) return false;
@@ -158,7 +164,8 @@ bool FlyingObject::solid_collides(const Solid& solid, const geometry::Triangle& 
       return true;
   // No surface contact: the triangle lies wholly inside or wholly outside; one vertex decides,
   // exactly whatever the accuracy.
-  if (solid.outside == geometry::Sign::zero || !geometry::box_contains(solid.box, environment[0])) return false;
+  if (solid.outside == geometry::Sign::zero || !geometry::box_contains(solid.box, environment[0]))
+    return false;
   for (const auto& f : solid.faces)
     if (geometry::orient3d(f[0], f[1], f[2], environment[0]) == solid.outside) return false;
   return true;
@@ -175,7 +182,8 @@ void FlyingObject::place(const Pose& pose) {
         std::isfinite(pose.translation[2])) ||
       !std::isfinite(n) || std::fabs(n - 1) > 1e-6) {
     char text[200];
-    std::snprintf(text, sizeof text, "invalid pose: translation (%g, %g, %g), quaternion (%g, %g, %g, %g)",
+    std::snprintf(text, sizeof text,
+                  "invalid pose: translation (%g, %g, %g), quaternion (%g, %g, %g, %g)",
                   pose.translation[0], pose.translation[1], pose.translation[2], pose.rotation[0],
                   pose.rotation[1], pose.rotation[2], pose.rotation[3]);
     throw InputError(text);
@@ -184,10 +192,11 @@ void FlyingObject::place(const Pose& pose) {
   for (int a = 0; a < 3; ++a)
     if (std::fabs(pose.translation[a]) > kMaxCoordinateMagnitude) {
       char text[200];
-      std::snprintf(text, sizeof text,
-                    "invalid pose: translation %c = %g is beyond %g in magnitude: placing the object "
-                    "there would overflow",
-                    "xyz"[a], pose.translation[a], kMaxCoordinateMagnitude);
+      std::snprintf(
+          text, sizeof text,
+          "invalid pose: translation %c = %g is beyond %g in magnitude: placing the object "
+          "there would overflow",
+          "xyz"[a], pose.translation[a], kMaxCoordinateMagnitude);
       throw InputError(text);
     }
   // rotation_matrix normalises a q off unit norm: every prune here assumes an orthogonal
@@ -222,7 +231,8 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
     for (int k = 0; k < 6; ++k) {
       const int axis = k / 2;
       const double sign = k % 2 == 0 ? -1.0 : 1.0;
-      const double r0 = rotation_[3 * axis], r1 = rotation_[3 * axis + 1], r2 = rotation_[3 * axis + 2];
+      const double r0 = rotation_[3 * axis], r1 = rotation_[3 * axis + 1],
+                   r2 = rotation_[3 * axis + 2];
       const auto coordinate = [&](std::uint32_t hull_vertex) {
         const Vec3& x = model_->mesh.vertices[model_->hull_vertices[hull_vertex]];
         return r0 * x[0] + r1 * x[1] + r2 * x[2] + translation_[axis];
@@ -233,7 +243,8 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
         moved = false;
         // The neighbours of the vertex the pass started from: `at` moves during the pass.
         const std::uint32_t from = at;
-        for (std::uint32_t i = model_->hull_offsets[from]; i < model_->hull_offsets[from + 1]; ++i) {
+        for (std::uint32_t i = model_->hull_offsets[from]; i < model_->hull_offsets[from + 1];
+             ++i) {
           const std::uint32_t next = model_->hull_neighbours[i];
           const double value = sign * coordinate(next);
           if (value > best) best = value, at = next, moved = true;
@@ -245,8 +256,9 @@ geometry::Box FlyingObject::world_box(const Pose& pose) {
   }
   // The placement rounds each coordinate; rounded values can make a near-tie climb stop one
   // vertex short. Grow the box far beyond those roundings (it only prunes).
-  const double magnitude = model_->radius + std::max({std::fabs(translation_[0]), std::fabs(translation_[1]),
-                                                      std::fabs(translation_[2])});
+  const double magnitude =
+      model_->radius + std::max({std::fabs(translation_[0]), std::fabs(translation_[1]),
+                                 std::fabs(translation_[2])});
   const double margin = magnitude * 0x1p-40;
   for (int a = 0; a < 3; ++a) box.lo[a] -= margin, box.hi[a] += margin;
   return box;
@@ -271,7 +283,8 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
   start = Clock::now();
   // Bounding boxes are enough here: the region only has to cover the steps' boxes, and each
   // step skips the shards whose stored bounds miss its box.
-  const BoxSearchResult found = tets_near_box(mesh, index.tet_filter(), located.tet, region, search_);
+  const BoxSearchResult found =
+      tets_near_box(mesh, index.tet_filter(), located.tet, region, search_);
   counters.tets_visited = found.tets_visited;
   counters.tets_overlapping = std::uint32_t(found.tets.size());
   // The last region's pins, for the shards the new region keeps: releasing them and acquiring
@@ -313,7 +326,8 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     for (std::size_t k = 0; k < previous_pins_.size(); ++k) {
       if (!previous_pins_[k]) continue;
       const auto kept = std::find(shards_.begin(), shards_.end(), previous_shards_[k]);
-      if (kept != shards_.end()) pins_[std::size_t(kept - shards_.begin())] = std::move(previous_pins_[k]);
+      if (kept != shards_.end())
+        pins_[std::size_t(kept - shards_.begin())] = std::move(previous_pins_[k]);
     }
   }
   previous_pins_.clear();  // the rest are released
@@ -334,8 +348,10 @@ bool FlyingObject::search(const geometry::Box& box, StepCounters& counters) {
     }
     hints_.clear();
     for (std::size_t k = 0; k < shards_.size(); ++k)
-      if (!geometry::boxes_overlap(box, shard_reach_[k]) && geometry::boxes_overlap(ahead, shard_reach_[k]) &&
-          index.tet_filter().planes_may_meet(shard_tet_[k], ahead) && !index.cache().contains(shards_[k]))
+      if (!geometry::boxes_overlap(box, shard_reach_[k]) &&
+          geometry::boxes_overlap(ahead, shard_reach_[k]) &&
+          index.tet_filter().planes_may_meet(shard_tet_[k], ahead) &&
+          !index.cache().contains(shards_[k]))
         hints_.push_back(shards_[k]);
     if (!hints_.empty()) index.cache().prefetch(hints_);
   }
@@ -359,11 +375,15 @@ void FlyingObject::prefetch_ahead(const geometry::Box& next_region, std::uint32_
   const CollisionIndex& index = *index_;
   const TetMesh& mesh = index.mesh();
   const WalkResult ahead = locate_point(mesh, from_tet, centre_in_mesh_box(next_region, index));
-  if (ahead.tet == TetMesh::no_neighbour || !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet))) return;
+  if (ahead.tet == TetMesh::no_neighbour ||
+      !geometry::boxes_overlap(next_region, mesh.bounds(ahead.tet)))
+    return;
   hints_.clear();
-  for (const std::uint32_t tet : tets_near_box(mesh, index.tet_filter(), ahead.tet, next_region, prefetch_search_).tets) {
+  for (const std::uint32_t tet :
+       tets_near_box(mesh, index.tet_filter(), ahead.tet, next_region, prefetch_search_).tets) {
     const std::uint32_t shard = index.shard_of_tet(tet);
-    if (shard != TetMesh::no_neighbour && geometry::boxes_overlap(next_region, index.shard_bounds(shard)) &&
+    if (shard != TetMesh::no_neighbour &&
+        geometry::boxes_overlap(next_region, index.shard_bounds(shard)) &&
         !index.cache().contains(shard))
       hints_.push_back(shard);
   }
@@ -414,7 +434,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // The phase I box covers both poses of a swept step.
   if (swept) box.extend(previous_box_);
   // Environment triangles within the accuracy's reach of the object count: grow the box.
-  const double reach = geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
+  const double reach =
+      geometry::collision_margin(options.accuracy, geometry::extent(box), geometry::extent(box));
   if (solid_query)
     box = reach > 0 ? geometry::inflated(box, reach) : box;  // covers the solid box's own growth
   else if (reach > 0)
@@ -428,15 +449,17 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // The clock's reads were 6 % of the time of a flight of free steps (perf): one reading ends a
   // phase and starts the next.
   Clock::time_point phase_start = Clock::now();
-  if (time_box) counters.locate_seconds = std::chrono::duration<double>(phase_start - start).count();
+  if (time_box)
+    counters.locate_seconds = std::chrono::duration<double>(phase_start - start).count();
   if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
     result.outside_model = true;
     release_region();
     return;
   }
-  const bool inside_region = searched_valid_ && box.lo[0] >= searched_box_.lo[0] && box.lo[1] >= searched_box_.lo[1] &&
-                             box.lo[2] >= searched_box_.lo[2] && box.hi[0] <= searched_box_.hi[0] &&
-                             box.hi[1] <= searched_box_.hi[1] && box.hi[2] <= searched_box_.hi[2];
+  const bool inside_region = searched_valid_ && box.lo[0] >= searched_box_.lo[0] &&
+                             box.lo[1] >= searched_box_.lo[1] && box.lo[2] >= searched_box_.lo[2] &&
+                             box.hi[0] <= searched_box_.hi[0] && box.hi[1] <= searched_box_.hi[1] &&
+                             box.hi[2] <= searched_box_.hi[2];
   if (!inside_region) {
     if (!search(box, counters)) {
       // A centre outside the convex mesh: the box meets only the model's empty margin.
@@ -466,8 +489,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     own_centre[a] = 0.5 * (model_->box.lo[a] + model_->box.hi[a]);
     own_half[a] = 0.5 * (model_->box.hi[a] - model_->box.lo[a]) + reach;
   }
-  const double translation_magnitude =
-      std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])});
+  const double translation_magnitude = std::max(
+      {std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])});
   // Does a world box meet the object's own box? Its centre taken to the object's frame and
   // its half extents through |R| (separating axes of the object's frame); the roundings are
   // covered by a margin far beyond them. Conservative: it only prunes.
@@ -486,7 +509,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   // its hull (the margin covers the planes' rounding, far beyond it).
   const double plane_margin = model_->radius * 0x1p-30;
   using Plane = std::pair<Vec3, double>;  // n.x <= offset holds the object
-  auto box_beyond_planes = [](std::span<const Plane> planes, double margin, const geometry::Box& b) {
+  auto box_beyond_planes = [](std::span<const Plane> planes, double margin,
+                              const geometry::Box& b) {
     for (const auto& [n, offset] : planes) {
       double lowest = 0;
       for (int a = 0; a < 3; ++a) lowest += n[a] * (n[a] > 0 ? b.lo[a] : b.hi[a]);
@@ -494,7 +518,9 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     }
     return false;
   };
-  auto beyond_hull = [&](const geometry::Box& b) { return box_beyond_planes(model_->hull_planes, plane_margin, b); };
+  auto beyond_hull = [&](const geometry::Box& b) {
+    return box_beyond_planes(model_->hull_planes, plane_margin, b);
+  };
   // For a round object, a box in its frame wholly outside the ball that holds it misses it
   // and its hull (the box is grown by the reach and margins already; the ball by far more
   // than the roundings of this test).
@@ -533,14 +559,16 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     world_planes_.resize(model_->hull_planes.size());
     const geometry::Box& model_box = index.mesh_bounds();
     const double magnitude = model_->radius + translation_magnitude +
-                             std::max({std::fabs(model_box.lo[0]), std::fabs(model_box.lo[1]), std::fabs(model_box.lo[2]),
-                                       std::fabs(model_box.hi[0]), std::fabs(model_box.hi[1]), std::fabs(model_box.hi[2])});
+                             std::max({std::fabs(model_box.lo[0]), std::fabs(model_box.lo[1]),
+                                       std::fabs(model_box.lo[2]), std::fabs(model_box.hi[0]),
+                                       std::fabs(model_box.hi[1]), std::fabs(model_box.hi[2])});
     for (std::size_t k = 0; k < model_->hull_planes.size(); ++k) {
       const auto& [n, offset] = model_->hull_planes[k];
       auto& [w, world_offset] = world_planes_[k];
-      for (int a = 0; a < 3; ++a) w[a] = rotation_[3 * a] * n[0] + rotation_[3 * a + 1] * n[1] + rotation_[3 * a + 2] * n[2];
-      world_offset = offset + w[0] * translation_[0] + w[1] * translation_[1] + w[2] * translation_[2] + reach +
-                     plane_margin + magnitude * 0x1p-40;
+      for (int a = 0; a < 3; ++a)
+        w[a] = rotation_[3 * a] * n[0] + rotation_[3 * a + 1] * n[1] + rotation_[3 * a + 2] * n[2];
+      world_offset = offset + w[0] * translation_[0] + w[1] * translation_[1] +
+                     w[2] * translation_[2] + reach + plane_margin + magnitude * 0x1p-40;
     }
   }
   // Either shape placed in the world: a world box it rules out misses the object.
@@ -551,9 +579,10 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     if (!own_frame) return true;
     if (world_shapes_miss(b)) return false;
     Vec3 c, h;
-    for (int a = 0; a < 3; ++a) c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
-    const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]), std::fabs(b.hi[0]),
-                                     std::fabs(b.hi[1]), std::fabs(b.hi[2])}) +
+    for (int a = 0; a < 3; ++a)
+      c[a] = 0.5 * (b.lo[a] + b.hi[a]) - translation_[a], h[a] = 0.5 * (b.hi[a] - b.lo[a]);
+    const double margin = (std::max({std::fabs(b.lo[0]), std::fabs(b.lo[1]), std::fabs(b.lo[2]),
+                                     std::fabs(b.hi[0]), std::fabs(b.hi[1]), std::fabs(b.hi[2])}) +
                            translation_magnitude + model_->radius) *
                           0x1p-40;
     geometry::Box in_frame;  // the node's box in the object's frame, grown by reach and margin
@@ -566,13 +595,15 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       in_frame.hi[a] = x + e + reach + margin;
     }
     if (beyond_hull(in_frame) || outside_ball(in_frame)) return false;
-    if (!near_surface_only || triangles < kSurfaceTestTriangles || std::max({h[0], h[1], h[2]}) > surface_test_extent)
+    if (!near_surface_only || triangles < kSurfaceTestTriangles ||
+        std::max({h[0], h[1], h[2]}) > surface_test_extent)
       return true;
     bool near_surface = false;
     model_->bvh.for_each_in_box(in_frame, [&](std::uint32_t) { return !(near_surface = true); });
     if (near_surface) return true;
     if (!model_->closed) return false;
-    return model_->interior_grid.classify(in_frame.center(), margin) != ObjectInteriorGrid::Side::outside;
+    return model_->interior_grid.classify(in_frame.center(), margin) !=
+           ObjectInteriorGrid::Side::outside;
   };
   // Inner R-tree nodes are asked of the object's own box too when the world box is much
   // looser than it (a turned tetrahedron's is up to five times its volume): the subtrees it
@@ -582,14 +613,16 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   const double own_volume = (model_->box.hi[0] - model_->box.lo[0] + 2 * reach) *
                             (model_->box.hi[1] - model_->box.lo[1] + 2 * reach) *
                             (model_->box.hi[2] - model_->box.lo[2] + 2 * reach);
-  const double world_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
+  const double world_volume =
+      (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
   const bool prune_inner = own_frame && world_volume > kLoose * own_volume;
   // A triangle stored in several of the step's shards is tested once: exact and double copies
   // are the input's coordinates, the same in every shard (rounded float copies each round to
   // their own shard's frame, so each is tested).
   met_triangles_.clear();
   auto test_shard = [&](const Shard& shard) {
-    const bool same_copies = index.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
+    const bool same_copies =
+        index.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
     auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
       if (stop) return;  // the shard query cannot be cut short; skip the rest
       if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
@@ -597,18 +630,21 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
         return;
       }
       // The environment triangle in the object's frame (rounded: it only prunes).
-      const std::array<Vec3, 3> framed{to_object_frame(environment[0]), to_object_frame(environment[1]),
+      const std::array<Vec3, 3> framed{to_object_frame(environment[0]),
+                                       to_object_frame(environment[1]),
                                        to_object_frame(environment[2])};
       geometry::Box query;
       for (const auto& p : framed) query.extend(p);
       // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
       double magnitude = model_->radius;
       for (const auto& p : environment)
-        for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
+        for (int a = 0; a < 3; ++a)
+          magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation_[a]));
       const double grow = reach + magnitude * 0x1p-40;
       for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
       if ((own_frame && (!geometry::boxes_overlap(query, model_->box) || beyond_hull(query))) ||
-          (ball_prunes && geometry::triangle_outside_ball(framed, model_->ball_centre, model_->ball_radius + grow)) ||
+          (ball_prunes && geometry::triangle_outside_ball(framed, model_->ball_centre,
+                                                          model_->ball_radius + grow)) ||
           !geometry::triangle_intersects_box(environment, box))
         return;
       ++counters.candidates;
@@ -625,7 +661,8 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       if (model_->closed && !result.collides) {
         const std::uint32_t component = shard.component_id(local);
         if (index.component_part(component) != CollisionIndex::kNoPart &&
-            geometry::box_contains(box, index.component_bounds(component)) && in_object_box(environment[0]))
+            geometry::box_contains(box, index.component_bounds(component)) &&
+            in_object_box(environment[0]))
           enclosed_.emplace_back(component, environment[0]);
       }
       // Object triangles that can meet the environment triangle lie within `grow` of its
@@ -650,7 +687,9 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
       };
       model_->bvh.for_each_in_box(query, near_plane, [&](std::uint32_t object_triangle) {
         ++counters.triangle_tests;
-        if (!geometry::triangles_collide(environment, world_triangle(object_triangle), options.accuracy)) return true;
+        if (!geometry::triangles_collide(environment, world_triangle(object_triangle),
+                                         options.accuracy))
+          return true;
         result.collides = true;
         if (all || result.contacts.empty())
           result.contacts.push_back(contact_with(index, shard, local, object_triangle));
@@ -719,11 +758,12 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     auto key = [](const Contact& c) { return std::tie(c.environment_triangle, c.object_triangle); };
     std::sort(result.contacts.begin(), result.contacts.end(),
               [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
-    result.contacts.erase(std::unique(result.contacts.begin(), result.contacts.end()), result.contacts.end());
+    result.contacts.erase(std::unique(result.contacts.begin(), result.contacts.end()),
+                          result.contacts.end());
   }
   const auto loop_end = Clock::now();
-  counters.test_seconds =
-      std::max(0.0, std::chrono::duration<double>(loop_end - loop_start).count() - counters.shard_seconds);
+  counters.test_seconds = std::max(
+      0.0, std::chrono::duration<double>(loop_end - loop_start).count() - counters.shard_seconds);
   if (!result.collides) check_containment(box, result, loop_end);
 }
 
@@ -740,7 +780,8 @@ bool FlyingObject::step_in_new_free_box(const geometry::Box& box, QueryResult& r
   result.counters.free_box_seconds = std::chrono::duration<double>(found_at - start).count();
   if (!found) {
     // Near an obstacle the next steps fail too: try again after 1, 2, 4, then 8 steps.
-    free_box_backoff_ = std::min<std::uint32_t>(std::max<std::uint32_t>(2 * free_box_backoff_, 1), 8);
+    free_box_backoff_ =
+        std::min<std::uint32_t>(std::max<std::uint32_t>(2 * free_box_backoff_, 1), 8);
     free_box_wait_ = free_box_backoff_;
     return false;
   }
@@ -749,9 +790,10 @@ bool FlyingObject::step_in_new_free_box(const geometry::Box& box, QueryResult& r
   // No triangle's box meets the step's box: no candidates, no contact. The containment vertex
   // is on the last free box's side of every closed part when the two boxes' insides overlap
   // (their union is connected and holds no triangle); else the walk decides.
-  const bool connected = had_free_box && last.lo[0] < free_box_.hi[0] && free_box_.lo[0] < last.hi[0] &&
-                         last.lo[1] < free_box_.hi[1] && free_box_.lo[1] < last.hi[1] &&
-                         last.lo[2] < free_box_.hi[2] && free_box_.lo[2] < last.hi[2];
+  const bool connected = had_free_box && last.lo[0] < free_box_.hi[0] &&
+                         free_box_.lo[0] < last.hi[0] && last.lo[1] < free_box_.hi[1] &&
+                         free_box_.lo[1] < last.hi[1] && last.lo[2] < free_box_.hi[2] &&
+                         free_box_.lo[2] < last.hi[2];
   if (!connected) {
     check_containment(box, result, found_at);
     // Inside an obstacle: the box is not free space (steps inside it would answer so).
@@ -811,7 +853,8 @@ bool FlyingObject::find_free_box(const geometry::Box& box) {
   };
   bool found = true;
   for (std::size_t k = 0; k < shards_.size() && found; ++k) {
-    if (!geometry::boxes_overlap(grown, shard_reach_[k]) || !index.tet_filter().planes_may_meet(shard_tet_[k], grown))
+    if (!geometry::boxes_overlap(grown, shard_reach_[k]) ||
+        !index.tet_filter().planes_may_meet(shard_tet_[k], grown))
       continue;
     const Shard* shard = nullptr;
     if (keep_pins_ && !pins_[k] && index.cache().contains(shards_[k])) {
@@ -858,10 +901,12 @@ void FlyingObject::check_object_inside_obstacle(QueryResult& result) {
   // whole component (it is connected and crosses no surface).
   if (!index_->has_interiors()) return;
   const std::size_t components = model_->component_vertices.size();
-  if (interior_memos_.size() != components) interior_memos_.assign(components, {}), interior_tets_.assign(components, 0);
+  if (interior_memos_.size() != components)
+    interior_memos_.assign(components, {}), interior_tets_.assign(components, 0);
   for (std::size_t c = 0; c < components && !result.collides; ++c) {
-    const ObstacleQuery inside = locate_in_obstacles(*index_, interior_tets_[c], world_vertex(model_->component_vertices[c]),
-                                                      interior_memos_[c], std::span<const ShardPin>(pins_));
+    const ObstacleQuery inside =
+        locate_in_obstacles(*index_, interior_tets_[c], world_vertex(model_->component_vertices[c]),
+                            interior_memos_[c], std::span<const ShardPin>(pins_));
     if (inside.containment == ObstacleContainment::inside) {
       result.collides = true;
       result.containment = Containment::object_inside_obstacle;
@@ -876,7 +921,8 @@ void FlyingObject::check_obstacle_inside_object(const geometry::Box& box, QueryR
   // lies wholly inside or wholly outside every closed component of the object: one vertex
   // decides. Most vertices are far from the object's surface, where the interior grid answers
   // at once; the rest need a parity count.
-  std::sort(enclosed_.begin(), enclosed_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(enclosed_.begin(), enclosed_.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
   enclosed_.erase(std::unique(enclosed_.begin(), enclosed_.end(),
                               [](const auto& a, const auto& b) { return a.first == b.first; }),
                   enclosed_.end());
@@ -890,9 +936,14 @@ void FlyingObject::check_obstacle_inside_object(const geometry::Box& box, QueryR
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i) {
     const geometry::Point& p = enclosed_[i].second;
     switch (model_->interior_grid.classify(to_object_frame(p), frame_margin(p))) {
-      case ObjectInteriorGrid::Side::inside: inside(enclosed_[i].first); break;
-      case ObjectInteriorGrid::Side::outside: break;
-      case ObjectInteriorGrid::Side::unknown: enclosed_[undecided++] = enclosed_[i]; break;
+      case ObjectInteriorGrid::Side::inside:
+        inside(enclosed_[i].first);
+        break;
+      case ObjectInteriorGrid::Side::outside:
+        break;
+      case ObjectInteriorGrid::Side::unknown:
+        enclosed_[undecided++] = enclosed_[i];
+        break;
     }
   }
   enclosed_.resize(undecided);
@@ -921,7 +972,8 @@ double FlyingObject::frame_margin(const geometry::Point& p) const {
   // Far beyond the rounding of to_object_frame and of the placement: a point this close to
   // the object's box or surface is left to the exact tests.
   return (model_->radius + std::max({std::fabs(p[0]), std::fabs(p[1]), std::fabs(p[2])}) +
-          std::max({std::fabs(translation_[0]), std::fabs(translation_[1]), std::fabs(translation_[2])})) *
+          std::max({std::fabs(translation_[0]), std::fabs(translation_[1]),
+                    std::fabs(translation_[2])})) *
          0x1p-40;
 }
 
@@ -931,14 +983,16 @@ bool FlyingObject::crossing_parity_holds(const geometry::Point& p, const geometr
   // Directions are nearly along the object's own axes, so that the segment's box in the
   // object's frame is thin and the BVH offers few triangles; slanted, so that the segment
   // misses the vertices that generated objects put on their axes.
-  static constexpr std::array<std::array<double, 3>, 6> kDirections{{{0.0123457, 0.0345679, 0.99932},
-                                                                     {0.99932, 0.0123457, 0.0345679},
-                                                                     {0.0345679, 0.99932, 0.0123457},
-                                                                     {-0.0234567, 0.0156789, -0.99960},
-                                                                     {-0.99960, -0.0234567, 0.0156789},
-                                                                     {0.0156789, -0.99960, -0.0234567}}};
+  static constexpr std::array<std::array<double, 3>, 6> kDirections{
+      {{0.0123457, 0.0345679, 0.99932},
+       {0.99932, 0.0123457, 0.0345679},
+       {0.0345679, 0.99932, 0.0123457},
+       {-0.0234567, 0.0156789, -0.99960},
+       {-0.99960, -0.0234567, 0.0156789},
+       {0.0156789, -0.99960, -0.0234567}}};
   // |d| = 1, so some coordinate moves by reach / sqrt(3) > the box's largest side.
-  const double reach = 2 * std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
+  const double reach =
+      2 * std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
   for (const auto& o : kDirections) {
     const Vec3 d{rotation_[0] * o[0] + rotation_[1] * o[1] + rotation_[2] * o[2],
                  rotation_[3] * o[0] + rotation_[4] * o[1] + rotation_[5] * o[2],
@@ -950,11 +1004,13 @@ bool FlyingObject::crossing_parity_holds(const geometry::Point& p, const geometr
     double magnitude = model_->radius;
     for (const auto& q : segment) {
       query.extend(to_object_frame(q));
-      for (int a = 0; a < 3; ++a) magnitude = std::max(magnitude, std::fabs(q[a]) + std::fabs(translation_[a]));
+      for (int a = 0; a < 3; ++a)
+        magnitude = std::max(magnitude, std::fabs(q[a]) + std::fabs(translation_[a]));
     }
     const double grow = magnitude * 0x1p-40;
     for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-    if (const auto odd = crossing_parity(model_->bvh, model_->closed_components, segment, query, [&](std::uint32_t t) { return world_triangle(t); }))
+    if (const auto odd = crossing_parity(model_->bvh, model_->closed_components, segment, query,
+                                         [&](std::uint32_t t) { return world_triangle(t); }))
       return *odd;
   }
   return false;  // every direction grazed the object: taken as outside

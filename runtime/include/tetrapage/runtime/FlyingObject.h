@@ -80,12 +80,12 @@ struct Contact {
 
 /// What one step did (the counters that explain its time).
 struct StepCounters {
-  bool searched = false;            ///< the box left the last searched region: walk + search ran
-  std::uint32_t tets_crossed = 0;   ///< by the walk that located the box's centre
-  std::uint32_t tets_visited = 0;   ///< by the box search
+  bool searched = false;           ///< the box left the last searched region: walk + search ran
+  std::uint32_t tets_crossed = 0;  ///< by the walk that located the box's centre
+  std::uint32_t tets_visited = 0;  ///< by the box search
   std::uint32_t tets_overlapping = 0;
-  std::uint32_t shards_touched = 0; ///< shards whose bounds met the object's box
-  std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
+  std::uint32_t shards_touched = 0;  ///< shards whose bounds met the object's box
+  std::uint32_t shard_misses = 0;    ///< shards paged in synchronously by this step
   /// phase I: shard triangles that meet the object's world box (exactly) and whose boxes, in
   /// the object's frame, meet its own box (a triangle stored in several of the step's shards
   /// counts once in a double-precision index)
@@ -93,14 +93,14 @@ struct StepCounters {
   /// phase I: shard triangles skipped because another of the step's shards held them already
   /// (a triangle crossing regions; double-precision indexes, whose copies are identical)
   std::uint64_t repeats = 0;
-  std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
+  std::uint64_t triangle_tests = 0;  ///< phase II: exact (or epsilon) triangle pair tests
   /// The object's box, and the walk when it searched. While the object holds a free box, the
   /// box is not timed: a step that ends inside the free box reads no clock at all.
   double locate_seconds = 0;
   double search_seconds = 0;
-  double shard_seconds = 0;         ///< acquiring shards (page-ins included)
-  double test_seconds = 0;          ///< phase I and II
-  double interior_seconds = 0;      ///< the containment checks of a step without contact
+  double shard_seconds = 0;     ///< acquiring shards (page-ins included)
+  double test_seconds = 0;      ///< phase I and II
+  double interior_seconds = 0;  ///< the containment checks of a step without contact
   /// The box lay inside the free box of an earlier step (a box that holds no environment
   /// triangle): nothing else ran, and the step is free.
   bool in_free_box = false;
@@ -140,7 +140,8 @@ class FlyingObject {
   FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object);
   /// A flying instance of a shared model (built beforehand, e.g. while the index opened).
   /// @throw InputError for a null index or model.
-  FlyingObject(std::shared_ptr<const CollisionIndex> index, std::shared_ptr<const ObjectModel> model);
+  FlyingObject(std::shared_ptr<const CollisionIndex> index,
+               std::shared_ptr<const ObjectModel> model);
   ~FlyingObject();
   FlyingObject(FlyingObject&&) noexcept;
   FlyingObject& operator=(FlyingObject&&) noexcept;
@@ -219,7 +220,7 @@ class FlyingObject {
   std::array<double, 9> previous_rotation_{};
   Vec3 previous_translation_{};
   geometry::Box previous_box_;
-  geometry::Box current_box_;  ///< this query's world box, before the accuracy's growth
+  geometry::Box current_box_;     ///< this query's world box, before the accuracy's growth
   std::unique_ptr<Solid> solid_;  ///< per-step scratch
   /// Per step: the hull's pruning planes placed in the world (n.x <= offset holds the object).
   std::vector<std::pair<Vec3, double>> world_planes_;
@@ -240,8 +241,9 @@ class FlyingObject {
   bool searched_valid_ = false;
   Vec3 searched_centre_{};
   std::vector<std::uint32_t> shards_;
-  std::vector<geometry::Box> shard_reach_;  ///< parallel to shards_: tet box and stored bounds, intersected
-  std::vector<std::uint32_t> shard_tet_;    ///< parallel to shards_: the shard's tet
+  std::vector<geometry::Box>
+      shard_reach_;  ///< parallel to shards_: tet box and stored bounds, intersected
+  std::vector<std::uint32_t> shard_tet_;      ///< parallel to shards_: the shard's tet
   std::vector<ShardCache<Shard>::Pin> pins_;  ///< parallel to shards_; empty until needed
   // The last region's shards and pins while a search builds the next (reused buffers).
   std::vector<std::uint32_t> previous_shards_;
@@ -254,7 +256,8 @@ class FlyingObject {
   // connected, surface-free box, so on the same side of every closed part.
   geometry::Box free_box_;
   bool free_box_valid_ = false;
-  std::uint32_t free_box_backoff_ = 0;  ///< steps to wait after a failed search, doubled per failure
+  std::uint32_t free_box_backoff_ =
+      0;  ///< steps to wait after a failed search, doubled per failure
   std::uint32_t free_box_wait_ = 0;
 };
 
