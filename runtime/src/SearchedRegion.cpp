@@ -70,6 +70,27 @@ bool SearchedRegion::search(const geometry::Box& box, const std::optional<Vec3>&
   }
   counters.search_seconds = seconds_since(start);
 
+  move_kept_pins();
+
+  if (index.options().prefetch) hint_ahead(box, region, motion);
+  if (index.options().prefetch && index.options().prefetch_ahead && valid_) {
+    // The next region, if the motion since the last search goes on.
+    geometry::Box next = region;
+    const Vec3 now = box.center();
+    for (int a = 0; a < 3; ++a) {
+      const double d = now[a] - centre_[a];
+      next.lo[a] += d, next.hi[a] += d;
+    }
+    prefetch_ahead(next, located.tet);
+  }
+  box_ = region;
+  centre_ = box.center();
+  valid_ = true;
+  return true;
+}
+
+void SearchedRegion::move_kept_pins() {
+  const CollisionIndex& index = *index_;
   // Pins of the region's shards are taken when a step first needs them, and kept while the
   // object stays in the region (unless the region outweighs an eighth of the budget, which
   // other objects share: then each step pins one shard at a time).
@@ -87,44 +108,32 @@ bool SearchedRegion::search(const geometry::Box& box, const std::optional<Vec3>&
     }
   }
   previous_pins_.clear();  // the rest are released
+}
 
-  if (index.options().prefetch) {
-    // The region's shards that the box does not meet yet but would within four more steps of
-    // its last motion: load them in the background now rather than synchronously then. (All
-    // the region's shards were loaded two to three times over for those the flights then
-    // used, and the useless loads evicted useful ones: docs/history/benchmarks-to-2026-11-26.md.)
-    constexpr double kHintSteps = 4;
-    geometry::Box ahead = region;
-    if (motion) {
-      ahead = box;
-      for (int a = 0; a < 3; ++a) {
-        const double d = kHintSteps * (*motion)[a];
-        (d < 0 ? ahead.lo[a] : ahead.hi[a]) += d;
-      }
-    }
-    hints_.clear();
-    for (std::size_t k = 0; k < shards_.size(); ++k)
-      if (!geometry::boxes_overlap(box, shard_reach_[k]) &&
-          geometry::boxes_overlap(ahead, shard_reach_[k]) &&
-          index.tet_filter().planes_may_meet(shard_tet_[k], ahead) &&
-          !index.cache().contains(shards_[k]))
-        hints_.push_back(shards_[k]);
-    if (!hints_.empty()) index.cache().prefetch(hints_);
-  }
-  if (index.options().prefetch && index.options().prefetch_ahead && valid_) {
-    // The next region, if the motion since the last search goes on.
-    geometry::Box next = region;
-    const Vec3 now = box.center();
+void SearchedRegion::hint_ahead(const geometry::Box& box, const geometry::Box& region,
+                                const std::optional<Vec3>& motion) {
+  const CollisionIndex& index = *index_;
+  // The region's shards that the box does not meet yet but would within four more steps of
+  // its last motion: load them in the background now rather than synchronously then. (All
+  // the region's shards were loaded two to three times over for those the flights then
+  // used, and the useless loads evicted useful ones: docs/history/benchmarks-to-2026-11-26.md.)
+  constexpr double kHintSteps = 4;
+  geometry::Box ahead = region;
+  if (motion) {
+    ahead = box;
     for (int a = 0; a < 3; ++a) {
-      const double d = now[a] - centre_[a];
-      next.lo[a] += d, next.hi[a] += d;
+      const double d = kHintSteps * (*motion)[a];
+      (d < 0 ? ahead.lo[a] : ahead.hi[a]) += d;
     }
-    prefetch_ahead(next, located.tet);
   }
-  box_ = region;
-  centre_ = box.center();
-  valid_ = true;
-  return true;
+  hints_.clear();
+  for (std::size_t k = 0; k < shards_.size(); ++k)
+    if (!geometry::boxes_overlap(box, shard_reach_[k]) &&
+        geometry::boxes_overlap(ahead, shard_reach_[k]) &&
+        index.tet_filter().planes_may_meet(shard_tet_[k], ahead) &&
+        !index.cache().contains(shards_[k]))
+      hints_.push_back(shards_[k]);
+  if (!hints_.empty()) index.cache().prefetch(hints_);
 }
 
 void SearchedRegion::prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet) {

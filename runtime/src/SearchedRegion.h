@@ -58,6 +58,13 @@ class SearchedRegion {
   const Shard* resident(std::size_t k);
 
  private:
+  // The last region's pins of the shards this region keeps move to this region's pins (when it
+  // keeps pins at all); the rest are released.
+  void move_kept_pins();
+  // Hints the prefetcher with the shards `box` would meet a few steps ahead along `motion`.
+  void hint_ahead(const geometry::Box& box, const geometry::Box& region,
+                  const std::optional<Vec3>& motion);
+  // Hints the prefetcher with the shards of the next region along the motion.
   void prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet);
 
   const CollisionIndex* index_;
