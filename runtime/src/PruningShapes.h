@@ -6,6 +6,7 @@
 /// per candidate, so they are inline here.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <span>
