@@ -9,6 +9,9 @@
 ///     object's BVH, decided on the object's world coordinates (apply_pose, the canonical
 ///     placement), so that the exact mode answers exactly what an exact oracle answers.
 /// One FlyingObject is used from one thread at a time; many may share a CollisionIndex.
+/// query() runs these steps over its parts, each private to runtime/src (PlacedObject: 1;
+/// SearchedRegion: 2 to 4; Coherence: the free box and the previous pose; PruningShapes and
+/// PhaseTwo: 5, with ObjectSolid; ContainmentCheck: one body inside the other).
 
 #include <array>
 #include <chrono>
@@ -80,12 +83,12 @@ struct Contact {
 
 /// What one step did (the counters that explain its time).
 struct StepCounters {
-  bool searched = false;            ///< the box left the last searched region: walk + search ran
-  std::uint32_t tets_crossed = 0;   ///< by the walk that located the box's centre
-  std::uint32_t tets_visited = 0;   ///< by the box search
+  bool searched = false;           ///< the box left the last searched region: walk + search ran
+  std::uint32_t tets_crossed = 0;  ///< by the walk that located the box's centre
+  std::uint32_t tets_visited = 0;  ///< by the box search
   std::uint32_t tets_overlapping = 0;
-  std::uint32_t shards_touched = 0; ///< shards whose bounds met the object's box
-  std::uint32_t shard_misses = 0;   ///< shards paged in synchronously by this step
+  std::uint32_t shards_touched = 0;  ///< shards whose bounds met the object's box
+  std::uint32_t shard_misses = 0;    ///< shards paged in synchronously by this step
   /// phase I: shard triangles that meet the object's world box (exactly) and whose boxes, in
   /// the object's frame, meet its own box (a triangle stored in several of the step's shards
   /// counts once in a double-precision index)
@@ -93,14 +96,14 @@ struct StepCounters {
   /// phase I: shard triangles skipped because another of the step's shards held them already
   /// (a triangle crossing regions; double-precision indexes, whose copies are identical)
   std::uint64_t repeats = 0;
-  std::uint64_t triangle_tests = 0; ///< phase II: exact (or epsilon) triangle pair tests
+  std::uint64_t triangle_tests = 0;  ///< phase II: exact (or epsilon) triangle pair tests
   /// The object's box, and the walk when it searched. While the object holds a free box, the
   /// box is not timed: a step that ends inside the free box reads no clock at all.
   double locate_seconds = 0;
   double search_seconds = 0;
-  double shard_seconds = 0;         ///< acquiring shards (page-ins included)
-  double test_seconds = 0;          ///< phase I and II
-  double interior_seconds = 0;      ///< the containment checks of a step without contact
+  double shard_seconds = 0;     ///< acquiring shards (page-ins included)
+  double test_seconds = 0;      ///< phase I and II
+  double interior_seconds = 0;  ///< the containment checks of a step without contact
   /// The box lay inside the free box of an earlier step (a box that holds no environment
   /// triangle): nothing else ran, and the step is free.
   bool in_free_box = false;
@@ -140,7 +143,8 @@ class FlyingObject {
   FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object);
   /// A flying instance of a shared model (built beforehand, e.g. while the index opened).
   /// @throw InputError for a null index or model.
-  FlyingObject(std::shared_ptr<const CollisionIndex> index, std::shared_ptr<const ObjectModel> model);
+  FlyingObject(std::shared_ptr<const CollisionIndex> index,
+               std::shared_ptr<const ObjectModel> model);
   ~FlyingObject();
   FlyingObject(FlyingObject&&) noexcept;
   FlyingObject& operator=(FlyingObject&&) noexcept;
@@ -168,94 +172,21 @@ class FlyingObject {
   bool closed() const { return model_->closed; }
 
  private:
-  void place(const Pose& pose);
-  // Walk, box search and pinning for a new searched region around `box`; false when the box
-  // lies outside the mesh.
-  bool search(const geometry::Box& box, StepCounters& counters);
-  void prefetch_ahead(const geometry::Box& next_region, std::uint32_t from_tet);
-  void release_region();
-  const Vec3& world_vertex(std::uint32_t v);
-  // Containment checks of a step whose surfaces do not touch.
-  // `start`: now, for its clock.
-  void check_containment(const geometry::Box& box, QueryResult& result,
-                         std::chrono::steady_clock::time_point start);
-  void check_object_inside_obstacle(QueryResult& result);
-  void check_obstacle_inside_object(const geometry::Box& box, QueryResult& result);
-  // Does the placed object hold p? By the parity of crossings (the interior grid could not
-  // tell): p must not lie on the object's surface.
-  bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box);
-  bool in_object_box(const geometry::Point& p) const;
-  // After a free step whose box is `box`: a box around it holding no environment triangle
-  // (free_box_), grown towards where the object heads; false when none was found.
-  bool find_free_box(const geometry::Box& box);
+  // The parts of the runtime step (runtime/src): the placed object, the searched region, the
+  // pruning shapes, the solid, the containment check and what the steps keep (coherence).
+  struct Parts;
+  // The step's box lies outside the model: nothing to touch.
+  void outside_model(QueryResult& result);
   // A step whose box is outside the free box: its answer when a new free box around it was
   // found (free, or inside an obstacle), else false and the step goes on to phase I.
   bool step_in_new_free_box(const geometry::Box& box, QueryResult& result);
-  // How far from the object's box or surface a world point must be for the frame change's
-  // rounding not to matter.
-  double frame_margin(const geometry::Point& p) const;
-  // A world point taken back to the object's frame at the current pose (rounded: callers
-  // only prune with it, with margins far beyond the rounding).
-  Vec3 to_object_frame(const geometry::Point& p) const;
-  geometry::Triangle world_triangle(std::uint32_t t);
-  // The solid that stands for the object in this step (shape hull or box, or swept), built on
-  // the first candidate that needs it; does an environment triangle collide with it?
-  struct Solid;
-  void build_solid(const QueryOptions& options, Solid& solid);
-  static bool solid_collides(const Solid& solid, const geometry::Triangle& environment,
-                             const geometry::Accuracy& accuracy, double reach);
+  // Phases I and II over the region's shards that the step needs, then containment.
+  void test_region(const geometry::Box& box, const QueryOptions& options, bool solid_query,
+                   std::chrono::steady_clock::time_point loop_start, QueryResult& result);
 
   std::shared_ptr<const CollisionIndex> index_;
   std::shared_ptr<const ObjectModel> model_;
-  // Per step: the environment components whose boxes lie in the object's box (only those can
-  // lie inside the object), each with a vertex of a candidate triangle of theirs.
-  std::vector<std::pair<std::uint32_t, geometry::Point>> enclosed_;
-  // Per object component: where its last containment walk ended, and its last answer.
-  std::vector<std::uint32_t> interior_tets_;
-  std::vector<ObstacleMemo> interior_memos_;
-  std::array<std::uint32_t, 6> extreme_{};  ///< hull positions of the last min/max per axis
-  // The previous query's pose and world box (before the accuracy's growth), for swept motion.
-  bool previous_valid_ = false;
-  std::array<double, 9> previous_rotation_{};
-  Vec3 previous_translation_{};
-  geometry::Box previous_box_;
-  geometry::Box current_box_;  ///< this query's world box, before the accuracy's growth
-  std::unique_ptr<Solid> solid_;  ///< per-step scratch
-  /// Per step: the hull's pruning planes placed in the world (n.x <= offset holds the object).
-  std::vector<std::pair<Vec3, double>> world_planes_;
-  TriangleIdSet met_triangles_;  ///< the triangles phase I has met this step
-
-  // Per-step state.
-  std::array<double, 9> rotation_{};
-  Vec3 translation_{};
-  std::uint64_t step_ = 0;
-  std::vector<Vec3> world_;
-  std::vector<std::uint64_t> world_step_;
-  std::uint32_t last_tet_ = 0;
-  BoxSearchScratch search_;
-  BoxSearchScratch prefetch_search_;
-  // The searched region: a box grown around the object's box, its tets' shards, pinned while
-  // the object's box stays inside it (most steps then touch neither the mesh nor the cache).
-  geometry::Box searched_box_;
-  bool searched_valid_ = false;
-  Vec3 searched_centre_{};
-  std::vector<std::uint32_t> shards_;
-  std::vector<geometry::Box> shard_reach_;  ///< parallel to shards_: tet box and stored bounds, intersected
-  std::vector<std::uint32_t> shard_tet_;    ///< parallel to shards_: the shard's tet
-  std::vector<ShardCache<Shard>::Pin> pins_;  ///< parallel to shards_; empty until needed
-  // The last region's shards and pins while a search builds the next (reused buffers).
-  std::vector<std::uint32_t> previous_shards_;
-  std::vector<ShardCache<Shard>::Pin> previous_pins_;
-  bool keep_pins_ = false;
-  std::vector<std::uint32_t> hints_;
-  // A box that meets no environment triangle, around the box of a step whose answer was free
-  // (no contact, the object in no obstacle). Any later step whose box lies strictly inside it
-  // is free too: it has no candidates, and the object's containment vertex lies in the same
-  // connected, surface-free box, so on the same side of every closed part.
-  geometry::Box free_box_;
-  bool free_box_valid_ = false;
-  std::uint32_t free_box_backoff_ = 0;  ///< steps to wait after a failed search, doubled per failure
-  std::uint32_t free_box_wait_ = 0;
+  std::unique_ptr<Parts> parts_;
 };
 
 }  // namespace tetrapage

@@ -1,0 +1,58 @@
+#pragma once
+/// @file ContainmentCheck.h (private)
+/// Containment, for a step whose surfaces do not touch: is a component of the object inside a
+/// closed obstacle (the index's interiors), or a component of the environment inside a closed
+/// component of the object?
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "PlacedObject.h"
+#include "StepClock.h"
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/ObjectModel.h"
+#include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/runtime/geometry/Box.h"
+
+namespace tetrapage {
+
+class ContainmentCheck {
+ public:
+  ContainmentCheck(const CollisionIndex& index, const ObjectModel& model)
+      : index_(&index), model_(&model) {}
+
+  void begin_step() { enclosed_.clear(); }
+  /// An environment component whose box lies in the object's box (only those can lie inside
+  /// the object), with a vertex of a candidate triangle of it.
+  void note_enclosed(std::uint32_t component, const geometry::Point& vertex) {
+    enclosed_.emplace_back(component, vertex);
+  }
+  /// Both checks for the step whose box is `box`, the object placed as `object`; `pins`: the
+  /// shards the walks may read without pinning; `start`: now, for its clock.
+  void check(const geometry::Box& box, PlacedObject& object, std::span<const ShardPin> pins,
+             QueryResult& result, Clock::time_point start);
+
+ private:
+  void check_object_inside_obstacle(PlacedObject& object, std::span<const ShardPin> pins,
+                                    QueryResult& result);
+  void check_obstacle_inside_object(const geometry::Box& box, PlacedObject& object,
+                                    QueryResult& result);
+  // Does the placed object hold p? By the parity of crossings (the interior grid could not
+  // tell): p must not lie on the object's surface.
+  bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box,
+                             PlacedObject& object) const;
+
+  const CollisionIndex* index_;
+  const ObjectModel* model_;
+  // Per step: the environment components whose boxes lie in the object's box (only those can
+  // lie inside the object), each with a vertex of a candidate triangle of theirs.
+  std::vector<std::pair<std::uint32_t, geometry::Point>> enclosed_;
+  // Per object component: where its last containment walk ended, and its last answer.
+  std::vector<std::uint32_t> interior_tets_;
+  std::vector<ObstacleMemo> interior_memos_;
+};
+
+}  // namespace tetrapage

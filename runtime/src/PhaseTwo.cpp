@@ -1,0 +1,153 @@
+#include "PhaseTwo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "tetrapage/runtime/geometry/TriangleBox.h"
+#include "tetrapage/runtime/geometry/TriangleDistance.h"
+#include "tetrapage/runtime/geometry/TriangleTriangle.h"
+
+namespace tetrapage {
+
+PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, PlacedObject& object,
+                   const PruningShapes& shapes, ObjectSolid& solid, const Coherence& coherence,
+                   ContainmentCheck& containment, TriangleIdSet& met_triangles,
+                   const QueryOptions& options, bool solid_query, const geometry::Box& box,
+                   QueryResult& result)
+    : index_(index),
+      model_(model),
+      object_(object),
+      shapes_(shapes),
+      solid_(solid),
+      coherence_(coherence),
+      containment_(containment),
+      met_triangles_(met_triangles),
+      options_(options),
+      solid_query_(solid_query),
+      all_(options.mode == QueryMode::all_contacts),
+      box_(box),
+      result_(result),
+      counters_(result.counters) {
+  solid_.built = false;
+  // A triangle stored in several of the step's shards is tested once: exact and double copies
+  // are the input's coordinates, the same in every shard (rounded float copies each round to
+  // their own shard's frame, so each is tested).
+  met_triangles_.clear();
+}
+
+void PhaseTwo::add_contact(const Shard& shard, std::uint32_t local, std::uint32_t object_triangle) {
+  result_.collides = true;
+  if (all_ || result_.contacts.empty()) {
+    const std::uint32_t component = shard.component_id(local);
+    result_.contacts.push_back(
+        {index_.component_part(component), shard.triangle_id(local), object_triangle, component});
+  }
+  if (!all_) stop_ = true;
+}
+
+void PhaseTwo::test_mesh(const Shard& shard, std::uint32_t local,
+                         const geometry::Triangle& environment, const std::array<Vec3, 3>& framed,
+                         const geometry::Box& query, double grow) {
+  // Object triangles that can meet the environment triangle lie within `grow` of its
+  // plane, in the object's frame (its corners taken there round by less than `grow`).
+  const Vec3& p0 = framed[0];
+  const Vec3 u{framed[1][0] - p0[0], framed[1][1] - p0[1], framed[1][2] - p0[2]};
+  const Vec3 v{framed[2][0] - p0[0], framed[2][1] - p0[1], framed[2][2] - p0[2]};
+  const Vec3 n{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+  const double n_size = std::fabs(n[0]) + std::fabs(n[1]) + std::fabs(n[2]);
+  const double uv_size = (std::fabs(u[0]) + std::fabs(u[1]) + std::fabs(u[2])) *
+                         (std::fabs(v[0]) + std::fabs(v[1]) + std::fabs(v[2]));
+  auto near_plane = [&](const geometry::Box& b) {
+    double lowest = 0, highest = 0, far = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double l = b.lo[a] - p0[a], h = b.hi[a] - p0[a];
+      lowest += n[a] * (n[a] > 0 ? l : h);
+      highest += n[a] * (n[a] > 0 ? h : l);
+      far = std::max({far, std::fabs(l), std::fabs(h)});
+    }
+    const double bound = 2 * grow * n_size + uv_size * far * 0x1p-40;
+    return !(lowest > bound || highest < -bound);
+  };
+  model_.bvh.for_each_in_box(query, near_plane, [&](std::uint32_t object_triangle) {
+    ++counters_.triangle_tests;
+    if (!geometry::triangles_collide(environment, object_.world_triangle(object_triangle),
+                                     options_.accuracy))
+      return true;
+    add_contact(shard, local, object_triangle);
+    return all_;
+  });
+}
+
+void PhaseTwo::test_candidate(const Shard& shard, std::uint32_t local,
+                              const geometry::Triangle& environment) {
+  // The environment triangle in the object's frame (rounded: it only prunes).
+  const std::array<Vec3, 3> framed{object_.to_object_frame(environment[0]),
+                                   object_.to_object_frame(environment[1]),
+                                   object_.to_object_frame(environment[2])};
+  geometry::Box query;
+  for (const auto& p : framed) query.extend(p);
+  // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
+  const Vec3& translation = object_.translation();
+  double magnitude = model_.radius;
+  for (const auto& p : environment)
+    for (int a = 0; a < 3; ++a)
+      magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation[a]));
+  const double grow = shapes_.reach() + magnitude * 0x1p-40;
+  for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
+  if ((shapes_.own_frame() &&
+       (!geometry::boxes_overlap(query, model_.box) || shapes_.beyond_hull(query))) ||
+      (shapes_.ball_prunes() &&
+       geometry::triangle_outside_ball(framed, model_.ball_centre, model_.ball_radius + grow)) ||
+      !geometry::triangle_intersects_box(environment, box_))
+    return;
+  ++counters_.candidates;
+  if (solid_query_) {
+    if (!solid_.built) solid_.build(options_, model_, object_, coherence_);
+    ++counters_.triangle_tests;
+    if (solid_.collides(environment, options_.accuracy, shapes_.reach()))
+      add_contact(shard, local, Contact::kNoObjectTriangle);
+    return;
+  }
+  if (model_.closed && !result_.collides) {
+    const std::uint32_t component = shard.component_id(local);
+    if (index_.component_part(component) != CollisionIndex::kNoPart &&
+        geometry::box_contains(box_, index_.component_bounds(component)) &&
+        object_.in_object_box(environment[0]))
+      containment_.note_enclosed(component, environment[0]);
+  }
+  test_mesh(shard, local, environment, framed, query, grow);
+}
+
+void PhaseTwo::test_shard(const Shard& shard) {
+  const bool same_copies =
+      index_.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
+  auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
+    if (stop_) return;  // the shard query cannot be cut short; skip the rest
+    if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
+      ++counters_.repeats;
+      return;
+    }
+    test_candidate(shard, local, environment);
+  };
+  const auto meets_own_box = [this](const geometry::Box& b, std::uint32_t triangles) {
+    return shapes_.meets_own_box(b, triangles);
+  };
+  if (shapes_.prune_inner())
+    shard.for_each_box_candidate_pruning_inner_nodes(box_, meets_own_box, visit);
+  else
+    shard.for_each_box_candidate(box_, meets_own_box, visit);
+}
+
+void PhaseTwo::finish() {
+  if (!all_ || result_.contacts.size() <= 1) return;
+  // A triangle that crosses regions is stored in each of their shards, and float copies are
+  // each tested (above): report a pair once.
+  auto key = [](const Contact& c) { return std::tie(c.environment_triangle, c.object_triangle); };
+  std::sort(result_.contacts.begin(), result_.contacts.end(),
+            [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
+  result_.contacts.erase(std::unique(result_.contacts.begin(), result_.contacts.end()),
+                         result_.contacts.end());
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,61 @@
+#pragma once
+/// @file PhaseTwo.h (private)
+/// One step's test of a shard's candidates (step 5 of the runtime step): phase I's R-tree
+/// descent pruned by the object's shapes, each candidate met once, taken to the object's
+/// frame and pruned there; then phase II, the candidate against the object's BVH (or its
+/// solid), decided on world coordinates, and the contacts found.
+
+#include <cstdint>
+
+#include "ContainmentCheck.h"
+#include "ObjectSolid.h"
+#include "PlacedObject.h"
+#include "PruningShapes.h"
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/ObjectModel.h"
+#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/TriangleIdSet.h"
+
+namespace tetrapage {
+
+class PhaseTwo {
+ public:
+  /// The parts one step reads: the phase I box `box`, the object asked as a solid when
+  /// `solid_query` (built on the first candidate that needs it), results into `result`.
+  PhaseTwo(const CollisionIndex& index, const ObjectModel& model, PlacedObject& object,
+           const PruningShapes& shapes, ObjectSolid& solid, const Coherence& coherence,
+           ContainmentCheck& containment, TriangleIdSet& met_triangles, const QueryOptions& options,
+           bool solid_query, const geometry::Box& box, QueryResult& result);
+
+  void test_shard(const Shard& shard);
+  /// first_hit found its contact: the other shards need not be tested.
+  bool stopped() const { return stop_; }
+  /// With all contacts, each pair once.
+  void finish();
+
+ private:
+  void test_candidate(const Shard& shard, std::uint32_t local,
+                      const geometry::Triangle& environment);
+  void test_mesh(const Shard& shard, std::uint32_t local, const geometry::Triangle& environment,
+                 const std::array<Vec3, 3>& framed, const geometry::Box& query, double grow);
+  void add_contact(const Shard& shard, std::uint32_t local, std::uint32_t object_triangle);
+
+  const CollisionIndex& index_;
+  const ObjectModel& model_;
+  PlacedObject& object_;
+  const PruningShapes& shapes_;
+  ObjectSolid& solid_;
+  const Coherence& coherence_;
+  ContainmentCheck& containment_;
+  TriangleIdSet& met_triangles_;
+  const QueryOptions& options_;
+  const bool solid_query_;
+  const bool all_;
+  const geometry::Box& box_;
+  QueryResult& result_;
+  StepCounters& counters_;
+  bool stop_ = false;
+};
+
+}  // namespace tetrapage
