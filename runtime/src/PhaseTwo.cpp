@@ -109,29 +109,47 @@ void PhaseTwo::test_candidate(const Shard& shard, std::uint32_t local,
       add_contact(shard, local, Contact::kNoObjectTriangle);
     return;
   }
-  if (model_.closed && !result_.collides) {
-    const std::uint32_t component = shard.component_id(local);
-    if (index_.component_part(component) != CollisionIndex::kNoPart &&
-        geometry::box_contains(box_, index_.component_bounds(component)) &&
-        object_.in_object_box(environment[0]))
-      containment_.note_enclosed(component, environment[0]);
-  }
+  note_if_enclosed(shard, local, environment);
   test_mesh(shard, local, environment, framed, query, grow);
+}
+
+void PhaseTwo::note_if_enclosed(const Shard& shard, std::uint32_t local,
+                                const geometry::Triangle& environment) {
+  // A component whose box lies in the object's may lie wholly inside it (checked once the
+  // step has found no contact).
+  if (!model_.closed || result_.collides) return;
+  const std::uint32_t component = shard.component_id(local);
+  if (index_.component_part(component) != CollisionIndex::kNoPart &&
+      geometry::box_contains(box_, index_.component_bounds(component)) &&
+      object_.in_object_box(environment[0]))
+    containment_.note_enclosed(component, environment[0]);
 }
 
 void PhaseTwo::test_shard(const Shard& shard) {
   const bool same_copies =
       index_.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
+  // The leaf the visited triangles come from (each leaf's triangles follow its test) lies
+  // inside the object, apart from its surface.
+  bool in_leaf_inside_object = false;
   auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
     if (stop_) return;  // the shard query cannot be cut short; skip the rest
     if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
       ++counters_.repeats;
       return;
     }
+    if (in_leaf_inside_object) {
+      note_if_enclosed(shard, local, environment);
+      return;
+    }
     test_candidate(shard, local, environment);
   };
-  const auto meets_own_box = [this](const geometry::Box& b, std::uint32_t triangles) {
-    return shapes_.meets_own_box(b, triangles);
+  // An R-tree leaf's box holds its triangles: a leaf that reaches only the object's inside
+  // holds no triangle near its surface (a grid cell's triangles reach beyond the cell).
+  const bool leaves_hold_triangles = shard.kind() == ShardKind::rtree;
+  const auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
+    const PruningShapes::NodeReach reach = shapes_.reach_of(b, triangles);
+    in_leaf_inside_object = leaves_hold_triangles && reach == PruningShapes::NodeReach::inside;
+    return reach != PruningShapes::NodeReach::apart;
   };
   if (shapes_.prune_inner())
     shard.for_each_box_candidate_pruning_inner_nodes(box_, meets_own_box, visit);

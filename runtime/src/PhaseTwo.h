@@ -40,6 +40,8 @@ class PhaseTwo {
   void test_mesh(const Shard& shard, std::uint32_t local, const geometry::Triangle& environment,
                  const std::array<Vec3, 3>& framed, const geometry::Box& query, double grow);
   void add_contact(const Shard& shard, std::uint32_t local, std::uint32_t object_triangle);
+  void note_if_enclosed(const Shard& shard, std::uint32_t local,
+                        const geometry::Triangle& environment);
 
   const CollisionIndex& index_;
   const ObjectModel& model_;

@@ -54,7 +54,19 @@ class PruningShapes {
   }
   // Does a world box (an R-tree node's or a shard's, holding `triangles`, 0 when unknown) meet
   // the object's own box?
-  bool meets_own_box(const geometry::Box& b, std::uint32_t triangles) const;
+  bool meets_own_box(const geometry::Box& b, std::uint32_t triangles) const {
+    return reach_of(b, triangles) != NodeReach::apart;
+  }
+  /// What of the object a node's box can reach.
+  enum class NodeReach : std::uint8_t {
+    apart,    ///< nothing: the node's triangles miss the object
+    surface,  ///< maybe the object's surface
+    /// Only the object's inside: the box (grown by the reach) meets no object triangle's box,
+    /// and lies in the closed object. Its triangles touch no object triangle; they matter
+    /// only as part of an environment component that may lie wholly inside the object.
+    inside,
+  };
+  NodeReach reach_of(const geometry::Box& b, std::uint32_t triangles) const;
 
  private:
   static bool box_beyond_planes(std::span<const Plane> planes, double margin,
@@ -100,12 +112,13 @@ class PruningShapes {
   std::vector<Plane> world_planes_;
 };
 
-inline bool PruningShapes::meets_own_box(const geometry::Box& b, std::uint32_t triangles) const {
+inline PruningShapes::NodeReach PruningShapes::reach_of(const geometry::Box& b,
+                                                        std::uint32_t triangles) const {
   // Does a world box meet the object's own box? Its centre taken to the object's frame and
   // its half extents through |R| (separating axes of the object's frame); the roundings are
   // covered by a margin far beyond them. Conservative: it only prunes.
-  if (!own_frame_) return true;
-  if (world_shapes_miss(b)) return false;
+  if (!own_frame_) return NodeReach::surface;
+  if (world_shapes_miss(b)) return NodeReach::apart;
   const std::array<double, 9>& rotation = object_->rotation();
   const Vec3& translation = object_->translation();
   Vec3 c, h;
@@ -120,23 +133,24 @@ inline bool PruningShapes::meets_own_box(const geometry::Box& b, std::uint32_t t
     const double x = rotation[a] * c[0] + rotation[3 + a] * c[1] + rotation[6 + a] * c[2];
     const double e = std::fabs(rotation[a]) * h[0] + std::fabs(rotation[3 + a]) * h[1] +
                      std::fabs(rotation[6 + a]) * h[2];
-    if (std::fabs(x - own_centre_[a]) > e + own_half_[a] + margin) return false;
+    if (std::fabs(x - own_centre_[a]) > e + own_half_[a] + margin) return NodeReach::apart;
     in_frame.lo[a] = x - e - reach_ - margin;
     in_frame.hi[a] = x + e + reach_ + margin;
   }
-  if (beyond_hull(in_frame) || outside_ball(in_frame)) return false;
+  if (beyond_hull(in_frame) || outside_ball(in_frame)) return NodeReach::apart;
   // For the mesh, a node must also come near the object's surface (its BVH) or lie inside it:
   // a node whose box meets no object triangle's box lies wholly inside or wholly outside the
   // object, and one point of it tells which.
   if (!near_surface_only_ || triangles < kSurfaceTestTriangles ||
       std::max({h[0], h[1], h[2]}) > surface_test_extent_)
-    return true;
+    return NodeReach::surface;
   bool near_surface = false;
   model_->bvh.for_each_in_box(in_frame, [&](std::uint32_t) { return !(near_surface = true); });
-  if (near_surface) return true;
-  if (!model_->closed) return false;
-  return model_->interior_grid.classify(in_frame.center(), margin) !=
-         ObjectInteriorGrid::Side::outside;
+  if (near_surface) return NodeReach::surface;
+  if (!model_->closed || model_->interior_grid.classify(in_frame.center(), margin) ==
+                             ObjectInteriorGrid::Side::outside)
+    return NodeReach::apart;
+  return NodeReach::inside;
 }
 
 }  // namespace tetrapage
