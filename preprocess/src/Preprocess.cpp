@@ -14,7 +14,7 @@
 #include "Ingest.h"
 #include "Interiors.h"
 #include "MortonGrid.h"
-#include "ShardBuilder.h"
+#include "Shards.h"
 #include "TriangleBinning.h"
 #include "WriteIndex.h"
 #include "tetrapage/formats/ByteSize.h"
