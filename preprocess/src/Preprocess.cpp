@@ -11,7 +11,7 @@
 
 #include "Binning.h"
 #include "Buckets.h"
-#include "CoarseMesh.h"
+#include "CoarseMeshStage.h"
 #include "Ingest.h"
 #include "Interiors.h"
 #include "MortonGrid.h"
