@@ -90,13 +90,51 @@ std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memo
                                  std::max(fewest, most));
 }
 
+// Appends a loaded soup's parts, components and triangles to the model; the soups are
+// spilled once they hold more than a quarter of the budget.
+void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptions& options,
+                 const std::filesystem::path& spill_folder, PreprocessSummary& summary) {
+  summary.degenerate_dropped += loaded.degenerate_dropped;
+  summary.files_read += loaded.files_read;
+  const auto part_offset = std::uint32_t(model.part_names.size());
+  for (const auto& name : loaded.soup.part_names) model.part_names.push_back(name);
+  if (loaded.soup.part_names.empty())
+    model.part_names.push_back("part" + std::to_string(part_offset));
+  if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
+    throw InputError("the inputs hold more than 2^32 - 2 connected components");
+  const auto component_offset = std::uint32_t(model.components.size());
+  for (SurfaceComponent& c : loaded.components) {
+    c.part += part_offset;
+    model.bounds.extend(c.bounds);
+    model.components.push_back(c);
+  }
+  model.soups.append(loaded.soup, component_offset);
+  const std::uint64_t held_limit = options.memory_bytes / 4;
+  if (!model.soups.spilled() && (model.soups.held_bytes() > held_limit || options.force_spill))
+    model.soups.spill_to(spill_path(spill_folder, "triangles"));
+}
+
+// Counts a soup's triangles into the model and keeps its centroids in the reservoir sample
+// (of at most sample_capacity).
+void sample_centroids(IngestedModel& model, const std::vector<Vec3>& centroids,
+                      std::size_t sample_capacity, std::mt19937_64& random) {
+  for (std::size_t t = 0; t < centroids.size(); ++t, ++model.triangle_count) {
+    if (model.sample.size() < sample_capacity) {
+      model.sample.push_back(centroids[t]);
+    } else {
+      const std::uint64_t slot =
+          std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(random);
+      if (slot < sample_capacity) model.sample[slot] = centroids[t];
+    }
+  }
+}
+
 }  // namespace
 
 IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
                      const PreprocessOptions& options, const std::filesystem::path& spill_folder,
                      PreprocessSummary& summary) {
   IngestedModel model;
-  const std::uint64_t held_limit = options.memory_bytes / 4;
   // At most 2M centroids, at least 2^16: a site stands for the mean of hundreds of sampled
   // centroids at the default region size. A cap of 4M gave the 10M scene the same regions
   // (26,081 against 26,071), duplication (1.2623 against 1.2630) and flights in memory (six
@@ -106,36 +144,6 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
       std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 21));
   model.sample.reserve(std::min<std::size_t>(sample_capacity, 1 << 16));
   std::mt19937_64 random(0x7e7a9a9e);
-
-  // In input order (ids, part numbers and the sample do not depend on the threads).
-  auto add_soup = [&](LoadedSoup& loaded) {
-    summary.degenerate_dropped += loaded.degenerate_dropped;
-    summary.files_read += loaded.files_read;
-    const auto part_offset = std::uint32_t(model.part_names.size());
-    for (const auto& name : loaded.soup.part_names) model.part_names.push_back(name);
-    if (loaded.soup.part_names.empty())
-      model.part_names.push_back("part" + std::to_string(part_offset));
-    if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
-      throw InputError("the inputs hold more than 2^32 - 2 connected components");
-    const auto component_offset = std::uint32_t(model.components.size());
-    for (SurfaceComponent& c : loaded.components) {
-      c.part += part_offset;
-      model.bounds.extend(c.bounds);
-      model.components.push_back(c);
-    }
-    model.soups.append(loaded.soup, component_offset);
-    if (!model.soups.spilled() && (model.soups.held_bytes() > held_limit || options.force_spill))
-      model.soups.spill_to(spill_path(spill_folder, "triangles"));
-    for (std::size_t t = 0; t < loaded.centroids.size(); ++t, ++model.triangle_count) {
-      if (model.sample.size() < sample_capacity) {
-        model.sample.push_back(loaded.centroids[t]);
-      } else {
-        const std::uint64_t slot =
-            std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(random);
-        if (slot < sample_capacity) model.sample[slot] = loaded.centroids[t];
-      }
-    }
-  };
 
   // One part file at a time per thread: the ingest never holds the assembly.
   const std::vector<InputPiece> jobs = input_pieces(inputs);
@@ -148,7 +156,9 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
       jobs.size(), in_flight,
       [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
-        add_soup(*loaded);
+        // In input order (ids, part numbers and the sample do not depend on the threads).
+        append_soup(model, *loaded, options, spill_folder, summary);
+        sample_centroids(model, loaded->centroids, sample_capacity, random);
         progress.advance();
       });
   progress.finish();

@@ -9,13 +9,13 @@
 #include <sstream>
 #include <type_traits>
 
+#include "Binning.h"
 #include "Buckets.h"
-#include "CoarseMesh.h"
+#include "CoarseMeshStage.h"
 #include "Ingest.h"
 #include "Interiors.h"
 #include "MortonGrid.h"
-#include "ShardBuilder.h"
-#include "TriangleBinning.h"
+#include "Shards.h"
 #include "WriteIndex.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"

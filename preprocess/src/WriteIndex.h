@@ -8,7 +8,7 @@
 
 #include "Ingest.h"
 #include "Interiors.h"
-#include "ShardBuilder.h"
+#include "Shards.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/TetMesh.h"
 #include "tetrapage/preprocess/Preprocess.h"

@@ -1,5 +1,5 @@
 #pragma once
-/// @file ShardBuilder.h (private)
+/// @file Shards.h (private)
 /// Stage 6 of the preprocess (docs/ARCHITECTURE.md): the shards, bucket by bucket, built,
 /// compressed and appended to the index. The builder of one shard, build_shard, is public:
 /// tetrapage/preprocess/ShardBuilder.h.

@@ -1,5 +1,5 @@
 #pragma once
-/// @file TriangleBinning.h (private)
+/// @file Binning.h (private)
 /// Stage 5 of the preprocess (docs/ARCHITECTURE.md): every triangle binned into every tet it
 /// meets, its copies appended to their tets' buckets. The exact test of one triangle,
 /// bin_triangle, is public: tetrapage/preprocess/TriangleBinning.h.

@@ -1,5 +1,5 @@
 #pragma once
-/// @file CoarseMesh.h (private)
+/// @file CoarseMeshStage.h (private)
 /// Stage 2 of the preprocess (docs/ARCHITECTURE.md): sites sampled from the ingested
 /// centroids and their Delaunay mesh. The sampling and the mesh of given sites are public:
 /// tetrapage/preprocess/CoarseMesh.h.
