@@ -66,11 +66,14 @@ void collect_instances(const std::string& file, const aiNode* root, const Matrix
       throw FormatError(file + ": Assimp's scene has a missing node (a null child at depth " +
                         std::to_string(next.depth) + "): its meshes cannot be placed");
     if (next.depth > kMaxNodeDepth)
-      throw InputError(file + ": the scene's nodes nest deeper than " +
-                       std::to_string(kMaxNodeDepth));
+      throw FormatError(file + ": the scene's nodes nest deeper than " +
+                        std::to_string(kMaxNodeDepth));
     const Matrix transform = multiply(next.parent, to_matrix(next.node->mTransformation));
     if (next.node->mNumMeshes > 0) instances.push_back({next.node, transform});
-    if (next.node->mChildren == nullptr) continue;
+    if (next.node->mNumChildren > 0 && next.node->mChildren == nullptr)
+      throw FormatError(file + ": Assimp's scene has a node with " +
+                        std::to_string(next.node->mNumChildren) +
+                        " children and no list of them: their meshes cannot be placed");
     // Reversed, so that children come out in the file's order.
     for (unsigned c = next.node->mNumChildren; c-- > 0;)
       pending.push_back({next.node->mChildren[c], transform, next.depth + 1});
@@ -121,7 +124,8 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
     soup.begin_part(name);
     for (unsigned m = 0; m < node->mNumMeshes; ++m) {
       // An importer's scene is input too: a mesh it names must exist and hold its arrays.
-      if (node->mMeshes == nullptr || node->mMeshes[m] >= scene->mNumMeshes)
+      if (node->mMeshes == nullptr || scene->mMeshes == nullptr ||
+          node->mMeshes[m] >= scene->mNumMeshes)
         throw FormatError(path.string() + ": node '" + node->mName.C_Str() +
                           "' names a mesh the scene lacks");
       const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];

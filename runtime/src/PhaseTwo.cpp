@@ -149,6 +149,7 @@ void PhaseTwo::test_shard(const Shard& shard) {
   const auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
     const PruningShapes::NodeReach reach = shapes_.reach_of(b, triangles);
     in_leaf_inside_object = leaves_hold_triangles && reach == PruningShapes::NodeReach::inside;
+    counters_.leaves_inside_object += in_leaf_inside_object;
     return reach != PruningShapes::NodeReach::apart;
   };
   if (shapes_.prune_inner())

@@ -62,8 +62,9 @@ class PruningShapes {
     apart,    ///< nothing: the node's triangles miss the object
     surface,  ///< maybe the object's surface
     /// Only the object's inside: the box (grown by the reach) meets no object triangle's box,
-    /// and lies in the closed object. Its triangles touch no object triangle; they matter
-    /// only as part of an environment component that may lie wholly inside the object.
+    /// and lies in the closed object (or the object's interior grid cannot tell). Its triangles
+    /// touch no object triangle; they matter only as part of an environment component that may lie
+    /// wholly inside the object.
     inside,
   };
   NodeReach reach_of(const geometry::Box& b, std::uint32_t triangles) const;

@@ -12,11 +12,11 @@
 #include <cmath>
 #include <filesystem>
 
-#include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
@@ -141,7 +141,8 @@ TEST(Interiors, PreprocessClassifiesTheClosedComponents) {
   for (std::uint32_t c = 0; c + 1 < components; ++c) EXPECT_TRUE(index.component_closed(c)) << c;
   EXPECT_FALSE(index.component_closed(components - 1));
   // The three boxes of boxes.obj are the part before the sheet's.
-  for (std::uint32_t c = components - 4; c + 1 < components; ++c) EXPECT_EQ(index.component_part(c), parts - 2);
+  for (std::uint32_t c = components - 4; c + 1 < components; ++c)
+    EXPECT_EQ(index.component_part(c), parts - 2);
   EXPECT_EQ(index.component_part(components - 1), parts - 1);
 }
 
@@ -193,15 +194,17 @@ TEST(Interiors, AMovingPointDecidedFromItsLastAnswerAgreesWithTheOracle) {
   // The same walk again with every other shard pinned by the caller (a flying object's
   // region): the pinned ones are read from there.
   std::vector<ShardPin> held;
-  for (std::uint32_t s = 0; s < index.shard_count(); s += 2) held.push_back(index.cache().acquire(s));
+  for (std::uint32_t s = 0; s < index.shard_count(); s += 2)
+    held.push_back(index.cache().acquire(s));
   int inside = 0, from_memo = 0, wrong = 0;
   const int steps = 20000;
   for (int i = 0; i < steps; ++i) {
     // Every 50 steps a jump to a random point of the box, then short steps from there.
     for (int a = 0; a < 3; ++a)
-      p[a] = i % 50 == 0 ? random.uniform(box.lo[a], box.hi[a])
-                         : std::clamp(p[a] + random.uniform(-0.002, 0.002) * (box.hi[a] - box.lo[a]), box.lo[a],
-                                      box.hi[a]);
+      p[a] = i % 50 == 0
+                 ? random.uniform(box.lo[a], box.hi[a])
+                 : std::clamp(p[a] + random.uniform(-0.002, 0.002) * (box.hi[a] - box.lo[a]),
+                              box.lo[a], box.hi[a]);
     const bool same_tet = memo.valid;
     const std::uint32_t memo_tet = memo.tet;
     const ObstacleQuery answer = locate_in_obstacles(index, hint, p, memo);
@@ -211,7 +214,8 @@ TEST(Interiors, AMovingPointDecidedFromItsLastAnswerAgreesWithTheOracle) {
     const ObstacleQuery from_held = locate_in_obstacles(index, held_hint, p, held_memo, held);
     EXPECT_EQ(from_held.containment, answer.containment) << "step " << i;
     EXPECT_EQ(from_held.component, answer.component) << "step " << i;
-    if (answer.containment != ObstacleContainment::inside && answer.containment != ObstacleContainment::outside)
+    if (answer.containment != ObstacleContainment::inside &&
+        answer.containment != ObstacleContainment::outside)
       continue;
     EXPECT_EQ(answer.component, plain.component) << "step " << i;
     const bool oracle_inside = oracle.inside_environment(p);
@@ -230,9 +234,12 @@ TEST(Interiors, ClassifiedInSeveralPassesTheTablesAreTheSame) {
   ASSERT_EQ(m.summary.interiors.rfind("stored (", 0), 0u) << m.summary.interiors;
   EXPECT_NE(m.summary.interiors.rfind("stored (1 pass)", 0), 0u) << m.summary.interiors;
   const IndexReader one(whole.index), several(m.index);
-  EXPECT_EQ(one.read_table_uint64("interior_offsets"), several.read_table_uint64("interior_offsets"));
-  EXPECT_EQ(one.read_table_uint32("interior_components"), several.read_table_uint32("interior_components"));
-  EXPECT_EQ(one.read_table_double("reference_points"), several.read_table_double("reference_points"));
+  EXPECT_EQ(one.read_table_uint64("interior_offsets"),
+            several.read_table_uint64("interior_offsets"));
+  EXPECT_EQ(one.read_table_uint32("interior_components"),
+            several.read_table_uint32("interior_components"));
+  EXPECT_EQ(one.read_table_double("reference_points"),
+            several.read_table_double("reference_points"));
   EXPECT_EQ(one.read_table_uint8("component_closed"), several.read_table_uint8("component_closed"));
 }
 
@@ -300,21 +307,25 @@ std::vector<Pose> line_poses(const Vec3& from, const Vec3& to, int steps, std::u
 
 // Flies the poses; every collision answer must be the oracle's, and where the oracle sees the
 // containment `kind`, the runtime must name it. Returns how many poses had it.
-int fly_against_oracle(FlyingObject& flying, const ReferenceCollider& oracle, const std::vector<Pose>& poses,
-                       Containment kind, int* contained_in_free_box = nullptr) {
+int fly_against_oracle(FlyingObject& flying, const ReferenceCollider& oracle,
+                       const std::vector<Pose>& poses, Containment kind,
+                       int* contained_in_free_box = nullptr) {
   int contained = 0, wrong = 0;
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const auto expected = oracle.query(poses[i]);
     const QueryResult got = flying.query(poses[i]);
-    if (contained_in_free_box && got.counters.found_free_box && got.containment == kind) ++*contained_in_free_box;
-    const bool oracle_contained =
-        kind == Containment::object_inside_obstacle ? expected.object_inside : expected.obstacle_inside;
+    if (contained_in_free_box && got.counters.found_free_box && got.containment == kind)
+      ++*contained_in_free_box;
+    const bool oracle_contained = kind == Containment::object_inside_obstacle
+                                      ? expected.object_inside
+                                      : expected.obstacle_inside;
     if (oracle_contained) {
       ++contained;
       EXPECT_EQ(got.containment, kind) << "pose " << i;
     }
     if (got.collides != expected.collides && ++wrong <= 5)
-      ADD_FAILURE() << "pose " << i << ": runtime " << got.collides << ", oracle " << expected.collides;
+      ADD_FAILURE() << "pose " << i << ": runtime " << got.collides << ", oracle "
+                    << expected.collides;
   }
   EXPECT_EQ(wrong, 0);
   return contained;
@@ -335,7 +346,9 @@ TEST(Interiors, AFlightEndingInsideAnObstacleCollidesAsTheOracleSays) {
   const auto more = line_poses({0.4, 0.85, 0.4}, {0.9, 0.2, 0.6}, 600, 4);
   poses.insert(poses.end(), more.begin(), more.end());
   int contained_in_free_box = 0;
-  EXPECT_GT(fly_against_oracle(flying, oracle, poses, Containment::object_inside_obstacle, &contained_in_free_box), 100)
+  EXPECT_GT(fly_against_oracle(flying, oracle, poses, Containment::object_inside_obstacle,
+                               &contained_in_free_box),
+            100)
       << "the flight must end inside obstacles";
   // Deep inside, a box around the object holds no triangle: the walk still decides.
   EXPECT_GT(contained_in_free_box, 20);
@@ -352,6 +365,47 @@ TEST(Interiors, AnObstacleInsideAClosedObjectCollides) {
   // Over the small box at 1.2-1.22: the object swallows it whole for part of the way.
   const auto poses = line_poses({1.0, 1.21, 1.21}, {1.4, 1.21, 1.21}, 400, 5);
   EXPECT_GT(fly_against_oracle(flying, oracle, poses, Containment::obstacle_inside_object), 20);
+}
+
+TEST(Interiors, LeavesInsideAClosedObjectAreOnlyNotedAndTheAnswersStayTheOracles) {
+  // A closed box larger than the scene's copies, flown through them over R-tree shards: leaves
+  // deep inside it meet no object triangle, and phase I only notes their triangles for
+  // containment (StepCounters::leaves_inside_object). The answers, and the copies the box
+  // swallows whole, stay the oracle's.
+  const Model& m = model();
+  const fs::path rtree = m.folder / "rtree.tpi";
+  PreprocessOptions options;
+  options.region_triangles = 64;
+  options.precision = StoredPrecision::float64;
+  options.interiors = true;
+  options.shard = ShardChoice::rtree;
+  preprocess({m.folder / "scene.json", m.folder / "boxes.obj", m.folder / "sheet.obj"}, rtree,
+             options);
+  TriangleSoup big;
+  add_box(big, {-0.15, -0.15, -0.15}, {0.15, 0.15, 0.15});
+  const ReferenceCollider oracle(m.environment, big);
+  auto index = std::make_shared<const CollisionIndex>(rtree);
+  FlyingObject flying(index, big);
+  std::uint64_t leaves_inside = 0;
+  int wrong = 0, swallowed = 0;
+  for (const double y : {0.3, 0.5, 0.7}) {
+    for (const Pose& pose : line_poses({0.05, y, 0.5}, {0.95, y, 0.5}, 300, 11)) {
+      const auto expected = oracle.query(pose);
+      const QueryResult got = flying.query(pose);
+      leaves_inside += got.counters.leaves_inside_object;
+      if (expected.obstacle_inside && !expected.surfaces_touch) {
+        ++swallowed;
+        EXPECT_EQ(got.containment, Containment::obstacle_inside_object);
+      }
+      if (got.collides != expected.collides && ++wrong <= 5)
+        ADD_FAILURE() << "y " << y << ": runtime " << got.collides << ", oracle "
+                      << expected.collides;
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(leaves_inside, 0u) << "no leaf lay inside the box: the test no longer reaches the path";
+  RecordProperty("leaves_inside_object", std::to_string(leaves_inside));
+  RecordProperty("swallowed", swallowed);
 }
 
 TEST(Interiors, AnIndexWithoutInteriorsAnswersUnknown) {

@@ -237,7 +237,8 @@ typedef struct tetrapage_query_info {
   uint32_t tets_visited;   /* by the search for the tets overlapping the box */
   uint32_t shards_touched;
   uint32_t shard_misses;   /* shards paged in synchronously */
-  uint64_t candidates;     /* environment triangles meeting the object's box */
+  uint64_t candidates;     /* environment triangles meeting the object's box (except those
+                              of R-tree leaves inside a closed object, apart from its surface) */
   uint64_t triangle_tests; /* triangle pair tests */
   double seconds;          /* locate + search + shards + tests + containment */
   /* Why a query collides without touching surfaces: 0 it does not (or surfaces touch),

@@ -91,8 +91,12 @@ struct StepCounters {
   std::uint32_t shard_misses = 0;    ///< shards paged in synchronously by this step
   /// phase I: shard triangles that meet the object's world box (exactly) and whose boxes, in
   /// the object's frame, meet its own box (a triangle stored in several of the step's shards
-  /// counts once in a double-precision index)
+  /// counts once in a double-precision index), except those of leaves_inside_object
   std::uint64_t candidates = 0;
+  /// phase I: R-tree leaves whose box meets no triangle's box of the closed object and lies
+  /// inside it (or where the object's interior grid cannot tell): their triangles can touch no
+  /// object triangle and are only noted for containment, not counted as candidates
+  std::uint32_t leaves_inside_object = 0;
   /// phase I: shard triangles skipped because another of the step's shards held them already
   /// (a triangle crossing regions; double-precision indexes, whose copies are identical)
   std::uint64_t repeats = 0;

@@ -149,7 +149,9 @@ class Shard {
   /// box rejected about one in twenty of the inner nodes on the benchmark flights, which did
   /// not pay for the tests (a caller that pages shards in asks its filter of a shard before),
   /// unless the object's world box is much looser than its own (see the next).
-  /// A triangle is visited when some leaf or cell holding it is accepted. No state is shared
+  /// A triangle is visited when some leaf or cell holding it is accepted. Each visit of an
+  /// R-tree leaf's triangles follows its own accept call, before any other accept call (a
+  /// caller may keep what it learnt of the leaf for its triangles). No state is shared
   /// between concurrent queries.
   template <class Accept, class Visit>
   void for_each_box_candidate(const geometry::Box& box, Accept&& accept, Visit&& visit) const {
