@@ -25,9 +25,7 @@ class SearchedRegion {
 
   /// The box lies inside the region searched last (no walk nor search needed).
   bool contains(const geometry::Box& box) const {
-    return valid_ && box.lo[0] >= box_.lo[0] && box.lo[1] >= box_.lo[1] &&
-           box.lo[2] >= box_.lo[2] && box.hi[0] <= box_.hi[0] && box.hi[1] <= box_.hi[1] &&
-           box.hi[2] <= box_.hi[2];
+    return valid_ && geometry::box_contains(box_, box);
   }
   /// Walk, box search and pinning for a new searched region around `box`; false when the box
   /// lies outside the mesh. `motion`: how far the object's box centre moved since the last
