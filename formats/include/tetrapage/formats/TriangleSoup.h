@@ -40,15 +40,26 @@ struct BoundingBox {
 };
 
 /// Indexed triangles with a part id per triangle. Parts are the assembly's instances:
-/// part_names[part_of[t]] names the part triangle t belongs to.
+/// part_names[part_of[t]] names the part triangle t belongs to, and part_path(p) says where that
+/// instance sits in the assembly.
 struct TriangleSoup {
   std::vector<Vec3> vertices;
   std::vector<TriangleIndices> triangles;
   std::vector<std::uint32_t> part_of;  ///< one per triangle
+  /// What the file calls each part (a STEP product, an OBJ group, a manifest part); several
+  /// instances of one part share it.
   std::vector<std::string> part_names;
+  /// Each part's instance path, unique in the model: the instances' names from the root down,
+  /// joined by '/' ("rack/board#3/U7"). Empty when every path is the part's name (one file).
+  std::vector<std::string> part_paths;
 
   std::size_t triangle_count() const { return triangles.size(); }
   std::size_t part_count() const { return part_names.size(); }
+  const std::string& part_path(std::size_t part) const {
+    return part_paths.empty() ? part_names[part] : part_paths[part];
+  }
+  /// Adds a part (no triangles yet) and returns its id; an empty path is the name.
+  std::uint32_t add_part(std::string name, std::string path = {});
 
   /// The three corners of triangle t.
   std::array<Vec3, 3> corners(std::size_t t) const {
