@@ -3,8 +3,10 @@
 namespace tetrapage {
 
 std::uint32_t TriangleSoup::add_part(std::string name, std::string path) {
-  if (!path.empty() && part_paths.empty()) part_paths = part_names;
-  if (!part_paths.empty()) part_paths.push_back(path.empty() ? name : std::move(path));
+  // part_paths is either empty (every path is the name) or one per part.
+  const bool paths_held = !part_paths.empty() || part_names.empty();
+  if (!path.empty() && !paths_held) part_paths = part_names;
+  if (!path.empty() || !part_paths.empty()) part_paths.push_back(path.empty() ? name : std::move(path));
   part_names.push_back(std::move(name));
   return static_cast<std::uint32_t>(part_names.size() - 1);
 }
@@ -18,7 +20,7 @@ void TriangleSoup::append(const TriangleSoup& other) {
     triangles.push_back({t[0] + vertex_offset, t[1] + vertex_offset, t[2] + vertex_offset});
   for (auto p : other.part_of) part_of.push_back(p + part_offset);
   if (!other.part_paths.empty() && part_paths.empty()) part_paths = part_names;
-  if (!part_paths.empty())
+  if (!part_paths.empty() || !other.part_paths.empty())
     for (std::size_t p = 0; p < other.part_count(); ++p) part_paths.push_back(other.part_path(p));
   part_names.insert(part_names.end(), other.part_names.begin(), other.part_names.end());
 }
