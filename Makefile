@@ -12,7 +12,9 @@ DEMO_DIR  ?= out/demo
 DEB_PACKAGES := cmake make g++ pkg-config \
   libeigen3-dev libcgal-dev libcgal-demo assimp-testmodels libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
-  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev libdeflate-dev liblz4-dev hdf5-filter-plugin time python3
+  libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev libdeflate-dev liblz4-dev hdf5-filter-plugin time python3 \
+  libocct-data-exchange-dev libocct-ocaf-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
+  libocct-foundation-dev occt-misc freecad-common
 
 # What `make fuzz` needs besides: clang and its libFuzzer and sanitizer runtimes.
 FUZZ_PACKAGES := clang-14 libclang-rt-14-dev

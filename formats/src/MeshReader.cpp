@@ -30,11 +30,14 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   if (extension == ".off") return MeshFormat::off;
   if (extension == ".gltf") return MeshFormat::gltf;
   if (extension == ".glb") return MeshFormat::glb;
+  // Before Assimp, whose IFC importer claims .stp and refuses every other STEP schema.
+  if (extension == ".iges" || extension == ".igs") return MeshFormat::iges;
+  if (is_cad_path(path)) return MeshFormat::step;
   if (extension.size() > 1 && aiIsExtensionSupported(extension.c_str()) == AI_TRUE)
     return MeshFormat::assimp_other;
   throw InputError("'" + path.string() + "': no mesh reader for the extension '" + extension +
-                   "' (readable: .obj, .stl, .ply, .off, .gltf, .glb and the formats Assimp "
-                   "imports)");
+                   "' (readable: .obj, .stl, .ply, .off, .gltf, .glb, STEP (.step, .stp), IGES "
+                   "(.iges, .igs) and the formats Assimp imports)");
 }
 
 bool is_degenerate_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
@@ -104,7 +107,8 @@ std::uint64_t file_size_or_zero(const std::filesystem::path& path) {
 
 }  // namespace
 
-TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report) {
+TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report,
+                       const TessellationOptions& tessellation) {
   const auto start = std::chrono::steady_clock::now();
   ReadReport local;
   ReadReport& out = report != nullptr ? *report : local;
@@ -130,6 +134,9 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report) {
     case MeshFormat::assimp_other:
       soup = read_mesh_with_assimp(path, &out);
       break;
+    case MeshFormat::step:
+    case MeshFormat::iges:
+      return read_cad(path, tessellation, &out);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return soup;

@@ -6,18 +6,20 @@
 
 #include <filesystem>
 
+#include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/TriangleSoup.h"
 
 namespace tetrapage {
 
-enum class MeshFormat { obj, stl, ply, off, gltf, glb, assimp_other };
+enum class MeshFormat { obj, stl, ply, off, gltf, glb, step, iges, assimp_other };
 
 /// The format named by a path's extension (case-insensitive).
 /// @throw InputError if no reader handles that extension.
 MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
 /// Reads one mesh file as one part (named by the file's stem; a glTF file gives one part per
-/// mesh node). Degenerate triangles (repeated indices, or exactly collinear corners) are
+/// mesh node; a STEP or IGES file one per placed shape, tessellated as `tessellation` says:
+/// read_cad). Degenerate triangles (repeated indices, or exactly collinear corners) are
 /// dropped and counted in the report; polygons are fan-triangulated. Vertices are kept as the
 /// file stores them (STL corners are not merged; unused vertices stay). OBJ faces may only
 /// use vertices defined above them (as every OBJ exporter writes them). The report, if
@@ -27,7 +29,8 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 ///        line or element).
 /// @throw InputError for NaN/infinite coordinates, indices out of range, or a mesh with no
 ///        triangle left (message names the file, line or element, and the value).
-TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr);
+TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr,
+                       const TessellationOptions& tessellation = {});
 
 /// Reads any file through Assimp (aiProcess_Triangulate), even one of the formats that have a
 /// reader of our own: the comparison path for benchmarks and tests. Walks the node hierarchy

@@ -95,6 +95,14 @@ struct ReadReport {
   double seconds = 0.0;
   /// "ascii", "binary", "binary_little_endian", "binary_big_endian"; empty through Assimp.
   std::string encoding;
+  /// The unit of the coordinates the reader returned, empty when the file does not say.
+  std::string length_unit;
+  /// CAD input: the largest chordal deviation the tessellation was asked for, in the
+  /// coordinates returned (0: the file held triangles, used as they are).
+  double tessellation_deflection = 0.0;
+  /// CAD input: the shapes left out because they failed to tessellate (skip_bad_parts), each
+  /// "instance path: reason".
+  std::vector<std::string> skipped_parts;
 };
 
 }  // namespace tetrapage

@@ -1,0 +1,281 @@
+// The STEP and IGES reader against OpenCASCADE's own exact measures of the B-rep (bounding box
+// and area computed from the surfaces, not from any triangulation), and against assemblies
+// this test writes itself through OCCT's XCAF writer, whose placements and names it knows.
+
+#include <BRepBndLib.hxx>
+#include <BRepGProp.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <Bnd_Box.hxx>
+#include <GProp_GProps.hxx>
+#include <IGESControl_Reader.hxx>
+#include <Interface_Static.hxx>
+#include <STEPCAFControl_Writer.hxx>
+#include <STEPControl_Reader.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
+#include <gp_Quaternion.hxx>
+#include <map>
+#include <set>
+
+#include "TestSupport.h"
+#include "tetrapage/formats/CadReader.h"
+
+namespace tetrapage {
+namespace {
+
+const std::filesystem::path kOcctData = "/usr/share/opencascade/data";
+const std::filesystem::path kFreecadIdf = "/usr/share/freecad/Mod/Idf/Idflibs";
+
+TopoDS_Shape exact_shape(const std::filesystem::path& path) {
+  const std::string extension = path.extension().string();
+  if (extension == ".iges" || extension == ".igs") {
+    IGESControl_Reader reader;
+    EXPECT_EQ(reader.ReadFile(path.string().c_str()), IFSelect_RetDone);
+    reader.TransferRoots();
+    return reader.OneShape();
+  }
+  STEPControl_Reader reader;
+  EXPECT_EQ(reader.ReadFile(path.string().c_str()), IFSelect_RetDone);
+  reader.TransferRoots();
+  return reader.OneShape();
+}
+
+double soup_area(const TriangleSoup& soup) {
+  double area = 0;
+  for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
+    const auto [a, b, c] = soup.corners(t);
+    const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    area += 0.5 * std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]);
+  }
+  return area;
+}
+
+// Every edge (a pair of corner positions) used an even number of times: a closed surface.
+bool every_edge_paired(const TriangleSoup& soup) {
+  std::map<std::pair<Vec3, Vec3>, int> uses;
+  for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
+    const auto corners = soup.corners(t);
+    for (int k = 0; k < 3; ++k) {
+      Vec3 p = corners[k], q = corners[(k + 1) % 3];
+      if (q < p) std::swap(p, q);
+      ++uses[{p, q}];
+    }
+  }
+  return std::all_of(uses.begin(), uses.end(), [](const auto& use) { return use.second % 2 == 0; });
+}
+
+struct SampleCase {
+  std::filesystem::path path;
+  bool closed;
+};
+
+class CadSamples : public ::testing::TestWithParam<SampleCase> {};
+
+TEST_P(CadSamples, TessellationLiesWithinTheDeflectionOfTheExactShape) {
+  const auto& sample = GetParam();
+  if (!std::filesystem::exists(sample.path)) GTEST_SKIP() << sample.path << " not installed";
+  ReadReport report;
+  const TriangleSoup soup = read_cad(sample.path, {}, &report);
+  const TopoDS_Shape shape = exact_shape(sample.path);
+  Bnd_Box exact;
+  BRepBndLib::AddOptimal(shape, exact, Standard_False, Standard_False);
+  double lo[3], hi[3];
+  exact.Get(lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]);
+  const double deflection = report.tessellation_deflection;
+  ASSERT_GT(deflection, 0);
+  EXPECT_EQ(report.length_unit, "mm");
+  const BoundingBox box = soup.bounds();
+  const double diagonal = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  // Vertices lie on the surfaces (up to OCCT's tolerances), and no face is farther than the
+  // deflection from the triangles.
+  const double slack = 1e-6 * diagonal;
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_GE(box.lo[a], lo[a] - slack) << sample.path;
+    EXPECT_LE(box.hi[a], hi[a] + slack) << sample.path;
+    EXPECT_LE(box.lo[a], lo[a] + deflection + slack) << sample.path;
+    EXPECT_GE(box.hi[a], hi[a] - deflection - slack) << sample.path;
+  }
+  GProp_GProps properties;
+  BRepGProp::SurfaceProperties(shape, properties);
+  EXPECT_NEAR(soup_area(soup), properties.Mass(), 0.01 * properties.Mass()) << sample.path;
+  if (sample.closed) {
+    EXPECT_TRUE(every_edge_paired(soup)) << sample.path;
+  }
+  EXPECT_EQ(soup.part_of.size(), soup.triangles.size());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    OcctAndFreecadSamples, CadSamples,
+    ::testing::Values(SampleCase{kOcctData / "step" / "screw.step", true},
+                      SampleCase{kOcctData / "step" / "linkrods.step", true},
+                      SampleCase{kOcctData / "iges" / "bearing.iges", false},
+                      SampleCase{kFreecadIdf / "SOT23.stp", false},
+                      SampleCase{kFreecadIdf / "0603_SMD.stp", false}));
+
+TEST(CadReader, AFinerDeflectionGivesMoreTrianglesCloserToTheArea) {
+  const auto path = kOcctData / "step" / "screw.step";
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed";
+  GProp_GProps properties;
+  BRepGProp::SurfaceProperties(exact_shape(path), properties);
+  TessellationOptions coarse, fine;
+  coarse.deflection = 0.01;
+  fine.deflection = 0.0005;
+  ReadReport coarse_report, fine_report;
+  const TriangleSoup coarse_soup = read_cad(path, coarse, &coarse_report);
+  const TriangleSoup fine_soup = read_cad(path, fine, &fine_report);
+  EXPECT_GT(fine_soup.triangle_count(), coarse_soup.triangle_count());
+  EXPECT_LT(fine_report.tessellation_deflection, coarse_report.tessellation_deflection);
+  EXPECT_LT(std::fabs(soup_area(fine_soup) - properties.Mass()), std::fabs(soup_area(coarse_soup) - properties.Mass()));
+  // An absolute deflection is used as given.
+  TessellationOptions absolute;
+  absolute.relative_deflection = false;
+  absolute.deflection = 0.05;
+  ReadReport absolute_report;
+  read_cad(path, absolute, &absolute_report);
+  EXPECT_DOUBLE_EQ(absolute_report.tessellation_deflection, 0.05);
+}
+
+// An assembly written by OCCT's XCAF writer: a rack of two boards, each with a box part "U7"
+// placed twice and a cylinder "J1" once, in the given STEP unit.
+struct WrittenAssembly {
+  std::filesystem::path path;
+  std::vector<gp_Trsf> box_placements;  // world placements of the box instances, in mm
+};
+
+TDF_Label add_named(const Handle(XCAFDoc_ShapeTool)& tool, const TopoDS_Shape& shape, const char* name) {
+  const TDF_Label label = tool->AddShape(shape, Standard_False);
+  TDataStd_Name::Set(label, name);
+  return label;
+}
+
+gp_Trsf placement(double angle, double x, double y, double z) {
+  gp_Trsf t;
+  t.SetRotation(gp_Quaternion(gp_Vec(0, 0, 1), angle));
+  t.SetTranslationPart(gp_Vec(x, y, z));
+  return t;
+}
+
+WrittenAssembly write_rack(const std::filesystem::path& folder, const char* unit) {
+  Handle(TDocStd_Document) document;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
+  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(document->Main());
+  const TDF_Label box = add_named(tool, BRepPrimAPI_MakeBox(10, 20, 5).Shape(), "CHIP_10x20");
+  const TDF_Label cylinder = add_named(tool, BRepPrimAPI_MakeCylinder(3, 8).Shape(), "CONN");
+  const TDF_Label board = tool->NewShape();
+  TDataStd_Name::Set(board, "board");
+  const gp_Trsf u7_a = placement(0, 5, 5, 0), u7_b = placement(M_PI / 2, 60, 5, 0);
+  TDataStd_Name::Set(tool->AddComponent(board, box, TopLoc_Location(u7_a)), "U7");
+  TDataStd_Name::Set(tool->AddComponent(board, box, TopLoc_Location(u7_b)), "U7");
+  TDataStd_Name::Set(tool->AddComponent(board, cylinder, TopLoc_Location(placement(0, 30, 40, 0))), "J1");
+  tool->UpdateAssemblies();
+  const TDF_Label rack = tool->NewShape();
+  TDataStd_Name::Set(rack, "rack");
+  const gp_Trsf board_0 = placement(0, 0, 0, 0), board_1 = placement(0, 0, 0, 100);
+  TDataStd_Name::Set(tool->AddComponent(rack, board, TopLoc_Location(board_0)), "board_0");
+  TDataStd_Name::Set(tool->AddComponent(rack, board, TopLoc_Location(board_1)), "board_1");
+  tool->UpdateAssemblies();
+  Interface_Static::SetCVal("write.step.unit", unit);
+  STEPCAFControl_Writer writer;
+  WrittenAssembly written{folder / (std::string("rack_") + unit + ".step"), {}};
+  EXPECT_TRUE(writer.Transfer(document, STEPControl_AsIs));
+  EXPECT_EQ(writer.Write(written.path.string().c_str()), IFSelect_RetDone);
+  Interface_Static::SetCVal("write.step.unit", "MM");
+  XCAFApp_Application::GetApplication()->Close(document);
+  for (const gp_Trsf& b : {board_0, board_1})
+    for (const gp_Trsf& u : {u7_a, u7_b}) written.box_placements.push_back(b * u);
+  return written;
+}
+
+TEST(CadReader, AnAssemblyGivesEveryInstanceWithItsNamePathAndPlacement) {
+  const auto folder = test::scratch_folder("rack");
+  const WrittenAssembly written = write_rack(folder, "MM");
+  ReadReport report;
+  const TriangleSoup soup = read_cad(written.path, {}, &report);
+  ASSERT_EQ(soup.part_count(), 6u);  // two boards of three instances
+  std::set<std::string> paths;
+  std::vector<std::uint32_t> boxes;
+  for (std::uint32_t p = 0; p < soup.part_count(); ++p) {
+    paths.insert(soup.part_path(p));
+    if (soup.part_names[p] == "CHIP_10x20") boxes.push_back(p);
+  }
+  EXPECT_EQ(paths, (std::set<std::string>{"rack/board_0/U7#0", "rack/board_0/U7#1", "rack/board_0/J1",
+                                          "rack/board_1/U7#0", "rack/board_1/U7#1", "rack/board_1/J1"}));
+  ASSERT_EQ(boxes.size(), 4u);
+  // Each box instance's vertices are the box's corners moved by the placement we wrote.
+  for (std::size_t k = 0; k < boxes.size(); ++k) {
+    std::set<std::array<long, 3>> expected, got;
+    for (double x : {0.0, 10.0})
+      for (double y : {0.0, 20.0})
+        for (double z : {0.0, 5.0}) {
+          const gp_Pnt p = gp_Pnt(x, y, z).Transformed(written.box_placements[k]);
+          expected.insert({std::lround(p.X() * 1e6), std::lround(p.Y() * 1e6), std::lround(p.Z() * 1e6)});
+        }
+    for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
+      if (soup.part_of[t] != boxes[k]) continue;
+      for (const Vec3& c : soup.corners(t))
+        got.insert({std::lround(c[0] * 1e6), std::lround(c[1] * 1e6), std::lround(c[2] * 1e6)});
+    }
+    EXPECT_EQ(got, expected) << soup.part_path(boxes[k]);
+  }
+}
+
+TEST(CadReader, UnitsOfTheFileComeBackAsMillimetres) {
+  const auto folder = test::scratch_folder("units");
+  const TriangleSoup reference = read_cad(write_rack(folder, "MM").path);
+  for (const char* unit : {"INCH", "M"}) {
+    ReadReport report;
+    const TriangleSoup soup = read_cad(write_rack(folder, unit).path, {}, &report);
+    EXPECT_EQ(report.length_unit, "mm");
+    ASSERT_EQ(soup.triangle_count(), reference.triangle_count()) << unit;
+    const BoundingBox a = soup.bounds(), b = reference.bounds();
+    for (int axis = 0; axis < 3; ++axis) {
+      EXPECT_NEAR(a.lo[axis], b.lo[axis], 1e-6) << unit;
+      EXPECT_NEAR(a.hi[axis], b.hi[axis], 1e-6) << unit;
+    }
+  }
+}
+
+TEST(CadReader, DamagedFilesAreRefusedNamingTheFile) {
+  const auto folder = test::scratch_folder("damaged");
+  const auto screw = kOcctData / "step" / "screw.step";
+  if (!std::filesystem::exists(screw)) GTEST_SKIP() << screw << " not installed";
+  std::ifstream in(screw, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"truncated_header.step", bytes.substr(0, 200)},
+      {"garbage.step", std::string(4096, '\x7f')},
+      {"empty.stp", ""},
+      {"not_iges.igs", "this is not an IGES file\n"},
+      {"data_only.step", "ISO-10303-21;\nHEADER;\nENDSEC;\nDATA;\nENDSEC;\nEND-ISO-10303-21;\n"},
+  };
+  for (const auto& [name, content] : cases) {
+    const auto path = folder / name;
+    test::write_file(path, content);
+    try {
+      read_cad(path);
+      ADD_FAILURE() << name << " was read";
+    } catch (const Error& error) {
+      EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
+    }
+  }
+  // Cut in the middle of its entities: refused, or read as what survived (never a crash).
+  const auto half = folder / "half.step";
+  test::write_file(half, bytes.substr(0, bytes.size() / 2));
+  try {
+    const TriangleSoup soup = read_cad(half);
+    EXPECT_GT(soup.triangle_count(), 0u);
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find(half.string()), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(read_cad(folder / "missing.step"), IoError);
+  TessellationOptions bad;
+  bad.deflection = 0;
+  EXPECT_THROW(read_cad(screw, bad), InputError);
+}
+
+}  // namespace
+}  // namespace tetrapage
