@@ -379,6 +379,14 @@ struct IndexReader::Impl {
     h.source = read_string_attribute(g, schema::attribute::source);
     h.build_report_json = read_string_attribute(g, schema::attribute::build_report);
     h.created_by = read_string_attribute(g, schema::attribute::created_by);
+    if (has_attribute(g, schema::attribute::length_unit))
+      h.length_unit = read_string_attribute(g, schema::attribute::length_unit);
+    if (has_attribute(g, schema::attribute::tessellation_deflection)) {
+      h.tessellation_deflection = read_number_attribute<double>(g, schema::attribute::tessellation_deflection, 1)[0];
+      if (!(h.tessellation_deflection >= 0) || !std::isfinite(h.tessellation_deflection))
+        format_error("root attribute 'tessellation_deflection' is " + number_text(h.tessellation_deflection) +
+                     ", expected a finite number >= 0");
+    }
   }
 
   /// The shapes of the mesh's datasets (read_mesh reads them).
@@ -589,6 +597,12 @@ struct IndexReader::Impl {
   }
 
   // ---- attributes -------------------------------------------------------------------------
+
+  bool has_attribute(hid_t object, const char* name) const {
+    const htri_t exists = H5Aexists(object, name);
+    if (exists < 0) hdf5_format_error("cannot look up root attribute '" + std::string(name) + "'");
+    return exists > 0;
+  }
 
   AttributeHandle open_attribute(hid_t object, const char* name) const {
     const htri_t exists = H5Aexists(object, name);

@@ -483,6 +483,9 @@ std::uint64_t IndexWriter::commit(const IndexHeader& header) {
     w.write_string_attribute(r, schema::attribute::source, header.source);
     w.write_string_attribute(r, schema::attribute::build_report, header.build_report_json);
     w.write_string_attribute(r, schema::attribute::created_by, created_by_text());
+    w.write_string_attribute(r, schema::attribute::length_unit, header.length_unit);
+    w.write_number_attribute<double>(r, schema::attribute::tessellation_deflection,
+                                     header.tessellation_deflection);
     if (!root.close()) w.fail("the root group (closing it)");
   }
   if (!w.shard_data.close()) w.fail("dataset /shards/data (closing it)");

@@ -312,11 +312,11 @@ Manifest read_manifest(const std::filesystem::path& path) {
 }
 
 TriangleSoup load_assembly(const Manifest& manifest, std::vector<ReadReport>* reports,
-                           Progress& progress) {
+                           Progress& progress, const TessellationOptions& tessellation) {
   TriangleSoup assembly;
   for (const ManifestPart& part : manifest.parts) {
     ReadReport report;
-    const TriangleSoup source = read_mesh(part.file, &report);
+    const TriangleSoup source = read_mesh(part.file, &report, tessellation);
     const std::string stem = part.file.stem().string();
     for (std::size_t k = 0; k < part.instances.size(); ++k) {
       const Transform& m = part.instances[k];
@@ -379,10 +379,11 @@ std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& i
   return pieces;
 }
 
-TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports) {
+TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports,
+                              const TessellationOptions& tessellation) {
   if (!piece.manifest) {
     ReadReport report;
-    TriangleSoup soup = read_mesh(piece.input, &report);
+    TriangleSoup soup = read_mesh(piece.input, &report, tessellation);
     if (reports != nullptr) reports->push_back(std::move(report));
     return soup;
   }
@@ -390,19 +391,20 @@ TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* 
   single.path = piece.manifest->path;
   single.units = piece.manifest->units;
   single.parts = {piece.manifest->parts.at(piece.part)};
-  return load_assembly(single, reports);
+  return load_assembly(single, reports, Progress::silent(), tessellation);
 }
 
 TriangleSoup load_inputs(const std::vector<std::filesystem::path>& inputs,
-                         std::vector<ReadReport>* reports, Progress& progress) {
+                         std::vector<ReadReport>* reports, Progress& progress,
+                         const TessellationOptions& tessellation) {
   TriangleSoup all;
   for (const auto& input : inputs) {
     TriangleSoup soup;
     if (is_manifest_path(input)) {
-      soup = load_assembly(read_manifest(input), reports, progress);
+      soup = load_assembly(read_manifest(input), reports, progress, tessellation);
     } else {
       ReadReport report;
-      soup = read_mesh(input, &report);
+      soup = read_mesh(input, &report, tessellation);
       if (reports != nullptr) reports->push_back(std::move(report));
       progress.advance(1);
     }

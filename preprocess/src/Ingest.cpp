@@ -25,7 +25,12 @@ namespace {
 struct LoadedSoup {
   std::uint64_t degenerate_dropped = 0;
   std::uint64_t files_read = 0;
+  std::string length_unit;  // of its coordinates: the manifest's, or what the reader said
+  std::string file;         // what the unit came from, for messages
+  std::vector<std::string> skipped_parts;
+  double tessellation_deflection = 0;
   TriangleSoup soup;
+  std::vector<std::uint64_t> part_triangles;
   std::vector<Vec3> centroids;  // per triangle
   std::vector<SurfaceComponent> components;
 };
@@ -44,15 +49,25 @@ void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& pie
       " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
 }
 
-LoadedSoup load_soup(const InputPiece& piece) {
+LoadedSoup load_soup(const InputPiece& piece, const TessellationOptions& tessellation) {
   LoadedSoup loaded;
   std::vector<ReadReport> reports;
-  loaded.soup = load_input_piece(piece, &reports);
+  loaded.soup = load_input_piece(piece, &reports, tessellation);
   for (const auto& report : reports) {
     loaded.degenerate_dropped += report.degenerate_dropped;
     ++loaded.files_read;
+    loaded.tessellation_deflection = std::max(loaded.tessellation_deflection, report.tessellation_deflection);
+    for (const std::string& skipped : report.skipped_parts) loaded.skipped_parts.push_back(report.path + ": " + skipped);
+  }
+  loaded.file = piece.input.string();
+  if (piece.manifest) {
+    loaded.length_unit = piece.manifest->units;
+  } else if (!reports.empty()) {
+    loaded.length_unit = reports.front().length_unit;
   }
   TriangleSoup& soup = loaded.soup;
+  loaded.part_triangles.assign(std::max<std::size_t>(soup.part_count(), 1), 0);
+  for (const std::uint32_t part : soup.part_of) ++loaded.part_triangles[part];
   check_coordinate_magnitudes(soup, piece);
   SurfaceComponents found = find_surface_components(soup);
   soup.part_of = std::move(found.component_of);
@@ -90,16 +105,50 @@ std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memo
                                  std::max(fewest, most));
 }
 
+// The model's unit is the one its inputs state; inputs that state different units cannot be
+// one model without a manifest to convert them.
+void note_length_unit(IngestedModel& model, const LoadedSoup& loaded) {
+  if (loaded.length_unit.empty()) return;
+  if (model.length_unit.empty()) {
+    model.length_unit = loaded.length_unit;
+    model.length_unit_source = loaded.file;
+  } else if (model.length_unit != loaded.length_unit) {
+    throw InputError(loaded.file + " is in " + loaded.length_unit + " but " + model.length_unit_source + " in " +
+                     model.length_unit + ": place both in one manifest, which converts each file to its units");
+  }
+}
+
+// --unit names the unit of inputs that state none; it may not contradict one that does.
+void settle_length_unit(IngestedModel& model, const std::string& option) {
+  if (option.empty()) return;
+  metres_per_unit(option);  // an unknown unit is an InputError naming it
+  if (model.length_unit.empty()) {
+    model.length_unit = option;
+  } else if (model.length_unit != option) {
+    throw InputError("--unit " + option + ", but " + model.length_unit_source + " is in " + model.length_unit);
+  }
+}
+
 // Appends a loaded soup's parts, components and triangles to the model; the soups are
 // spilled once they hold more than a quarter of the budget.
 void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptions& options,
                  const std::filesystem::path& spill_folder, PreprocessSummary& summary) {
   summary.degenerate_dropped += loaded.degenerate_dropped;
+  summary.skipped_parts.insert(summary.skipped_parts.end(), loaded.skipped_parts.begin(), loaded.skipped_parts.end());
   summary.files_read += loaded.files_read;
   const auto part_offset = std::uint32_t(model.part_names.size());
-  for (const auto& name : loaded.soup.part_names) model.part_names.push_back(name);
-  if (loaded.soup.part_names.empty())
+  for (std::size_t p = 0; p < loaded.soup.part_count(); ++p) {
+    model.part_names.push_back(loaded.soup.part_names[p]);
+    model.part_paths.push_back(loaded.soup.part_path(p));
+  }
+  if (loaded.soup.part_names.empty()) {
     model.part_names.push_back("part" + std::to_string(part_offset));
+    model.part_paths.push_back(model.part_names.back());
+  }
+  model.part_triangles.insert(model.part_triangles.end(), loaded.part_triangles.begin(),
+                              loaded.part_triangles.end());
+  model.tessellation_deflection = std::max(model.tessellation_deflection, loaded.tessellation_deflection);
+  note_length_unit(model, loaded);
   if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
     throw InputError("the inputs hold more than 2^32 - 2 connected components");
   const auto component_offset = std::uint32_t(model.components.size());
@@ -154,7 +203,7 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
                                              std::size_t(tbb::this_task_arena::max_concurrency()));
   produce_in_parallel_consume_in_order(
       jobs.size(), in_flight,
-      [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j])); },
+      [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j], options.tessellation)); },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         // In input order (ids, part numbers and the sample do not depend on the threads).
         append_soup(model, *loaded, options, spill_folder, summary);
@@ -164,6 +213,9 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
   progress.finish();
   summary.triangles_read = model.triangle_count;
   summary.parts = model.part_names.size();
+  settle_length_unit(model, options.length_unit);
+  summary.length_unit = model.length_unit;
+  summary.tessellation_deflection = model.tessellation_deflection;
   summary.components = model.components.size();
   if (model.triangle_count == 0)
     throw InputError("the inputs hold no triangle (after dropping degenerate ones)");

@@ -24,6 +24,11 @@ struct IngestedModel {
   std::uint64_t triangle_count = 0;
   BoundingBox bounds;
   std::vector<std::string> part_names;
+  std::vector<std::string> part_paths;           // one per part (the name when a file has none)
+  std::vector<std::uint64_t> part_triangles;     // triangles kept, per part
+  std::string length_unit;                       // the model's unit, "" when no input says
+  std::string length_unit_source;                // the input that said it
+  double tessellation_deflection = 0;            // the largest of the CAD inputs', model units
   // The surfaces' connected components, model-wide (the ids the records and shards carry).
   std::vector<SurfaceComponent> components;
 };

@@ -169,6 +169,9 @@ std::string PreprocessSummary::to_json() const {
   j["output"] = output.string();
   j["files_read"] = files_read;
   j["parts"] = parts;
+  j["length_unit"] = length_unit;
+  j["tessellation_deflection"] = tessellation_deflection;
+  j["skipped_parts"] = skipped_parts;
   j["triangles_read"] = triangles_read;
   j["degenerate_dropped"] = degenerate_dropped;
   j["region_triangles"] = region_triangles;
@@ -219,6 +222,11 @@ std::string PreprocessSummary::to_text() const {
                 (unsigned long long)triangles_read, (unsigned long long)degenerate_dropped,
                 (unsigned long long)files_read, (unsigned long long)parts);
   text << line;
+  if (!length_unit.empty()) text << "model unit " << length_unit << "\n";
+  if (tessellation_deflection > 0)
+    text << "STEP/IGES tessellated within a deflection of " << tessellation_deflection << " "
+         << (length_unit.empty() ? "model units" : length_unit) << "\n";
+  for (const std::string& skipped : skipped_parts) text << "skipped part " << skipped << "\n";
   std::snprintf(
       line, sizeof line,
       "regions %llu (empty %llu; %llu triangles per region asked), shards: grid %llu, rtree %llu; "

@@ -21,6 +21,7 @@ struct ReadyShard {
   std::uint64_t payload_bytes = 0;
   EncodedShard encoded;
   BoundingBox bounds;
+  std::uint64_t lowest_id = 0, highest_id = 0;
   std::uint32_t tet = 0;
 };
 
@@ -50,6 +51,9 @@ std::shared_ptr<ReadyShard> build_encoded_shard(const BucketCopies& copies, std:
   for (const geometry::Triangle& t : triangles)
     for (const auto& p : t) ready->bounds.extend(p);
   ready->tet = copies.tet(first);
+  const auto [lowest, highest] = std::minmax_element(ids.begin(), ids.end());
+  ready->lowest_id = *lowest;
+  ready->highest_id = *highest;
   const ShardTriangles region{triangles, ids, parts};
   if (options.shard == ShardChoice::automatic) {
     ShardCostReport costs =
@@ -88,6 +92,7 @@ void append_shard(const ReadyShard& ready, IndexWriter& writer, ShardTables& tab
   tables.shard_tet.push_back(ready.tet);
   tables.shard_kind.push_back(std::uint8_t(built.kind));
   tables.shard_triangles.push_back(built.triangle_count);
+  tables.shard_id_ranges.insert(tables.shard_id_ranges.end(), {ready.lowest_id, ready.highest_id});
   summary.stored_triangles += built.triangle_count;
   summary.shard_payload_bytes += ready.payload_bytes;
   summary.max_rounding_distance =

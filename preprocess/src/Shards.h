@@ -23,6 +23,7 @@ struct ShardTables {
   std::vector<std::uint8_t> shard_kind;
   std::vector<double>
       shard_bounds;  ///< 6 per shard: lo xyz, hi xyz, enclosing the stored triangles
+  std::vector<std::uint64_t> shard_id_ranges;  ///< 2 per shard: its smallest and largest id
 };
 
 /// Empties the buckets one at a time into shards (a tet's shard holds its copies; `tet_rank`:

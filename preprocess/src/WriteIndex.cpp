@@ -37,6 +37,27 @@ void write_shard_tables(IndexWriter& writer, const ShardTables& shards) {
   writer.write_table(schema::table::shard_triangles,
                      std::span<const std::uint32_t>(shards.shard_triangles));
   writer.write_table(schema::table::shard_bounds, std::span<const double>(shards.shard_bounds));
+  writer.write_table(schema::table::shard_id_ranges, std::span<const std::uint64_t>(shards.shard_id_ranges));
+}
+
+// Strings as a table of their bytes and one of offsets (n + 1, the last the bytes' length).
+void write_strings(IndexWriter& writer, std::string_view offsets_table, std::string_view bytes_table,
+                   const std::vector<std::string>& strings) {
+  std::vector<std::uint64_t> offsets{0};
+  std::vector<std::uint8_t> bytes;
+  for (const std::string& s : strings) {
+    bytes.insert(bytes.end(), s.begin(), s.end());
+    offsets.push_back(bytes.size());
+  }
+  writer.write_table(offsets_table, std::span<const std::uint64_t>(offsets));
+  writer.write_table(bytes_table, std::span<const std::uint8_t>(bytes));
+}
+
+// The parts (docs/FORMAT.md): each one's name, instance path and triangle count.
+void write_parts(IndexWriter& writer, const IngestedModel& model) {
+  write_strings(writer, schema::table::part_name_offsets, schema::table::part_name_bytes, model.part_names);
+  write_strings(writer, schema::table::part_path_offsets, schema::table::part_path_bytes, model.part_paths);
+  writer.write_table(schema::table::part_triangles, std::span<const std::uint64_t>(model.part_triangles));
 }
 
 void write_interiors(IndexWriter& writer, const Interiors& interiors) {
@@ -56,6 +77,7 @@ void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& sh
   writer.write_mesh(mesh);
   write_shard_tables(writer, shards);
   write_components(writer, model.components);
+  write_parts(writer, model);
   if (interiors.stored) write_interiors(writer, interiors);
   IndexHeader header;
   header.precision = summary.precision;
@@ -66,6 +88,8 @@ void write_index(IndexWriter& writer, const TetMesh& mesh, const ShardTables& sh
   header.max_rounding_distance = summary.max_rounding_distance;
   header.bounds = model.bounds;
   header.source = source;
+  header.length_unit = model.length_unit;
+  header.tessellation_deflection = model.tessellation_deflection;
   header.created_by = "tetrapage preprocess";
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   header.build_report_json = summary.to_json();

@@ -114,11 +114,19 @@ int main(int argc, char** argv) {
     printf("pose %ld: %s", k, collides ? "collides" : "free");
     if (collides) printf(", %zu contacts", count);
     printf("  (at %g %g %g)\n", pose[0], pose[1], pose[2]);
-    for (c = 0; c < written; ++c)
-      printf("  environment part %u triangle %llu touches object triangle %u\n",
-             (unsigned)contacts[c].environment_part,
+    for (c = 0; c < written; ++c) {
+      char path[256];
+      size_t length = 0;
+      if (tetrapage_index_part_path(index, contacts[c].environment_part, path, sizeof path, &length) !=
+          TETRAPAGE_OK) {
+        fprintf(stderr, "error: pose %ld: %s\n", k, tetrapage_last_error());
+        goto done;
+      }
+      printf("  environment part %u (%s) triangle %llu touches object triangle %u\n",
+             (unsigned)contacts[c].environment_part, path,
              (unsigned long long)contacts[c].environment_triangle,
              (unsigned)contacts[c].object_triangle);
+    }
     if (written < count) printf("  ... %zu more\n", count - written);
   }
   printf("collisions: %ld of %ld poses\n", collisions, pose_count);

@@ -59,8 +59,9 @@ int main(int argc, char** argv) {
       std::printf("  (at %g %g %g)\n", poses[k].translation[0], poses[k].translation[1],
                   poses[k].translation[2]);
       for (std::size_t c = 0; c < result.contacts.size() && c < 5; ++c)
-        std::printf("  environment part %u triangle %llu touches object triangle %u\n",
+        std::printf("  environment part %u (%s) triangle %llu touches object triangle %u\n",
                     result.contacts[c].environment_part,
+                    index->parts().path(result.contacts[c].environment_part).c_str(),
                     static_cast<unsigned long long>(result.contacts[c].environment_triangle),
                     result.contacts[c].object_triangle);
       if (result.contacts.size() > 5) std::printf("  ... %zu more\n", result.contacts.size() - 5);

@@ -296,6 +296,77 @@ tetrapage_status tetrapage_index_bounds(const tetrapage_index* index, double lo[
   });
 }
 
+namespace {
+
+// The C API's string convention (tetrapage.h): copied, cut to fit, NUL-terminated, and the
+// whole length returned.
+void copy_string(const std::string& text, char* buffer, size_t capacity, size_t* length) {
+  require(length, "length");
+  if (capacity > 0) {
+    require(buffer, "buffer");
+    const size_t copied = std::min(capacity - 1, text.size());
+    std::memcpy(buffer, text.data(), copied);
+    buffer[copied] = '\0';
+  }
+  *length = text.size();
+}
+
+std::uint32_t checked_part(const tetrapage::CollisionIndex& index, uint32_t part) {
+  if (part >= index.parts().count())
+    throw tetrapage::InputError(index.path().string() + ": no part " + std::to_string(part) + " (the model has " +
+                                std::to_string(index.parts().count()) + ")");
+  return part;
+}
+
+}  // namespace
+
+tetrapage_status tetrapage_index_part_count(const tetrapage_index* index, uint32_t* count) {
+  return guarded(__func__, [&] {
+    const auto state = index_state(index);
+    require(count, "count");
+    *count = uint32_t(state->index->parts().count());
+  });
+}
+
+tetrapage_status tetrapage_index_part_name(const tetrapage_index* index, uint32_t part, char* buffer,
+                                           size_t capacity, size_t* length) {
+  return guarded(__func__, [&] {
+    const auto state = index_state(index);
+    copy_string(state->index->parts().name(checked_part(*state->index, part)), buffer, capacity, length);
+  });
+}
+
+tetrapage_status tetrapage_index_part_path(const tetrapage_index* index, uint32_t part, char* buffer,
+                                           size_t capacity, size_t* length) {
+  return guarded(__func__, [&] {
+    const auto state = index_state(index);
+    copy_string(state->index->parts().path(checked_part(*state->index, part)), buffer, capacity, length);
+  });
+}
+
+tetrapage_status tetrapage_index_length_unit(const tetrapage_index* index, char* buffer, size_t capacity,
+                                             size_t* length) {
+  return guarded(__func__, [&] {
+    const auto state = index_state(index);
+    copy_string(state->index->header().length_unit, buffer, capacity, length);
+  });
+}
+
+tetrapage_status tetrapage_index_triangle(const tetrapage_index* index, uint64_t id, double corners[9],
+                                          uint32_t* part) {
+  return guarded(__func__, [&] {
+    const auto state = index_state(index);
+    require(corners, "corners");
+    require(part, "part");
+    const auto stored = state->index->stored_triangle(id);
+    if (!stored)
+      throw tetrapage::InputError(state->index->path().string() + ": no stored triangle has id " + std::to_string(id));
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) corners[3 * k + a] = stored->corners[k][a];
+    *part = state->index->component_part(stored->component);
+  });
+}
+
 tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* vertices,
                                          size_t vertex_count, const uint32_t* triangles,
                                          size_t triangle_count, tetrapage_object** object) {

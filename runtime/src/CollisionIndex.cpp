@@ -51,6 +51,10 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   }
   check_budget_fits_shards();
   read_components(where);
+  const std::uint32_t listed_parts =
+      component_part_.empty() ? 0 : *std::max_element(component_part_.begin(), component_part_.end()) + 1;
+  parts_ = IndexParts::read(reader_, listed_parts);
+  read_shard_id_ranges(where);
   stores_input_coordinates_ = header().precision != "float";
   read_interiors(where);
   ShardCacheOptions cache_options;
@@ -151,6 +155,27 @@ void CollisionIndex::read_interiors(const std::string& where) {
                         " holds a non-finite point for tet " + std::to_string(t));
   }
   interior_offsets_ = std::move(offsets);
+}
+
+void CollisionIndex::read_shard_id_ranges(const std::string& where) {
+  if (!reader_.has_table(schema::table::shard_id_ranges)) return;  // an index from before the table
+  shard_id_ranges_ = reader_.read_table_uint64(schema::table::shard_id_ranges);
+  if (shard_id_ranges_.size() != 2 * std::size_t(shard_count()))
+    throw FormatError(where + schema::table_path(schema::table::shard_id_ranges) + " has " +
+                      std::to_string(shard_id_ranges_.size()) + " values for " + std::to_string(shard_count()) +
+                      " shards (2 each)");
+}
+
+std::optional<CollisionIndex::StoredTriangle> CollisionIndex::stored_triangle(std::uint64_t id) const {
+  if (id >= header().input_triangles) return std::nullopt;
+  for (std::uint32_t shard = 0; shard < shard_count(); ++shard) {
+    if (!shard_id_ranges_.empty() && (id < shard_id_ranges_[2 * shard] || id > shard_id_ranges_[2 * shard + 1]))
+      continue;
+    const auto pin = cache_->acquire(shard);
+    for (std::uint32_t local = 0; local < pin->triangle_count(); ++local)
+      if (pin->triangle_id(local) == id) return StoredTriangle{pin->triangle(local), shard, pin->component_id(local)};
+  }
+  return std::nullopt;
 }
 
 void CollisionIndex::preload(const std::function<void(std::uint32_t)>& progress) const {

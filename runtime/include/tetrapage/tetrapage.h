@@ -110,6 +110,40 @@ tetrapage_status tetrapage_close(tetrapage_index* index);
    Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument), TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_index_bounds(const tetrapage_index* index, double lo[3], double hi[3]);
 
+/* The number of parts of the indexed model (a contact's environment_part is below it).
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_index_part_count(const tetrapage_index* index, uint32_t* count);
+
+/* Strings are returned the same way: the text (UTF-8) is copied into `buffer` of `capacity`
+   bytes, cut to fit and always NUL-terminated when capacity > 0, and its whole length
+   (without the NUL) goes to *length, so that a caller can ask again with a larger buffer.
+   `buffer` may be null when capacity is 0. */
+
+/* What the model's file calls part `part` ("CONN_2x5"; "part K" in an index from before part
+   names were recorded).
+   Errors: TETRAPAGE_ERROR_INPUT (no such part), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_index_part_name(const tetrapage_index* index, uint32_t part, char* buffer,
+                                           size_t capacity, size_t* length);
+
+/* Where part `part` sits in the assembly: its instance path ("rack/board_3/U7").
+   Errors: as tetrapage_index_part_name. */
+tetrapage_status tetrapage_index_part_path(const tetrapage_index* index, uint32_t part, char* buffer,
+                                           size_t capacity, size_t* length);
+
+/* The model's length unit ("mm", "m", "in", ...; "" when the index records none).
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_index_length_unit(const tetrapage_index* index, char* buffer, size_t capacity,
+                                             size_t* length);
+
+/* A stored triangle by its model-wide id (a contact's environment_triangle): its corners as
+   stored, x0 y0 z0 x1 y1 z1 x2 y2 z2, and its part. Pages in the shards that may hold it.
+   Errors: TETRAPAGE_ERROR_INPUT (no stored triangle has that id), TETRAPAGE_ERROR_IO and
+           TETRAPAGE_ERROR_FORMAT (paging a shard in), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_index_triangle(const tetrapage_index* index, uint64_t id, double corners[9],
+                                          uint32_t* part);
+
 /* ------------------------------------------------------------------------------------------ */
 /* Flying objects                                                                              */
 
@@ -127,7 +161,8 @@ tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* v
                                          size_t vertex_count, const uint32_t* triangles,
                                          size_t triangle_count, tetrapage_object** object);
 
-/* Creates an object from a mesh file (OBJ, PLY, OFF, STL, glTF/GLB, ...; all parts merged).
+/* Creates an object from a mesh file (OBJ, PLY, OFF, STL, glTF/GLB, ...; STEP and IGES
+   tessellated with the default deflection, in millimetres; all parts merged).
    Errors: TETRAPAGE_ERROR_IO, TETRAPAGE_ERROR_FORMAT, TETRAPAGE_ERROR_INPUT (as the mesh
            readers: the message names the file, the line or element and the value; as
            tetrapage_object_create for the mesh read), TETRAPAGE_ERROR_INVALID_ARGUMENT,

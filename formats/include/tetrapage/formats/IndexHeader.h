@@ -36,6 +36,11 @@ struct IndexHeader {
   std::string build_report_json;
   /// Program that wrote the file; the writer fills it in, the reader reports it.
   std::string created_by;
+  /// The model's length unit ("mm", "m", "in", ...), empty when no input said.
+  std::string length_unit;
+  /// The largest chordal deviation asked of the tessellation of CAD inputs, in the model's
+  /// unit; 0 when every input held triangles.
+  double tessellation_deflection = 0;
 };
 
 /// One line saying how an index stores coordinates and what that means for its answers (for

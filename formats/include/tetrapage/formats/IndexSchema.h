@@ -39,6 +39,13 @@ inline constexpr std::string_view interior_components = "interior_components";
 inline constexpr std::string_view component_part = "component_part";
 inline constexpr std::string_view component_closed = "component_closed";
 inline constexpr std::string_view component_bounds = "component_bounds";
+// Optional (indexes written before them lack them): parts by name, and shards by triangle id.
+inline constexpr std::string_view part_name_offsets = "part_name_offsets";
+inline constexpr std::string_view part_name_bytes = "part_name_bytes";
+inline constexpr std::string_view part_path_offsets = "part_path_offsets";
+inline constexpr std::string_view part_path_bytes = "part_path_bytes";
+inline constexpr std::string_view part_triangles = "part_triangles";
+inline constexpr std::string_view shard_id_ranges = "shard_id_ranges";
 }  // namespace table
 
 namespace attribute {
@@ -54,6 +61,9 @@ inline constexpr const char* bounds = "bounds";
 inline constexpr const char* source = "source";
 inline constexpr const char* build_report = "build_report";
 inline constexpr const char* created_by = "created_by";
+// Optional: absent in indexes written before them.
+inline constexpr const char* length_unit = "length_unit";
+inline constexpr const char* tessellation_deflection = "tessellation_deflection";
 }  // namespace attribute
 
 /// A table's dataset path, as messages name it: "/tables/NAME".

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/formats/TriangleSoup.h"
 
@@ -66,7 +67,8 @@ Manifest read_manifest(const std::filesystem::path& path);
 /// @throw as read_mesh (IoError, FormatError, InputError); InputError if a placement
 ///        overflows or the assembly has more than 2^32-1 vertices.
 TriangleSoup load_assembly(const Manifest& manifest, std::vector<ReadReport>* reports = nullptr,
-                           Progress& progress = Progress::silent());
+                           Progress& progress = Progress::silent(),
+                           const TessellationOptions& tessellation = {});
 
 /// One piece of a list of inputs, loadable on its own: a mesh file, or one part of a manifest
 /// (with its instances placed). Loading the pieces in order and appending them gives the soup
@@ -82,13 +84,15 @@ struct InputPiece {
 std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& inputs);
 
 /// Loads one piece; appends one report per file read. @throw as read_mesh and load_assembly.
-TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports = nullptr);
+TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports = nullptr,
+                              const TessellationOptions& tessellation = {});
 
 /// Loads inputs that are mesh files or manifests (.json), in order, into one soup (parts
 /// appended in order, indices shifted).
 /// @throw as read_mesh, read_manifest and load_assembly.
 TriangleSoup load_inputs(const std::vector<std::filesystem::path>& inputs,
                          std::vector<ReadReport>* reports = nullptr,
-                         Progress& progress = Progress::silent());
+                         Progress& progress = Progress::silent(),
+                         const TessellationOptions& tessellation = {});
 
 }  // namespace tetrapage

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/runtime/ShardKind.h"
 
@@ -50,6 +51,11 @@ struct PreprocessOptions {
   double query_extent = 0;
   /// Progress bars (or lines) on stderr.
   bool progress = false;
+  /// The length unit of inputs that state none (plain meshes): "m", "mm", "in", ...; STEP and
+  /// IGES files are read in millimetres, and a manifest states its units.
+  std::string length_unit;
+  /// How STEP and IGES inputs are tessellated.
+  TessellationOptions tessellation;
   /// Where spill files go; empty: next to the output.
   std::filesystem::path spill_folder;
   /// Spill the ingested triangles and the binned copies to disk whatever the budget (tests
@@ -79,6 +85,9 @@ struct PreprocessSummary {
   std::filesystem::path output;
   std::uint64_t files_read = 0;
   std::uint64_t parts = 0;
+  std::string length_unit;                 ///< the model's, "" when no input said
+  double tessellation_deflection = 0;      ///< of STEP/IGES inputs, in the model's unit
+  std::vector<std::string> skipped_parts;  ///< STEP/IGES shapes left out (--skip-bad-parts)
   std::uint64_t triangles_read = 0;        ///< kept triangles, as read and placed
   std::uint64_t degenerate_dropped = 0;    ///< by the readers and the placement
   std::uint64_t region_triangles = 0;      ///< the target used (the option, or the automatic one)

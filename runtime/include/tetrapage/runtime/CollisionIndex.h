@@ -9,9 +9,11 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "tetrapage/formats/IndexParts.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/TetMesh.h"
 #include "tetrapage/runtime/Shard.h"
@@ -98,6 +100,23 @@ class CollisionIndex {
   }
   const geometry::Box& component_bounds(std::uint32_t component) const { return component_bounds_[component]; }
 
+  /// The model's parts: names, instance paths and triangle counts (a contact's
+  /// environment_part indexes them).
+  const IndexParts& parts() const { return parts_; }
+
+  /// A stored triangle, found by its model-wide id (a contact's environment_triangle): its
+  /// corners as stored, its shard and its connected component.
+  struct StoredTriangle {
+    geometry::Triangle corners;
+    std::uint32_t shard = 0;
+    std::uint32_t component = 0;
+  };
+  /// Pages in the shards whose id range holds `id` (every shard for an index that does not
+  /// record the ranges) until one holds it; nullopt when none does (a degenerate triangle the
+  /// reader dropped has no id, so ids beyond input_triangles are never found).
+  /// @throw what the shard cache throws (I/O and checksum errors naming the index).
+  std::optional<StoredTriangle> stored_triangle(std::uint64_t id) const;
+
   /// Whether the index stores the interiors of closed components (preprocess --interiors on):
   /// each tet's reference point classified against them (ObstacleInterior.h).
   bool has_interiors() const { return !interior_offsets_.empty(); }
@@ -122,6 +141,7 @@ class CollisionIndex {
   void check_budget_fits_shards() const;
   void read_components(const std::string& where);
   void read_interiors(const std::string& where);
+  void read_shard_id_ranges(const std::string& where);
 
   IndexReader reader_;
   CollisionIndexOptions options_;
@@ -136,6 +156,8 @@ class CollisionIndex {
   std::vector<std::uint32_t> component_part_;
   std::vector<std::uint8_t> component_closed_;
   std::vector<geometry::Box> component_bounds_;
+  IndexParts parts_;
+  std::vector<std::uint64_t> shard_id_ranges_;  // 2 per shard, or empty
   std::vector<geometry::Point> reference_points_;
   std::vector<std::uint64_t> interior_offsets_;
   std::vector<std::uint32_t> interior_components_;
