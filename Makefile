@@ -19,7 +19,7 @@ DEB_PACKAGES := cmake make g++ pkg-config \
 # What `make fuzz` needs besides: clang and its libFuzzer and sanitizer runtimes.
 FUZZ_PACKAGES := clang-14 libclang-rt-14-dev
 
-.PHONY: deps fuzz-deps configure build test sanitize sanitize-threads fuzz demo bench bench-study bench-peers bench-peers-demo bench-accuracy bench-scale clean format
+.PHONY: deps fuzz-deps configure build test sanitize sanitize-threads fuzz demo bench bench-study bench-peers bench-peers-demo bench-accuracy bench-deflection bench-scale clean format
 
 # $(call install_missing,NAME,PACKAGES): installs those not present (sudo only when not root).
 define install_missing
@@ -152,6 +152,12 @@ bench-accuracy: build
 	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
 	$(BUILD)/bench/tetrapage_bench_accuracy --scene $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
 	  --steps 2000 --out $(BUILD)/bench-results/accuracy
+
+# Tessellation as a knob of the accuracy trade: a STEP environment and object at a few
+# deflections against the oracle over the finest one (docs/BENCHMARKS.md, "Speed against
+# accuracy"); deflection.md in $(BUILD)/bench-results/deflection.
+bench-deflection: build
+	BUILD=$(BUILD) bench/scripts/deflection_series.sh $(BUILD)/bench-results/deflection
 
 format:
 	find formats runtime preprocess study tools tests bench -name '*.h' -o -name '*.cpp' -o -name '*.c' | xargs clang-format -i

@@ -1,10 +1,16 @@
 // `tetrapage fly`: fly a pose file through an index with the paged runtime.
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <future>
+#include <optional>
 
 #include "Commands.h"
+#include "TessellationArguments.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/tools/ContactFile.h"
 #include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
@@ -20,7 +26,10 @@ namespace tetrapage::cli {
 namespace {
 
 struct FlyArguments {
-  std::filesystem::path index, object, path, answers, check, report;
+  std::filesystem::path index, object, path, answers, check, report, contacts;
+  std::string object_unit;
+  double object_scale = 1.0;
+  TessellationArguments tessellation;
   std::string memory = "256M";
   std::string accuracy = "exact";
   bool all_contacts = false;
@@ -31,8 +40,36 @@ struct FlyArguments {
   bool preload = false;
 };
 
+// The flying object: a mesh, a STEP or IGES file, or a manifest, in the index's unit (times
+// --object-scale) when both say their unit.
+TriangleSoup load_object(const FlyArguments& args) {
+  std::vector<ReadReport> reports;
+  TriangleSoup object = load_inputs({args.object}, &reports, Progress::silent(), args.tessellation.options(false));
+  std::string unit = is_manifest_path(args.object) ? read_manifest(args.object).units
+                                                   : (reports.empty() ? std::string() : reports.front().length_unit);
+  if (!args.object_unit.empty()) {
+    metres_per_unit(args.object_unit);  // an unknown unit is an InputError naming it
+    if (!unit.empty() && unit != args.object_unit)
+      throw InputError("--object-unit " + args.object_unit + ", but " + args.object.string() + " is in " + unit);
+    unit = args.object_unit;
+  }
+  const std::string index_unit = IndexReader(args.index).header().length_unit;
+  double scale = args.object_scale;
+  if (!unit.empty() && !index_unit.empty()) {
+    scale *= metres_per_unit(unit) / metres_per_unit(index_unit);
+  } else if (unit != index_unit) {
+    std::fprintf(stderr, "fly: the object is in %s and the index in %s: the object is taken in the index's units\n",
+                 unit.empty() ? "unstated units" : unit.c_str(), index_unit.empty() ? "unstated units" : index_unit.c_str());
+  }
+  if (!(scale > 0) || !std::isfinite(scale)) throw InputError("--object-scale must be a positive number");
+  if (scale != 1.0)
+    for (Vec3& v : object.vertices)
+      for (double& c : v) c *= scale;
+  return object;
+}
+
 void run_fly(const FlyArguments& args) {
-  check_outputs_writable({args.answers, args.report}, {args.index, args.object, args.path, args.check});
+  check_outputs_writable({args.answers, args.report, args.contacts}, {args.index, args.object, args.path, args.check});
   QueryOptions query_options;
   query_options.accuracy = geometry::parse_accuracy(args.accuracy);
   query_options.mode = args.all_contacts ? QueryMode::all_contacts : QueryMode::first_hit;
@@ -43,7 +80,7 @@ void run_fly(const FlyArguments& args) {
   index_options.shard_arena = !args.no_shard_arena;
   index_options.spin_before_sleep = std::chrono::microseconds(args.spin_before_sleep_us);
 
-  const TriangleSoup object_mesh = read_mesh(args.object);
+  const TriangleSoup object_mesh = load_object(args);
   const std::vector<Pose> poses = read_poses(args.path);
   AnswerCheck check(args.check, poses.size(), "fly");
   const auto open_start = std::chrono::steady_clock::now();
@@ -51,6 +88,8 @@ void run_fly(const FlyArguments& args) {
   auto model = std::async(std::launch::async, [&] { return std::make_shared<const ObjectModel>(object_mesh); });
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   FlyingObject object(index, model.get());
+  std::optional<ContactFile> contact_file;
+  if (!args.contacts.empty()) contact_file.emplace(args.contacts, *index, object.object());
   double preload_seconds = 0;
   if (args.preload) {
     if (index->total_shard_bytes() > index_options.memory_budget_bytes)
@@ -87,6 +126,7 @@ void run_fly(const FlyArguments& args) {
     tets_visited += result.counters.tets_visited;
     shards_touched += result.counters.shards_touched;
     check.record(i, answers[i]);
+    if (contact_file) contact_file->write_step(i, poses[i], result);
     progress.advance();
   }
   progress.finish();
@@ -115,6 +155,10 @@ void run_fly(const FlyArguments& args) {
               double(tets_visited) / steps, double(shards_touched) / steps, double(candidates) / steps,
               double(triangle_tests) / steps, format_byte_size(peak_resident_bytes()).c_str());
   if (!args.answers.empty()) write_answers(args.answers, answers);
+  if (contact_file) {
+    contact_file->commit();
+    std::printf("contacts: %llu rows written to %s\n", (unsigned long long)contact_file->rows(), args.contacts.c_str());
+  }
   if (!args.report.empty())
     write_report(args.report, {{"command", "fly"},
                                {"index", args.index.string()},
@@ -133,6 +177,7 @@ void run_fly(const FlyArguments& args) {
                                {"max_rounding_distance", index->header().max_rounding_distance},
                                {"answers_exact_for", index->header().precision == "float" ? "rounded model" : "input"},
                                {"contacts", contacts},
+                               {"contact_rows_written", contact_file ? contact_file->rows() : 0},
                                {"steps_outside_model", outside},
                                {"steps_per_second", steps_per_second},
                                {"latency_us", latency.to_json()},
@@ -169,7 +214,20 @@ void add_fly_command(CLI::App& app) {
   command->add_option("index", args->index, "Index file (.tpi) from `tetrapage preprocess`")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--object", args->object, "Flying object mesh")->required()->check(CLI::ExistingFile);
+  command->add_option("--object", args->object,
+                      "Flying object: a mesh, a STEP or IGES file (read in mm), or a manifest (.json); converted "
+                      "to the index's unit when both state theirs")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--object-unit", args->object_unit,
+                      "Unit of an object file that states none (plain meshes): m, cm, mm, um, in or ft");
+  command->add_option("--object-scale", args->object_scale, "Scale applied to the object after the unit conversion")
+      ->capture_default_str();
+  args->tessellation.add_to(command);
+  command->add_option("--contacts", args->contacts,
+                      "Write the contacts as CSV: step, kind, environment part (id, name, instance path), "
+                      "environment and object triangle, one point where they meet (the first contact of a "
+                      "step; every pair with --all-contacts)");
   command->add_option("--path", args->path, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz)")->required()->check(CLI::ExistingFile);
   command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")
       ->capture_default_str()

@@ -10,9 +10,11 @@
 #include <thread>
 
 #include "Commands.h"
+#include "TessellationArguments.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/IndexParts.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/IndexSchema.h"
 #include "tetrapage/formats/Manifest.h"
@@ -44,6 +46,8 @@ struct PreprocessArguments {
   double query_extent = 0;
   std::string interiors = "on";
   bool accept_undecided = false;
+  std::string unit;
+  TessellationArguments tessellation;
   std::filesystem::path report;
 };
 
@@ -61,6 +65,8 @@ void run_preprocess(const PreprocessArguments& args) {
   options.progress = true;
   options.interiors = args.interiors == "on";
   options.accept_undecided = args.accept_undecided;
+  options.length_unit = args.unit;
+  options.tessellation = args.tessellation.options(true);
   const PreprocessSummary summary = preprocess(args.inputs, args.output, options);
   std::fputs(summary.to_text().c_str(), stdout);
   if (!args.report.empty()) write_report(args.report, nlohmann::json::parse(summary.to_json()));
@@ -71,7 +77,35 @@ struct InspectArguments {
   std::filesystem::path report;
   std::uint64_t stabbing_segments = 10'000;
   std::uint64_t stabbing_seed = 1;
+  std::size_t parts_listed = 20;
 };
+
+// The model's unit, its tessellation and its parts (the first `listed`, or all for 0).
+nlohmann::json part_figures(const IndexReader& reader, std::size_t listed) {
+  const IndexHeader& header = reader.header();
+  const std::string unit = header.length_unit.empty() ? "model units (the index records no unit)" : header.length_unit;
+  std::printf("unit: %s\n", unit.c_str());
+  if (header.tessellation_deflection > 0)
+    std::printf("tessellation: STEP/IGES shapes within a deflection of %g %s of their surfaces\n",
+                header.tessellation_deflection, unit.c_str());
+  const auto component_part = reader.read_table_uint32(schema::table::component_part);
+  std::size_t listed_parts = 0;
+  for (const auto p : component_part) listed_parts = std::max<std::size_t>(listed_parts, std::size_t(p) + 1);
+  const IndexParts parts = IndexParts::read(reader, listed_parts);
+  std::printf("parts: %zu%s\n", parts.count(), parts.named() ? "" : " (unnamed: the index predates part names)");
+  const std::size_t shown = listed == 0 ? parts.count() : std::min(listed, parts.count());
+  nlohmann::json list = nlohmann::json::array();
+  for (std::uint32_t p = 0; p < shown; ++p) {
+    std::printf("  part %u: %s (%s), %llu triangles\n", p, parts.path(p).c_str(), parts.name(p).c_str(),
+                (unsigned long long)parts.triangles(p));
+    list.push_back({{"part", p}, {"path", parts.path(p)}, {"name", parts.name(p)}, {"triangles", parts.triangles(p)}});
+  }
+  if (shown < parts.count()) std::printf("  ... %zu more (--parts 0 lists every part)\n", parts.count() - shown);
+  return {{"length_unit", header.length_unit},
+          {"tessellation_deflection", header.tessellation_deflection},
+          {"parts", parts.count()},
+          {"part_list", list}};
+}
 
 struct InteriorFigures {
   std::string text;
@@ -148,6 +182,7 @@ void run_inspect(const InspectArguments& args) {
               format_byte_size(stored).c_str(), double(stored) / triangles, format_byte_size(kind_bytes[0]).c_str(),
               format_byte_size(kind_bytes[1]).c_str(), format_byte_size(decoded).c_str(),
               double(decoded) / triangles);
+  const nlohmann::json part_json = part_figures(reader, args.parts_listed);
   const InteriorFigures interiors = component_figures(reader, mesh.tet_count());
   std::printf("%s\n", interiors.text.c_str());
   std::optional<StabbingNumbers> stabbing;
@@ -184,7 +219,8 @@ void run_inspect(const InspectArguments& args) {
                           {"shard_stored_bytes", stored},
                           {"shard_decoded_bytes", decoded},
                           {"max_rounding_distance", header.max_rounding_distance},
-                          {"components", interiors.json}};
+                          {"components", interiors.json},
+                          {"model", part_json}};
     if (stabbing) {
       report["stabbing_segments"] = stabbing->segments;
       report["stabbing_number_walk"] = stabbing->walk;
@@ -351,7 +387,7 @@ void add_index_commands(CLI::App& app) {
       "Cut an assembly into a coarse tetrahedral mesh of regions, each with a grid or R-tree\n"
       "shard of the triangles it meets (exact test), and write one HDF5 index.\n"
       "The index is written under a temporary name and renamed only when complete.");
-  command->add_option("inputs", pre->inputs, "Mesh files (obj, stl, ply, off, gltf, glb, ...) or manifests (.json)")
+  command->add_option("inputs", pre->inputs, "Mesh files (obj, stl, ply, off, gltf, glb, ...), STEP or IGES files, or manifests (.json)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("-o,--output", pre->output, "The index file to write (e.g. model.tpi)")->required();
@@ -396,6 +432,10 @@ void add_index_commands(CLI::App& app) {
   command->add_flag("--accept-undecided", pre->accept_undecided,
                    "Store a region whose inside cannot be decided (every reference point tried lies on a\n"
                    "closed surface) as undecided, where containment is then unknown, instead of failing");
+  command->add_option("--unit", pre->unit,
+                      "Length unit of inputs that state none (plain meshes): m, cm, mm, um, in or ft; STEP "
+                      "and IGES are read in mm and a manifest states its units; recorded in the index");
+  pre->tessellation.add_to(command);
   command->add_option("--report", pre->report, "Write the summary as JSON");
   command->callback([pre] { run_preprocess(*pre); });
 
@@ -403,6 +443,7 @@ void add_index_commands(CLI::App& app) {
   auto* inspect_command = app.add_subcommand("inspect", "Show what an index holds and where its bytes go");
   inspect_command->add_option("index", inspect->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
   inspect_command->add_option("--report", inspect->report, "Write the figures as JSON");
+  inspect_command->add_option("--parts", inspect->parts_listed, "Parts listed (0: every part)")->capture_default_str();
   inspect_command
       ->add_option("--stabbing-segments", inspect->stabbing_segments,
                    "Random segments for the stabbing number, counted by the walk and by Embree (0: skip)")

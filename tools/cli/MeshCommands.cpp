@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "Commands.h"
+#include "TessellationArguments.h"
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/Error.h"
@@ -19,12 +20,14 @@ namespace {
 struct InfoArguments {
   std::vector<std::filesystem::path> files;
   std::filesystem::path report;
+  TessellationArguments tessellation;
 };
 
 struct ConvertArguments {
   std::filesystem::path input;
   std::filesystem::path output;
   std::filesystem::path report;
+  TessellationArguments tessellation;
 };
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -48,6 +51,9 @@ nlohmann::json report_json(const ReadReport& report) {
           {"triangles_read", report.triangles_read},
           {"degenerate_dropped", report.degenerate_dropped},
           {"polygons_triangulated", report.polygons_triangulated},
+          {"length_unit", report.length_unit},
+          {"tessellation_deflection", report.tessellation_deflection},
+          {"skipped_parts", report.skipped_parts},
           {"seconds", report.seconds},
           {"megabytes_per_second", megabytes_per_second(report.bytes, report.seconds)}};
 }
@@ -65,7 +71,7 @@ void run_info(const InfoArguments& args) {
     std::vector<ReadReport> reports;
     const auto start = std::chrono::steady_clock::now();
     const bool is_manifest = path.extension() == ".json" || path.extension() == ".JSON";
-    const TriangleSoup soup = load_inputs({path}, &reports);
+    const TriangleSoup soup = load_inputs({path}, &reports, Progress::silent(), args.tessellation.options(true));
     const double seconds = seconds_since(start);
     std::uint64_t bytes = 0, degenerate = 0, polygons = 0;
     for (const auto& report : reports) {
@@ -86,6 +92,13 @@ void run_info(const InfoArguments& args) {
         soup.part_count(), static_cast<unsigned long long>(degenerate),
         static_cast<unsigned long long>(polygons));
     print_bounds(box);
+    for (const auto& report : reports) {
+      if (!report.length_unit.empty()) std::printf("  %s: unit %s", report.path.c_str(), report.length_unit.c_str());
+      if (report.tessellation_deflection > 0)
+        std::printf(", tessellated within %g %s", report.tessellation_deflection, report.length_unit.c_str());
+      if (!report.length_unit.empty()) std::printf("\n");
+      for (const auto& skipped : report.skipped_parts) std::printf("  skipped part %s\n", skipped.c_str());
+    }
     std::printf("  read %.3f s, %.1f MB/s (%llu bytes%s)\n", seconds,
                 megabytes_per_second(bytes, seconds), static_cast<unsigned long long>(bytes),
                 is_manifest ? (", " + std::to_string(reports.size()) + " files").c_str() : "");
@@ -126,7 +139,7 @@ void run_convert(const ConvertArguments& args) {
   const auto start = std::chrono::steady_clock::now();
   std::vector<ReadReport> reports;
   Progress reading("reading", 0);
-  const TriangleSoup soup = load_inputs({args.input}, &reports, reading);
+  const TriangleSoup soup = load_inputs({args.input}, &reports, reading, args.tessellation.options(true));
   reading.finish();
   const double read_seconds = seconds_since(start);
   const auto write_start = std::chrono::steady_clock::now();
@@ -173,10 +186,11 @@ void add_mesh_commands(CLI::App& app) {
       "Readable: .obj, .stl (ASCII or binary), .ply (ASCII or binary), .off (our own readers,\n"
       "double precision), .gltf, .glb and the other formats Assimp imports (single precision),\n"
       "and assembly manifests (.json).");
-  info->add_option("files", info_args->files, "Mesh files or manifests (.json)")
+  info->add_option("files", info_args->files, "Mesh files, STEP or IGES files, or manifests (.json)")
       ->required()
       ->check(CLI::ExistingFile);
   info->add_option("--report", info_args->report, "Also write the figures as JSON");
+  info_args->tessellation.add_to(info);
   info->callback([info_args] { run_info(*info_args); });
 
   auto convert_args = std::make_shared<ConvertArguments>();
@@ -186,11 +200,12 @@ void add_mesh_commands(CLI::App& app) {
       "the output's extension: .obj, .ply (binary, double), .off (exact doubles), .stl\n"
       "(binary, float), .gltf/.glb (float; one node per part). The output appears only when\n"
       "complete.");
-  convert->add_option("input", convert_args->input, "Mesh file or manifest (.json)")
+  convert->add_option("input", convert_args->input, "Mesh file, STEP or IGES file, or manifest (.json)")
       ->required()
       ->check(CLI::ExistingFile);
   convert->add_option("-o,--output", convert_args->output, "Mesh file to write")->required();
   convert->add_option("--report", convert_args->report, "Also write the figures as JSON");
+  convert_args->tessellation.add_to(convert);
   convert->callback([convert_args] { run_convert(*convert_args); });
 }
 

@@ -1,0 +1,22 @@
+#pragma once
+// The options of every command that reads STEP or IGES: how B-rep shapes become triangles.
+
+#include <CLI/CLI.hpp>
+#include <string>
+
+#include "tetrapage/formats/CadReader.h"
+
+namespace tetrapage::cli {
+
+struct TessellationArguments {
+  std::string deflection = "0.1%";
+  double angular_deflection = TessellationOptions{}.angular_deflection;
+  bool skip_bad_parts = false;
+
+  /// Adds --deflection, --angular-deflection and --skip-bad-parts to `command`.
+  void add_to(CLI::App* command);
+  /// @throw InputError for a deflection that is not a positive length or percentage.
+  TessellationOptions options(bool show_progress) const;
+};
+
+}  // namespace tetrapage::cli

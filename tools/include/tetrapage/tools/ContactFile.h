@@ -1,0 +1,55 @@
+#pragma once
+/// @file ContactFile.h
+/// The contacts of a flight as CSV (`fly --contacts`), one row per contact:
+///   step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z
+/// kind is "surface" (an environment triangle meets an object triangle; x,y,z is one point of
+/// their intersection, computed exactly and rounded to double), "solid" (the object was
+/// checked as a solid: hull, box or swept; no object triangle nor point), "object_inside" or
+/// "obstacle_inside" (containment: part is the containing or contained environment part, and
+/// the triangle and point fields are empty). Names are quoted as CSV quotes them.
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/TemporaryFiles.h"
+#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/FlyingObject.h"
+
+namespace tetrapage {
+
+/// One point where two triangles meet (both closed), computed with CGAL's exact constructions
+/// and rounded to double; nullopt when they do not meet.
+std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b);
+
+class ContactFile {
+ public:
+  /// Opens `path` under a temporary name. @throw IoError.
+  ContactFile(const std::filesystem::path& path, const CollisionIndex& index, const TriangleSoup& object);
+  /// Removes the temporary unless commit() ran.
+  ~ContactFile();
+  ContactFile(const ContactFile&) = delete;
+  ContactFile& operator=(const ContactFile&) = delete;
+
+  /// The rows of one step's answer. @throw IoError; what the index throws paging a shard in.
+  void write_step(std::uint64_t step, const Pose& pose, const QueryResult& result);
+  std::uint64_t rows() const { return rows_; }
+  /// Flushes and renames the file into place. @throw IoError.
+  void commit();
+
+ private:
+  void write_row(std::uint64_t step, const char* kind, std::uint32_t part, const std::string& triangle_fields);
+
+  std::filesystem::path path_, temporary_;
+  std::optional<TemporaryFileGuard> guard_;
+  std::ofstream out_;
+  const CollisionIndex& index_;
+  const TriangleSoup& object_;
+  std::uint64_t rows_ = 0;
+  bool committed_ = false;
+};
+
+}  // namespace tetrapage
