@@ -10,8 +10,8 @@
 #   bench/scripts/deflection_series.sh [OUT_DIR]   (default: $BUILD/bench-results/deflection)
 #
 # Environment variables (defaults in brackets):
-#   ENV [occt-misc's linkrods.step]  OBJECT [occt-misc's screw.step]
-#   DEFLECTIONS [1% 0.3% 0.1% 0.03%]  REFERENCE [0.01%]  STEPS [5000]  REPEATS [3]
+#   ENV [occt-misc's linkrods.step]  OBJECT [occt-misc's bearing.iges]
+#   DEFLECTIONS [1% 0.3% 0.1% 0.05%]  REFERENCE [0.02%]  STEPS [5000]  REPEATS [3]
 #   DISPLACEMENT [1 % of the environment's diagonal]  BUILD [build]
 #   TETRAPAGE [$BUILD/tools/tetrapage]
 set -euo pipefail
@@ -19,9 +19,9 @@ BUILD=${BUILD:-build}
 OUT=${1:-$BUILD/bench-results/deflection}
 TETRAPAGE=${TETRAPAGE:-$BUILD/tools/tetrapage}
 ENV=${ENV:-/usr/share/opencascade/data/step/linkrods.step}
-OBJECT=${OBJECT:-/usr/share/opencascade/data/step/screw.step}
-DEFLECTIONS=${DEFLECTIONS:-"1% 0.3% 0.1% 0.03%"}
-REFERENCE=${REFERENCE:-0.01%}
+OBJECT=${OBJECT:-/usr/share/opencascade/data/iges/bearing.iges}
+DEFLECTIONS=${DEFLECTIONS:-"1% 0.3% 0.1% 0.05%"}
+REFERENCE=${REFERENCE:-0.02%}
 STEPS=${STEPS:-5000}
 REPEATS=${REPEATS:-3}
 mkdir -p "$OUT"
