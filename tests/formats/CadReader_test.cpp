@@ -4,6 +4,9 @@
 
 #include <BRepBndLib.hxx>
 #include <BRepGProp.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <Bnd_Box.hxx>
@@ -237,6 +240,46 @@ TEST(CadReader, UnitsOfTheFileComeBackAsMillimetres) {
       EXPECT_NEAR(a.hi[axis], b.hi[axis], 1e-6) << unit;
     }
   }
+}
+
+// A file with a shape the mesher cannot tessellate (a face bounded by an open wire) beside a
+// good one.
+std::filesystem::path write_with_bad_part(const std::filesystem::path& folder) {
+  Handle(TDocStd_Document) document;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
+  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(document->Main());
+  add_named(tool, BRepPrimAPI_MakeBox(10, 20, 5).Shape(), "GOOD");
+  BRepBuilderAPI_MakeWire open_wire;
+  open_wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(10, 0, 0)).Edge());
+  open_wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(10, 0, 0), gp_Pnt(10, 10, 0)).Edge());
+  add_named(tool, BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ()), open_wire.Wire(), Standard_True).Shape(),
+            "OPEN_FACE");
+  STEPCAFControl_Writer writer;
+  const auto path = folder / "bad_part.step";
+  EXPECT_TRUE(writer.Transfer(document, STEPControl_AsIs));
+  EXPECT_EQ(writer.Write(path.string().c_str()), IFSelect_RetDone);
+  XCAFApp_Application::GetApplication()->Close(document);
+  return path;
+}
+
+TEST(CadReader, APartThatFailsToTessellateIsNamedOrSkipped) {
+  const auto path = write_with_bad_part(test::scratch_folder("bad"));
+  try {
+    read_cad(path);
+    ADD_FAILURE() << "read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("OPEN_FACE"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("--skip-bad-parts"), std::string::npos) << error.what();
+  }
+  TessellationOptions skip;
+  skip.skip_bad_parts = true;
+  ReadReport report;
+  const TriangleSoup soup = read_cad(path, skip, &report);
+  ASSERT_EQ(report.skipped_parts.size(), 1u);
+  EXPECT_NE(report.skipped_parts[0].find("OPEN_FACE"), std::string::npos) << report.skipped_parts[0];
+  ASSERT_EQ(soup.part_count(), 1u);
+  EXPECT_EQ(soup.part_names[0], "GOOD");
+  EXPECT_EQ(soup.triangle_count(), 12u);  // a box's six faces, two triangles each
 }
 
 TEST(CadReader, DamagedFilesAreRefusedNamingTheFile) {
