@@ -97,7 +97,7 @@ for R in $(seq 1 "$REPEATS"); do
       F=$D/rack-insert.csv; [ $flight = insert ] || F=$D/billiard-$STEPS.csv
       P="$D/runs/$flight-$R"; mkdir -p "$D/runs"
       say "pass $R/$REPEATS, $name, $flight: tetrapage fly in memory and paged under $budget bytes (load $(loadavg))"
-      timed "$P.mem.log" "$P.mem.time" "$TETRAPAGE" fly "$D/rack.tpi" --object "$PLUG" --path "$F" --preload \
+      timed "$P.mem.log" "$P.mem.time" "$TETRAPAGE" fly "$D/rack.tpi" --object "$PLUG" --path "$F" --preload --memory 1T \
         --answers "$P.mem.answers.csv" --report "$P.mem.json"
       timed "$P.paged.log" "$P.paged.time" "$TETRAPAGE" fly "$D/rack.tpi" --object "$PLUG" --path "$F" \
         --memory "$budget" --check "$P.mem.answers.csv" --report "$P.paged.json"

@@ -8,10 +8,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <string>
 
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/tools/RackGenerator.h"
+
+#include "TestFiles.h"
 
 namespace tetrapage {
 namespace {
@@ -22,16 +25,10 @@ const char* const kIdfParts[] = {"1210_SMD.stp", "SOD_523.stp", "EPL22_6_16.stp"
                                  "SMB_DO_214AA.stp", "RLF_12545.stp"};
 
 std::filesystem::path test_folder(const std::string& name) {
-  const auto folder = std::filesystem::path(TETRAPAGE_TEST_TMP) / "rack" / name;
-  std::filesystem::remove_all(folder);
-  std::filesystem::create_directories(folder);
-  return folder;
+  return test::fresh_folder("rack", name);
 }
 
-std::string file_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::file_bytes;
 
 /// A parts folder of links to the samples (the generator searches a folder).
 std::filesystem::path sample_parts() {
@@ -68,13 +65,16 @@ bool disjoint(const BoundingBox& a, const BoundingBox& b) {
   return false;
 }
 
-/// Each placed instance's box, from its triangles' corners, with its name.
+/// Each placed instance's box, from its triangles' corners, by its path on the board (a STEP
+/// file of several shapes gives "entry#k/shape" parts: one instance).
 std::vector<std::pair<std::string, BoundingBox>> instance_boxes(const TriangleSoup& soup) {
-  std::vector<std::pair<std::string, BoundingBox>> boxes(soup.part_count());
-  for (std::size_t p = 0; p < soup.part_count(); ++p) boxes[p].first = soup.part_path(p);
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
-    for (const Vec3& v : soup.corners(t)) boxes[soup.part_of[t]].second.extend(v);
-  return boxes;
+  std::map<std::string, BoundingBox> boxes;
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    const std::string& path = soup.part_path(soup.part_of[t]);
+    BoundingBox& box = boxes[path.substr(0, path.find('/'))];
+    for (const Vec3& v : soup.corners(t)) box.extend(v);
+  }
+  return {boxes.begin(), boxes.end()};
 }
 
 void expect_board_laid_out(const std::filesystem::path& board, const BoardOptions& plate) {
@@ -90,10 +90,11 @@ void expect_board_laid_out(const std::filesystem::path& board, const BoardOption
     EXPECT_GE(box.lo[1], 0.0) << name;
     EXPECT_LE(box.hi[0], plate.length) << name;
     EXPECT_LE(box.hi[1], plate.width) << name;
-    for (std::size_t j = i + 1; j < boxes.size(); ++j)
-      if (boxes[j].first != "plate")
-        EXPECT_TRUE(disjoint(box, boxes[j].second))
-            << board << ": " << name << " meets " << boxes[j].first;
+    for (std::size_t j = i + 1; j < boxes.size(); ++j) {
+      if (boxes[j].first == "plate") continue;
+      EXPECT_TRUE(disjoint(box, boxes[j].second))
+          << board << ": " << name << " meets " << boxes[j].first;
+    }
   }
   EXPECT_GE(parts, 2u) << board << ": the layout placed almost nothing";
 }
@@ -103,10 +104,12 @@ TEST(RackGenerator, PartsOnABoardNeverOverlapAndStandOnThePlate) {
     GTEST_SKIP() << "occt-misc and freecad-common's STEP samples are not installed";
   const auto parts = sample_parts();
   const auto out = test_folder("layout");
-  const RackOptions options = sample_options(parts, 7);
+  RackOptions options = sample_options(parts, 7);
+  options.triangles = 200000;  // more than one board holds: both types in use
   const RackSummary summary = generate_rack(options, out / "rack.json");
   ASSERT_EQ(summary.types.size(), 2u);
   EXPECT_GE(summary.library.parts.size(), 3u) << "most samples should read";
+  ASSERT_GE(summary.boards, 2u) << "both types in use";
   for (const char* type : {"board_a.json", "board_b.json"})
     expect_board_laid_out(out / "rack-boards" / type, options.board);
 }
