@@ -16,10 +16,13 @@ DEB_PACKAGES := cmake make g++ pkg-config \
   libocct-data-exchange-dev libocct-ocaf-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
   libocct-foundation-dev occt-misc freecad-common
 
+# What `make bench-rack` needs besides: KiCad's STEP packages (about 1 GB; no test needs them).
+RACK_PACKAGES := kicad-packages3d
+
 # What `make fuzz` needs besides: clang and its libFuzzer and sanitizer runtimes.
 FUZZ_PACKAGES := clang-14 libclang-rt-14-dev
 
-.PHONY: deps fuzz-deps configure build test sanitize sanitize-threads fuzz demo bench bench-study bench-peers bench-peers-demo bench-accuracy bench-deflection bench-scale clean format
+.PHONY: deps fuzz-deps configure build test sanitize sanitize-threads fuzz demo bench bench-study bench-peers bench-peers-demo bench-accuracy bench-deflection bench-scale bench-rack clean format
 
 # $(call install_missing,NAME,PACKAGES): installs those not present (sudo only when not root).
 define install_missing
@@ -145,6 +148,14 @@ bench-peers: build
 bench-peers-demo: build
 	@test -f $(DEMO_DIR)/scene.tpi || $(MAKE) --no-print-directory demo
 	BUILD=$(BUILD) bench/scripts/peers_series.sh $(DEMO_DIR) $(BUILD)/bench-results/peers 8M 3
+
+# Real CAD parts (issue 26): racks of boards populated with KiCad's STEP packages, of RACK_SIZES
+# triangles; generate, preprocess (STEP read, tessellation, index), a connector's insertion and a
+# billiard flight in memory and paged, FCL and CGAL beside; rack.md in $(BUILD)/bench-results/rack.
+RACK_SIZES ?= 1000000 10000000
+bench-rack: build
+	$(call install_missing,bench-rack,$(RACK_PACKAGES))
+	BUILD=$(BUILD) SIZES="$(RACK_SIZES)" bench/scripts/rack_series.sh $(BUILD)/bench-results/rack
 
 # Speed against accuracy on the demo's scene and object (both indexes built, without interiors):
 # every accuracy x shape x motion x storage on a billiard and a grazing flight, a Pareto plot.

@@ -31,6 +31,7 @@
 #include "tetrapage/tools/TetrasGenerator.h"
 
 #include "RunCli.h"
+#include "TestFiles.h"
 
 namespace tetrapage {
 namespace {
@@ -38,16 +39,10 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 
 std::filesystem::path test_folder(const std::string& name) {
-  const auto folder = std::filesystem::path(TETRAPAGE_TEST_TMP) / "generators" / name;
-  std::filesystem::remove_all(folder);
-  std::filesystem::create_directories(folder);
-  return folder;
+  return test::fresh_folder("generators", name);
 }
 
-std::string file_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using test::file_bytes;
 
 double volume(const BoundingBox& box) {
   const Vec3 s = box.size();

@@ -22,6 +22,8 @@ CLI::Validator image_size_check();
 
 /// `generate scene|tetras|terrain|object` (tools/cli/GenerateEnvironment.cpp)
 void add_generate_environment_commands(CLI::App& generate);
+/// `generate rack` (tools/cli/GenerateRack.cpp)
+void add_generate_rack_command(CLI::App& generate);
 /// `generate flight` (tools/cli/GenerateFlight.cpp)
 void add_generate_flight_command(CLI::App& generate);
 /// `replay` (tools/cli/ReplayCommand.cpp)

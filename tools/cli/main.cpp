@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
       "generate", "Generate the study's environments, flying objects and billiard flights");
   generate->require_subcommand(1);
   tetrapage::cli::add_generate_environment_commands(*generate);
+  tetrapage::cli::add_generate_rack_command(*generate);
   tetrapage::cli::add_generate_flight_command(*generate);
   tetrapage::cli::add_replay_command(app);
   tetrapage::cli::add_mesh_commands(app);
