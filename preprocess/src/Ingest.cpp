@@ -37,10 +37,8 @@ void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& pie
   if (!beyond.found) return;
   char value[64];
   std::snprintf(value, sizeof value, "%g", beyond.value);
-  const std::string file =
-      piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
   throw InputError(
-      file + ": a vertex coordinate of " + value +
+      piece.file().string() + ": a vertex coordinate of " + value +
       " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
 }
 
@@ -74,15 +72,8 @@ std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memo
   std::uint64_t largest = 0;
   for (const InputPiece& job : jobs) {
     std::error_code error;
-    if (!job.manifest) {
-      largest = std::max<std::uint64_t>(largest, std::filesystem::file_size(job.input, error));
-      continue;
-    }
-    const ManifestPart& part = job.manifest->parts[job.part];
-    const std::uint64_t bytes = std::filesystem::file_size(part.file, error);
-    if (!error)
-      largest =
-          std::max<std::uint64_t>(largest, bytes * std::max<std::size_t>(part.instances.size(), 1));
+    const std::uint64_t bytes = std::filesystem::file_size(job.file(), error);
+    if (!error) largest = std::max<std::uint64_t>(largest, bytes * job.copies());
   }
   const std::size_t fewest = threads + 1, most = 4 * threads;
   if (largest == 0) return fewest;
@@ -97,7 +88,9 @@ void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptio
   summary.degenerate_dropped += loaded.degenerate_dropped;
   summary.files_read += loaded.files_read;
   const auto part_offset = std::uint32_t(model.part_names.size());
-  for (const auto& name : loaded.soup.part_names) model.part_names.push_back(name);
+  // The index names each part by its instance path: unique, where names repeat per instance.
+  for (std::size_t p = 0; p < loaded.soup.part_count(); ++p)
+    model.part_names.push_back(loaded.soup.part_path(p));
   if (loaded.soup.part_names.empty())
     model.part_names.push_back("part" + std::to_string(part_offset));
   if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
