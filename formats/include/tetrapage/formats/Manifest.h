@@ -84,8 +84,9 @@ double part_unit_scale(const ManifestPart& part, const std::string& manifest_uni
 ///        beyond 64, naming the chain of files; more than 2^24 mesh instances).
 Manifest read_manifest(const std::filesystem::path& path);
 
-/// Reads every mesh file once and places each of its instances, sub-assemblies expanded; one
-/// soup part per placed instance (one per node for a file of several parts, glTF).
+/// Reads the file of each mesh entry once (an entry reached through two sub-assembly entries
+/// counts twice) and places all its instances, sub-assemblies expanded; one soup part per
+/// placed instance (one per node for a file of several parts, glTF).
 /// Order: the mesh entries depth first through the manifests, and for each, its placements with
 /// the outer sub-assembly's instance varying slowest. Names: part_names is the entry's "name"
 /// (or the node's name in a file of several parts); part_paths the instance path from the top,
