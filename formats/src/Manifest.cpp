@@ -375,8 +375,8 @@ ReadManifest read_manifest_file(const std::filesystem::path& path, ManifestReadi
   auto manifest = std::make_shared<Manifest>();
   manifest->path = path;
   if (document.contains("units")) {
-    unit_of(document["units"], root.field("units"));
     manifest->units = text(document["units"], root.field("units"));
+    unit_of(document["units"], root.field("units"));  // a known unit
   }
   if (!document.contains("parts")) root.format_error("missing field 'parts'");
   const json& parts = document["parts"];
