@@ -11,6 +11,8 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <memory>
+#include <span>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -51,12 +53,12 @@ class JsonPlace {
     return {file_, path_.empty() ? key : path_ + "." + key};
   }
   [[noreturn]] void format_error(const std::string& what) const {
-    throw FormatError(file_ + ": " + (path_.empty() ? std::string("top level") : path_) + ": " +
-                      what);
+    throw FormatError(where() + what);
   }
-  [[noreturn]] void input_error(const std::string& what) const {
-    throw InputError(file_ + ": " + (path_.empty() ? std::string("top level") : path_) + ": " +
-                     what);
+  [[noreturn]] void input_error(const std::string& what) const { throw InputError(where() + what); }
+  [[noreturn]] void io_error(const std::string& what) const { throw IoError(where() + what); }
+  std::string where() const {
+    return file_ + ": " + (path_.empty() ? std::string("top level") : path_) + ": ";
   }
 
  private:
@@ -222,13 +224,21 @@ Transform parse_instance(const json& instance, const JsonPlace& place) {
   return transform;
 }
 
-}  // namespace
-
-bool is_manifest_path(const std::filesystem::path& path) {
-  return detail::lower_extension(path) == ".json";
+std::vector<Transform> parse_instances(const json& part, const JsonPlace& place) {
+  if (!part.contains("instances")) return {identity_transform()};
+  const json& instances = part["instances"];
+  const JsonPlace instances_place = place.field("instances");
+  if (!instances.is_array())
+    instances_place.format_error("expected an array, got " + shown(instances));
+  if (instances.empty())
+    instances_place.format_error("empty (leave 'instances' out to place the part once)");
+  std::vector<Transform> result;
+  for (std::size_t k = 0; k < instances.size(); ++k)
+    result.push_back(parse_instance(instances[k], instances_place[k]));
+  return result;
 }
 
-Manifest read_manifest(const std::filesystem::path& path) {
+json parse_document(const std::filesystem::path& path) {
   const std::string file = path.string();
   require_regular_file(path);  // a FIFO would block the read forever
   std::ifstream stream(path, std::ios::binary);
@@ -255,15 +265,118 @@ Manifest read_manifest(const std::filesystem::path& path) {
     throw FormatError(file + ": not valid JSON: " + what);
   }
   if (stream.bad()) throw IoError("cannot read manifest '" + file + "'");
+  return document;
+}
 
+/// Sub-assemblies nest at most this many manifests deep, the top one included.
+constexpr std::size_t kMaxAssemblyDepth = 64;
+/// The most mesh instances an assembly may place: sub-assemblies multiply their instances, so a
+/// few small manifests could otherwise ask for more placements than memory holds.
+constexpr std::uint64_t kMaxPlacements = std::uint64_t(1) << 24;
+
+/// A manifest read, and how many mesh instances it places (at most kMaxPlacements + 1).
+struct ReadManifest {
+  std::shared_ptr<const Manifest> manifest;
+  std::uint64_t placements = 0;
+};
+
+/// The state of one read_manifest: the files open from the top down (cycles, depth), and the
+/// sub-manifests read already, by canonical path (one read each, however often included).
+struct ManifestReading {
+  struct Open {
+    std::filesystem::path key, shown;
+  };
+  std::vector<Open> chain;
+  std::map<std::filesystem::path, ReadManifest> done;
+};
+
+std::filesystem::path file_key(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, error);
+  return error ? path.lexically_normal() : canonical;
+}
+
+ReadManifest read_manifest_file(const std::filesystem::path& path, ManifestReading& reading);
+
+/// The sub-manifest `file` named at `place`: refused when it is open already (a cycle) or one
+/// too deep, read at most once.
+ReadManifest read_sub_assembly(const std::filesystem::path& file, const JsonPlace& place,
+                               ManifestReading& reading) {
+  const std::filesystem::path key = file_key(file);
+  const auto chain = [&] {
+    std::string text;
+    for (const auto& open : reading.chain) text += open.shown.string() + " -> ";
+    return text + file.string();
+  };
+  for (const auto& open : reading.chain)
+    if (open.key == key) place.input_error("the assembly includes itself: " + chain());
+  if (reading.chain.size() >= kMaxAssemblyDepth) {
+    place.input_error("sub-assemblies nested deeper than " + std::to_string(kMaxAssemblyDepth) +
+                      " manifests: " + chain());
+  }
+  if (const auto found = reading.done.find(key); found != reading.done.end()) return found->second;
+  try {
+    ReadManifest sub = read_manifest_file(file, reading);
+    reading.done.emplace(key, sub);
+    return sub;
+  } catch (const IoError& error) {
+    place.io_error(error.what());
+  }
+}
+
+/// Parses parts[i]; `placements` grows by the mesh instances it places (saturating).
+ManifestPart parse_part(const json& part, const JsonPlace& place, const Manifest& manifest,
+                        ManifestReading& reading, std::uint64_t& placements) {
+  require_keys(part, place, {"name", "file", "manifest", "units", "instances"});
+  const bool is_assembly = part.contains("manifest");
+  if (is_assembly && part.contains("file"))
+    place.format_error("give either 'file' or 'manifest', not both");
+  if (!is_assembly && !part.contains("file"))
+    place.format_error("missing field 'file' (or 'manifest' for a sub-assembly)");
+  const char* field = is_assembly ? "manifest" : "file";
+  const std::filesystem::path named = text(part[field], place.field(field));
+  if (named.empty()) place.field(field).format_error("empty file name");
+  if (!is_assembly && is_manifest_path(named))
+    place.field("file").format_error("a manifest is included with 'manifest', not 'file'");
+  if (is_assembly && part.contains("units")) {
+    place.field("units").format_error("a sub-assembly's unit is its manifest's 'units'");
+  }
+  ManifestPart result;
+  const std::filesystem::path file =
+      named.is_absolute() ? named : manifest.path.parent_path() / named;
+  result.name =
+      part.contains("name") ? text(part["name"], place.field("name")) : named.stem().string();
+  if (result.name.empty()) place.field("name").format_error("empty part name");
+  if (part.contains("units")) {
+    result.unit_scale =
+        unit_of(part["units"], place.field("units")) / metres_per_unit(manifest.units);
+    result.units_given = true;
+  }
+  result.instances = parse_instances(part, place);
+  std::uint64_t each = 1;
+  if (is_assembly) {
+    const ReadManifest sub = read_sub_assembly(file, place.field("manifest"), reading);
+    result.assembly = sub.manifest;
+    result.unit_scale = metres_per_unit(sub.manifest->units) / metres_per_unit(manifest.units);
+    each = sub.placements;
+  } else {
+    result.file = file;
+  }
+  const std::uint64_t copies = std::min<std::uint64_t>(result.instances.size(), kMaxPlacements + 1);
+  placements = std::min(placements + copies * each, kMaxPlacements + 1);
+  return result;
+}
+
+ReadManifest read_manifest_file(const std::filesystem::path& path, ManifestReading& reading) {
+  const json document = parse_document(path);
+  const std::string file = path.string();
   const JsonPlace root(file, "");
   require_keys(document, root, {"units", "parts"});
-  Manifest manifest;
-  manifest.path = path;
-  double assembly_metres = 1.0;
+  auto manifest = std::make_shared<Manifest>();
+  manifest->path = path;
   if (document.contains("units")) {
-    manifest.units = text(document["units"], root.field("units"));
-    assembly_metres = unit_of(document["units"], root.field("units"));
+    manifest->units = text(document["units"], root.field("units"));
+    unit_of(document["units"], root.field("units"));  // a known unit
   }
   if (!document.contains("parts")) root.format_error("missing field 'parts'");
   const json& parts = document["parts"];
@@ -271,127 +384,251 @@ Manifest read_manifest(const std::filesystem::path& path) {
   if (!parts.is_array()) parts_place.format_error("expected an array, got " + shown(parts));
   if (parts.empty()) parts_place.input_error("the assembly has no part");
 
-  const std::filesystem::path folder = path.parent_path();
+  reading.chain.push_back({file_key(path), path});
+  std::uint64_t placements = 0;
   std::map<std::string, std::size_t> names;
   for (std::size_t i = 0; i < parts.size(); ++i) {
-    const json& part = parts[i];
     const JsonPlace place = parts_place[i];
-    require_keys(part, place, {"name", "file", "units", "instances"});
-    ManifestPart result;
-    if (!part.contains("file")) place.format_error("missing field 'file'");
-    const std::filesystem::path part_file = text(part["file"], place.field("file"));
-    if (part_file.empty()) place.field("file").format_error("empty file name");
-    result.file = part_file.is_absolute() ? part_file : folder / part_file;
-    result.name =
-        part.contains("name") ? text(part["name"], place.field("name")) : part_file.stem().string();
-    if (result.name.empty()) place.field("name").format_error("empty part name");
-    if (const auto [it, inserted] = names.emplace(result.name, i); !inserted) {
-      place.field("name").input_error("duplicate part name " + in_quotes(result.name) + " (also parts[" +
-                                      std::to_string(it->second) + "]; give each part a name)");
+    ManifestPart part = parse_part(parts[i], place, *manifest, reading, placements);
+    if (const auto [it, inserted] = names.emplace(part.name, i); !inserted) {
+      place.field("name").input_error("duplicate part name " + in_quotes(part.name) +
+                                      " (also parts[" + std::to_string(it->second) +
+                                      "]; give each part a name)");
     }
-    if (part.contains("units")) {
-      result.unit_scale = unit_of(part["units"], place.field("units")) / assembly_metres;
-    }
-    if (part.contains("instances")) {
-      const json& instances = part["instances"];
-      const JsonPlace instances_place = place.field("instances");
-      if (!instances.is_array()) {
-        instances_place.format_error("expected an array, got " + shown(instances));
-      }
-      if (instances.empty()) {
-        instances_place.format_error("empty (leave 'instances' out to place the part once)");
-      }
-      for (std::size_t k = 0; k < instances.size(); ++k)
-        result.instances.push_back(parse_instance(instances[k], instances_place[k]));
-    } else {
-      result.instances.push_back(identity_transform());
-    }
-    manifest.parts.push_back(std::move(result));
+    manifest->parts.push_back(std::move(part));
   }
-  return manifest;
+  reading.chain.pop_back();
+  if (placements > kMaxPlacements) {
+    root.input_error("the assembly places more than " + std::to_string(kMaxPlacements) +
+                     " mesh instances (sub-assemblies multiply their instances)");
+  }
+  return {std::move(manifest), placements};
+}
+
+/// A mesh entry of an assembly with every place the assembly puts it.
+struct PlacedEntry {
+  const Manifest* owner = nullptr;     ///< the manifest naming the file
+  const ManifestPart* part = nullptr;  ///< its entry there
+  std::vector<Transform> placements;   ///< owner's unit -> the top manifest's unit
+  std::vector<std::string> paths;      ///< each placement's instance path
+};
+
+/// a b, both affine.
+Transform compose(const Transform& a, const Transform& b) {
+  Transform result = identity_transform();
+  for (int row = 0; row < 3; ++row) {
+    for (int column = 0; column < 4; ++column) {
+      double sum = column == 3 ? a[4 * row + 3] : 0.0;
+      for (int k = 0; k < 3; ++k) sum += a[4 * row + k] * b[4 * k + column];
+      result[4 * row + column] = sum;
+    }
+  }
+  return result;
+}
+
+/// The mesh entry `entries` of `top` (InputPiece::entries), placed: from the top down, each
+/// level's instances compose with the placements above; a sub-assembly's unit scale is folded
+/// in after its instance. A top-level entry's instances are taken as they are.
+PlacedEntry place_entry(const Manifest& top, std::span<const std::size_t> entries) {
+  PlacedEntry placed{&top, nullptr, {identity_transform()}, {std::string()}};
+  for (std::size_t level = 0; level < entries.size(); ++level) {
+    if (placed.part != nullptr || entries[level] >= placed.owner->parts.size())
+      throw InputError(top.path.string() + ": an input piece names no mesh entry of the manifest");
+    const ManifestPart& part = placed.owner->parts[entries[level]];
+    PlacedEntry next{placed.owner, nullptr, {}, {}};
+    for (std::size_t p = 0; p < placed.placements.size(); ++p) {
+      for (std::size_t k = 0; k < part.instances.size(); ++k) {
+        Transform t =
+            level == 0 ? part.instances[k] : compose(placed.placements[p], part.instances[k]);
+        if (part.assembly) {
+          for (int row = 0; row < 3; ++row)
+            for (int column = 0; column < 3; ++column) t[4 * row + column] *= part.unit_scale;
+        }
+        const std::string label =
+            part.instances.size() == 1 ? part.name : part.name + "#" + std::to_string(k);
+        next.placements.push_back(t);
+        next.paths.push_back(level == 0 ? label : placed.paths[p] + "/" + label);
+      }
+    }
+    if (part.assembly) {
+      next.owner = part.assembly.get();
+    } else {
+      next.part = &part;
+    }
+    placed = std::move(next);
+  }
+  if (placed.part == nullptr)
+    throw InputError(top.path.string() + ": an input piece names no mesh entry of the manifest");
+  return placed;
+}
+
+/// The mesh entries of `manifest`, depth first (InputPiece::entries each).
+void mesh_entries(const Manifest& manifest, std::vector<std::size_t>& prefix,
+                  std::vector<std::vector<std::size_t>>& out) {
+  for (std::size_t i = 0; i < manifest.parts.size(); ++i) {
+    prefix.push_back(i);
+    if (manifest.parts[i].assembly) {
+      mesh_entries(*manifest.parts[i].assembly, prefix, out);
+    } else {
+      out.push_back(prefix);
+    }
+    prefix.pop_back();
+  }
+}
+
+/// Appends the parts of `source` placed by placement k of `placed`: one soup part per
+/// instance, or per node for a file of several parts.
+void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const PlacedEntry& placed,
+                      std::size_t k, double scale, ReadReport& report) {
+  const Transform& m = placed.placements[k];
+  const std::string& path = placed.paths[k];
+  const std::string where = placed.owner->path.string() + ": part '" + path + "'";
+  if (assembly.vertices.size() + source.vertices.size() > std::numeric_limits<std::uint32_t>::max())
+    throw InputError(where + ": the assembly has more vertices than a soup can index");
+  const auto vertex_base = static_cast<std::uint32_t>(assembly.vertices.size());
+  const auto part_base = static_cast<std::uint32_t>(assembly.part_count());
+  if (source.part_count() == 1) {
+    assembly.add_part(placed.part->name, path == placed.part->name ? std::string() : path);
+  } else {
+    // A file of several parts (glTF nodes, named "stem/node") keeps its node names.
+    const std::string stem = placed.part->file.stem().string() + "/";
+    const auto node = [&](const std::string& name) {
+      return name.starts_with(stem) ? name.substr(stem.size()) : name;
+    };
+    for (std::size_t p = 0; p < source.part_count(); ++p)
+      assembly.add_part(node(source.part_names[p]), path + "/" + node(source.part_path(p)));
+  }
+  for (const Vec3& v : source.vertices) {
+    const Vec3 s{v[0] * scale, v[1] * scale, v[2] * scale};
+    Vec3 p;
+    for (int row = 0; row < 3; ++row)
+      p[row] = (m[4 * row] * s[0] + m[4 * row + 1] * s[1] + m[4 * row + 2] * s[2]) + m[4 * row + 3];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw InputError(where + ": placing it overflows the coordinates");
+    assembly.vertices.push_back(p);
+  }
+  for (std::size_t t = 0; t < source.triangles.size(); ++t) {
+    const auto& tri = source.triangles[t];
+    const TriangleIndices p{tri[0] + vertex_base, tri[1] + vertex_base, tri[2] + vertex_base};
+    // Rounding in the placement can flatten a sliver: drop it like the reader would.
+    if (is_degenerate_triangle(assembly.vertices[p[0]], assembly.vertices[p[1]],
+                               assembly.vertices[p[2]])) {
+      ++report.degenerate_dropped;
+      continue;
+    }
+    assembly.triangles.push_back(p);
+    assembly.part_of.push_back(part_base + source.part_of[t]);
+  }
+}
+
+/// The largest factor by which a placement stretches a length.
+double largest_stretch(const Transform& m) {
+  double largest = 0;
+  for (int column = 0; column < 3; ++column)
+    largest = std::max(largest, std::hypot(m[column], m[4 + column], m[8 + column]));
+  return largest;
+}
+
+/// Reads the file of mesh entry `entries` once and appends all its placements; a
+/// tessellation's deflection is reported in the top manifest's unit.
+void load_entry(TriangleSoup& assembly, const Manifest& top, std::span<const std::size_t> entries,
+                std::vector<ReadReport>* reports, const TessellationOptions& tessellation) {
+  const PlacedEntry placed = place_entry(top, entries);
+  ReadReport report;
+  const TriangleSoup source = read_mesh(placed.part->file, &report, tessellation);
+  const double scale = part_unit_scale(*placed.part, placed.owner->units, report.length_unit);
+  double stretch = 0;
+  for (std::size_t k = 0; k < placed.placements.size(); ++k) {
+    append_placement(assembly, source, placed, k, scale, report);
+    stretch = std::max(stretch, largest_stretch(placed.placements[k]));
+  }
+  report.tessellation_deflection *= scale * stretch;
+  if (reports != nullptr) reports->push_back(std::move(report));
+}
+
+}  // namespace
+
+bool is_manifest_path(const std::filesystem::path& path) {
+  return detail::lower_extension(path) == ".json";
+}
+
+double part_unit_scale(const ManifestPart& part, const std::string& manifest_units,
+                       const std::string& file_unit) {
+  if (part.units_given || file_unit.empty()) return part.unit_scale;
+  double file_metres = 0;
+  try {
+    file_metres = metres_per_unit(file_unit);
+  } catch (const InputError&) {
+    throw InputError(part.file.string() + ": the file's unit " + in_quotes(file_unit) +
+                     " is not one of m, cm, mm, um, in, ft; give the part 'units' in the manifest");
+  }
+  return file_metres / metres_per_unit(manifest_units);
+}
+
+Manifest read_manifest(const std::filesystem::path& path) {
+  ManifestReading reading;
+  return *read_manifest_file(path, reading).manifest;
 }
 
 TriangleSoup load_assembly(const Manifest& manifest, std::vector<ReadReport>* reports,
                            Progress& progress, const TessellationOptions& tessellation) {
+  std::vector<std::vector<std::size_t>> entries;
+  std::vector<std::size_t> prefix;
+  mesh_entries(manifest, prefix, entries);
   TriangleSoup assembly;
-  for (const ManifestPart& part : manifest.parts) {
-    ReadReport report;
-    const TriangleSoup source = read_mesh(part.file, &report, tessellation);
-    const std::string stem = part.file.stem().string();
-    for (std::size_t k = 0; k < part.instances.size(); ++k) {
-      const Transform& m = part.instances[k];
-      const std::string label =
-          part.instances.size() == 1 ? part.name : part.name + "#" + std::to_string(k);
-      if (assembly.vertices.size() + source.vertices.size() >
-          std::numeric_limits<std::uint32_t>::max()) {
-        throw InputError(manifest.path.string() + ": part '" + label +
-                         "': the assembly has more vertices than a soup can index");
-      }
-      const auto vertex_base = static_cast<std::uint32_t>(assembly.vertices.size());
-      const auto part_base = static_cast<std::uint32_t>(assembly.part_names.size());
-      for (const auto& name : source.part_names) {
-        // A file of several parts (glTF nodes, named "stem/node") keeps its node names.
-        std::string sub = name.starts_with(stem + "/") ? name.substr(stem.size() + 1) : name;
-        assembly.part_names.push_back(source.part_count() == 1 ? label : label + "/" + sub);
-      }
-      for (const Vec3& p : source.vertices) {
-        const Vec3 s{p[0] * part.unit_scale, p[1] * part.unit_scale, p[2] * part.unit_scale};
-        Vec3 placed;
-        for (int row = 0; row < 3; ++row)
-          placed[row] =
-              (m[4 * row] * s[0] + m[4 * row + 1] * s[1] + m[4 * row + 2] * s[2]) + m[4 * row + 3];
-        if (!std::isfinite(placed[0]) || !std::isfinite(placed[1]) || !std::isfinite(placed[2])) {
-          throw InputError(manifest.path.string() + ": part '" + label +
-                           "': placing it overflows the coordinates");
-        }
-        assembly.vertices.push_back(placed);
-      }
-      for (std::size_t t = 0; t < source.triangles.size(); ++t) {
-        const auto& tri = source.triangles[t];
-        const TriangleIndices placed{tri[0] + vertex_base, tri[1] + vertex_base,
-                                     tri[2] + vertex_base};
-        // Rounding in the placement can flatten a sliver: drop it like the reader would.
-        if (is_degenerate_triangle(assembly.vertices[placed[0]], assembly.vertices[placed[1]],
-                                   assembly.vertices[placed[2]])) {
-          ++report.degenerate_dropped;
-          continue;
-        }
-        assembly.triangles.push_back(placed);
-        assembly.part_of.push_back(part_base + source.part_of[t]);
-      }
-    }
-    if (reports != nullptr) reports->push_back(std::move(report));
+  for (const auto& entry : entries) {
+    load_entry(assembly, manifest, entry, reports, tessellation);
     progress.advance(1);
   }
   return assembly;
+}
+
+const std::filesystem::path& InputPiece::file() const {
+  if (!manifest) return input;
+  const Manifest* owner = manifest.get();
+  for (std::size_t level = 0; level + 1 < entries.size(); ++level)
+    owner = owner->parts.at(entries[level]).assembly.get();
+  return owner->parts.at(entries.at(entries.size() - 1)).file;
+}
+
+std::size_t InputPiece::copies() const {
+  if (!manifest) return 1;
+  std::size_t copies = 1;
+  const Manifest* owner = manifest.get();
+  for (const std::size_t entry : entries) {
+    copies *= owner->parts.at(entry).instances.size();
+    owner = owner->parts[entry].assembly.get();
+  }
+  return copies;
 }
 
 std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& inputs) {
   std::vector<InputPiece> pieces;
   for (const auto& input : inputs) {
     if (!is_manifest_path(input)) {
-      pieces.push_back({input, nullptr, 0});
+      pieces.push_back({input, nullptr, {}});
       continue;
     }
     const auto manifest = std::make_shared<const Manifest>(read_manifest(input));
-    for (std::size_t p = 0; p < manifest->parts.size(); ++p) pieces.push_back({input, manifest, p});
+    std::vector<std::vector<std::size_t>> entries;
+    std::vector<std::size_t> prefix;
+    mesh_entries(*manifest, prefix, entries);
+    for (auto& entry : entries) pieces.push_back({input, manifest, std::move(entry)});
   }
   return pieces;
 }
 
 TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports,
                               const TessellationOptions& tessellation) {
-  if (!piece.manifest) {
-    ReadReport report;
-    TriangleSoup soup = read_mesh(piece.input, &report, tessellation);
-    if (reports != nullptr) reports->push_back(std::move(report));
+  TriangleSoup soup;
+  if (piece.manifest) {
+    load_entry(soup, *piece.manifest, piece.entries, reports, tessellation);
     return soup;
   }
-  Manifest single;
-  single.path = piece.manifest->path;
-  single.units = piece.manifest->units;
-  single.parts = {piece.manifest->parts.at(piece.part)};
-  return load_assembly(single, reports, Progress::silent(), tessellation);
+  ReadReport report;
+  soup = read_mesh(piece.input, &report, tessellation);
+  if (reports != nullptr) reports->push_back(std::move(report));
+  return soup;
 }
 
 TriangleSoup load_inputs(const std::vector<std::filesystem::path>& inputs,

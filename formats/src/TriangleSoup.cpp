@@ -3,10 +3,11 @@
 namespace tetrapage {
 
 std::uint32_t TriangleSoup::add_part(std::string name, std::string path) {
-  // part_paths is either empty (every path is the name) or one per part.
-  const bool paths_held = !part_paths.empty() || part_names.empty();
-  if (!path.empty() && !paths_held) part_paths = part_names;
-  if (!path.empty() || !part_paths.empty()) part_paths.push_back(path.empty() ? name : std::move(path));
+  // Paths are stored from the first that differs from its name on (an empty path is the
+  // name); the first part may be that one, when there are no names to copy yet.
+  const bool paths = !part_paths.empty() || !path.empty();
+  if (paths && part_paths.empty()) part_paths = part_names;
+  if (paths) part_paths.push_back(path.empty() ? name : std::move(path));
   part_names.push_back(std::move(name));
   return static_cast<std::uint32_t>(part_names.size() - 1);
 }
@@ -19,8 +20,9 @@ void TriangleSoup::append(const TriangleSoup& other) {
   for (const auto& t : other.triangles)
     triangles.push_back({t[0] + vertex_offset, t[1] + vertex_offset, t[2] + vertex_offset});
   for (auto p : other.part_of) part_of.push_back(p + part_offset);
-  if (!other.part_paths.empty() && part_paths.empty()) part_paths = part_names;
-  if (!part_paths.empty() || !other.part_paths.empty())
+  const bool paths = !part_paths.empty() || !other.part_paths.empty();
+  if (paths && part_paths.empty()) part_paths = part_names;
+  if (paths)
     for (std::size_t p = 0; p < other.part_count(); ++p) part_paths.push_back(other.part_path(p));
   part_names.insert(part_names.end(), other.part_names.begin(), other.part_names.end());
 }

@@ -42,10 +42,8 @@ void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& pie
   if (!beyond.found) return;
   char value[64];
   std::snprintf(value, sizeof value, "%g", beyond.value);
-  const std::string file =
-      piece.manifest ? piece.manifest->parts[piece.part].file.string() : piece.input.string();
   throw InputError(
-      file + ": a vertex coordinate of " + value +
+      piece.file().string() + ": a vertex coordinate of " + value +
       " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
 }
 
@@ -89,15 +87,8 @@ std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memo
   std::uint64_t largest = 0;
   for (const InputPiece& job : jobs) {
     std::error_code error;
-    if (!job.manifest) {
-      largest = std::max<std::uint64_t>(largest, std::filesystem::file_size(job.input, error));
-      continue;
-    }
-    const ManifestPart& part = job.manifest->parts[job.part];
-    const std::uint64_t bytes = std::filesystem::file_size(part.file, error);
-    if (!error)
-      largest =
-          std::max<std::uint64_t>(largest, bytes * std::max<std::size_t>(part.instances.size(), 1));
+    const std::uint64_t bytes = std::filesystem::file_size(job.file(), error);
+    if (!error) largest = std::max<std::uint64_t>(largest, bytes * job.copies());
   }
   const std::size_t fewest = threads + 1, most = 4 * threads;
   if (largest == 0) return fewest;

@@ -35,7 +35,7 @@ namespace {
         "--accept-undecided to store it as undecided (containment there is then unknown)");
   throw InputError("interiors: every reference point tried in " + where +
                    " lies on the surface of closed component " + std::to_string(component) +
-                   " of part '" + model.part_names[model.components[component].part] +
+                   " of part '" + model.part_paths[model.components[component].part] +
                    "'; pass --accept-undecided to store the tet as undecided (containment there is "
                    "then unknown)");
 }

@@ -1,5 +1,5 @@
-// Parts and their instance paths through add_part and append, whatever the order in which
-// parts with and without paths arrive.
+// TriangleSoup's parts: names and instance paths stay one per part, whatever the order in which
+// parts with and without paths are added or appended.
 
 #include <gtest/gtest.h>
 
@@ -8,32 +8,47 @@
 namespace tetrapage {
 namespace {
 
-TEST(TriangleSoupParts, EveryPartKeepsItsPathWhateverTheOrder) {
-  TriangleSoup soup;
-  EXPECT_EQ(soup.add_part("screw", "rack/screw#0"), 0u);
-  EXPECT_EQ(soup.add_part("plate"), 1u);
-  EXPECT_EQ(soup.add_part("screw", "rack/screw#1"), 2u);
-  ASSERT_EQ(soup.part_count(), 3u);
-  EXPECT_EQ(soup.part_path(0), "rack/screw#0");
-  EXPECT_EQ(soup.part_path(1), "plate");
-  EXPECT_EQ(soup.part_path(2), "rack/screw#1");
+/// Every part's path, by part_path (the name when none is stored).
+std::vector<std::string> paths_of(const TriangleSoup& soup) {
+  std::vector<std::string> paths;
+  for (std::size_t p = 0; p < soup.part_count(); ++p) paths.push_back(soup.part_path(p));
+  return paths;
+}
 
+TEST(TriangleSoup, AddPartKeepsAPathPerPartFromTheFirstOneOn) {
   TriangleSoup plain;
   plain.add_part("a");
   plain.add_part("b");
-  EXPECT_TRUE(plain.part_paths.empty());
-  EXPECT_EQ(plain.part_path(1), "b");
-  plain.append(soup);
-  ASSERT_EQ(plain.part_count(), 5u);
-  const std::vector<std::string> expected{"a", "b", "rack/screw#0", "plate", "rack/screw#1"};
-  for (std::uint32_t p = 0; p < plain.part_count(); ++p) EXPECT_EQ(plain.part_path(p), expected[p]);
-  EXPECT_EQ(plain.part_names[2], "screw");
+  EXPECT_TRUE(plain.part_paths.empty());  // every path is its name: none stored
+  EXPECT_EQ(paths_of(plain), (std::vector<std::string>{"a", "b"}));
+
+  TriangleSoup first;  // the first part already has a path of its own
+  first.add_part("U7", "board#0/U7");
+  first.add_part("frame");
+  EXPECT_EQ(first.part_names, (std::vector<std::string>{"U7", "frame"}));
+  EXPECT_EQ(first.part_paths, (std::vector<std::string>{"board#0/U7", "frame"}));
 
   TriangleSoup later;
-  later.append(plain);
-  later.add_part("c");
-  EXPECT_EQ(later.part_path(5), "c");
-  EXPECT_EQ(later.part_path(2), "rack/screw#0");
+  later.add_part("frame");
+  later.add_part("U7", "board#1/U7");
+  EXPECT_EQ(later.part_paths, (std::vector<std::string>{"frame", "board#1/U7"}));
+}
+
+TEST(TriangleSoup, AppendKeepsThePathsOfBothSoups) {
+  TriangleSoup with_paths;
+  with_paths.add_part("U7", "board#0/U7");
+  TriangleSoup plain;
+  plain.add_part("frame");
+  for (const auto& [front, back] :
+       {std::pair{&with_paths, &plain}, std::pair{&plain, &with_paths}}) {
+    TriangleSoup joined;  // empty: the first append copies everything
+    joined.append(*front);
+    joined.append(*back);
+    std::vector<std::string> expected = paths_of(*front);
+    expected.push_back(back->part_path(0));
+    EXPECT_EQ(paths_of(joined), expected);
+    EXPECT_EQ(joined.part_paths.size(), joined.part_count());
+  }
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 /// @file Manifest.h
-/// Assembly manifests (JSON): parts, each a mesh file placed one or more times.
+/// Assembly manifests (JSON): parts, each a mesh file or a sub-assembly (another manifest)
+/// placed one or more times.
 ///
 /// {
 ///   "units": "mm",                              // the assembly's unit (default "m")
@@ -8,14 +9,24 @@
 ///     { "name": "bracket", "file": "bracket.stl", "units": "in",
 ///       "instances": [ { "translation": [0,0,0], "rotation": [1,0,0,0], "scale": 1 },
 ///                      { "matrix": [16 numbers, row-major 4x4, last row 0 0 0 1] } ] },
-///     { "file": "frame.obj" }                   // no instances: placed once, identity
+///     { "file": "frame.obj" },                  // no instances: placed once, identity
+///     { "name": "board", "manifest": "board.json", "instances": [ ... ] }
 ///   ]
 /// }
-/// File paths are relative to the manifest's folder. rotation is a quaternion qw,qx,qy,qz
-/// (normalised on read); scale a number or three; an instance maps x to R (S x) + t. A part's
-/// own "units" scale it into the assembly's unit first; instance transforms are in the
-/// assembly's unit. "name" defaults to the file's stem and must be unique. Comments (// and
-/// /* */) are allowed; unknown fields are errors (they are usually typos).
+/// File paths are relative to the folder of the manifest naming them. rotation is a quaternion
+/// qw,qx,qy,qz (normalised on read); scale a number or three; an instance maps x to R (S x) + t.
+/// Instance transforms are in the unit of the manifest holding them.
+///
+/// Units: a mesh part's own "units" scale it into its manifest's unit; without them, a unit the
+/// file itself declares (ReadReport::length_unit: STEP, IGES) is converted instead, and a file
+/// that declares none is taken to be in the manifest's unit. A given "units" wins over the
+/// file's. A sub-assembly ("manifest" instead of "file"; no "units" of its own) is in its
+/// manifest's "units" (default "m", whoever includes it), converted into the including one's.
+///
+/// "name" defaults to the file's stem and must be unique in its manifest. Sub-assemblies nest
+/// up to 64 manifests deep; a manifest that includes itself, directly or not, is refused, and an
+/// assembly places at most 2^24 mesh instances in all. Comments (// and /* */) are allowed;
+/// unknown fields are errors (they are usually typos).
 
 #include <array>
 #include <filesystem>
@@ -34,10 +45,16 @@ using Transform = std::array<double, 16>;
 /// The 4x4 identity.
 Transform identity_transform();
 
+struct Manifest;
+
 struct ManifestPart {
   std::string name;
-  std::filesystem::path file;        ///< absolute, or relative to the working folder
-  double unit_scale = 1.0;           ///< part units -> assembly units
+  std::filesystem::path file;  ///< a mesh (absolute, or relative to the working folder); empty
+                               ///< for a sub-assembly
+  std::shared_ptr<const Manifest> assembly;  ///< a sub-assembly; null for a mesh file
+  /// Part units -> its manifest's units; for a sub-assembly, the sub-manifest's units -> ours.
+  double unit_scale = 1.0;
+  bool units_given = false;          ///< "units" was given (it wins over the file's own unit)
   std::vector<Transform> instances;  ///< at least one
 };
 
@@ -54,29 +71,54 @@ double metres_per_unit(const std::string& unit);
 /// Whether `path` names a manifest rather than a mesh: a ".json" extension, in any case.
 bool is_manifest_path(const std::filesystem::path& path);
 
-/// Parses a manifest. @throw IoError, FormatError (bad JSON, names the file and the JSON
-/// path of the bad field), InputError (unknown unit, non-finite or singular transform).
+/// The factor taking a mesh part's coordinates, as its reader returned them (in `file_unit`,
+/// ReadReport::length_unit, empty when the file does not say), into the unit `manifest_units`
+/// of the manifest naming it: the part's own "units" when given, else the file's unit, else 1.
+/// @throw InputError naming the part's file when `file_unit` is not a unit metres_per_unit knows.
+double part_unit_scale(const ManifestPart& part, const std::string& manifest_units,
+                       const std::string& file_unit);
+
+/// Parses a manifest and, through "manifest" entries, its sub-assemblies (each file read once).
+/// @throw IoError (a sub-manifest that cannot be read names the including file and field),
+///        FormatError (bad JSON, names the file and the JSON path of the bad field), InputError
+///        (unknown unit, non-finite or singular transform; a cycle of manifests or nesting
+///        beyond 64, naming the chain of files; more than 2^24 mesh instances).
 Manifest read_manifest(const std::filesystem::path& path);
 
-/// Reads every part file once and places each instance; one soup part per instance, named
-/// "name" for a single instance or "name#k" (k = 0, 1, ... the index in "instances"); a file
-/// of several parts (glTF nodes) gives "name/node" or "name#k/node". Placement computes
-/// (m0 sx + m1 sy + m2 sz) + m3 per row in double, s = unit_scale * x; triangles that
-/// rounding flattens are dropped and counted in the file's report. Reports (one per file
-/// read) are appended to `reports` if given; `progress` advances by one per file.
+/// Reads the file of each mesh entry once (an entry reached through two sub-assembly entries
+/// counts twice) and places all its instances, sub-assemblies expanded; one soup part per
+/// placed instance (one per node for a file of several parts, glTF).
+/// Order: the mesh entries depth first through the manifests, and for each, its placements with
+/// the outer sub-assembly's instance varying slowest. Names: part_names is the entry's "name"
+/// (or the node's name in a file of several parts); part_paths the instance path from the top,
+/// "rack/board#3/U7": an entry's name, with "#k" (k = its index in "instances") when it is
+/// placed more than once, and "/node" for a node. Placement composes the transforms from the
+/// top down in double (units folded in) and computes (m0 sx + m1 sy + m2 sz) + m3 per row,
+/// s = part_unit_scale * x; a top-level part's instance is used as given (identity and integer
+/// translations stay exact). Triangles that rounding flattens are dropped and counted in the
+/// file's report. Reports (one per file read) are appended to `reports` if given; `progress`
+/// advances by one per file.
 /// @throw as read_mesh (IoError, FormatError, InputError); InputError if a placement
-///        overflows or the assembly has more than 2^32-1 vertices.
+///        overflows, a file's unit is unknown, or the assembly has more than 2^32-1 vertices.
 TriangleSoup load_assembly(const Manifest& manifest, std::vector<ReadReport>* reports = nullptr,
                            Progress& progress = Progress::silent(),
                            const TessellationOptions& tessellation = {});
 
-/// One piece of a list of inputs, loadable on its own: a mesh file, or one part of a manifest
-/// (with its instances placed). Loading the pieces in order and appending them gives the soup
-/// load_inputs gives, triangle for triangle, while holding one piece at a time.
+/// One piece of a list of inputs, loadable on its own: a mesh file, or one mesh entry of a
+/// manifest (reached through its sub-assemblies) with all its placements. Loading the pieces
+/// in order and appending them gives the soup load_inputs gives, triangle for triangle, while
+/// holding one piece (one file, placed) at a time.
 struct InputPiece {
   std::filesystem::path input;
-  std::shared_ptr<const Manifest> manifest;  ///< null for a mesh file
-  std::size_t part = 0;                      ///< the manifest's part
+  std::shared_ptr<const Manifest> manifest;  ///< the top manifest; null for a mesh file
+  /// The mesh entry: parts[entries[0]] of the top manifest, then parts[entries[1]] of that
+  /// sub-assembly, and so on.
+  std::vector<std::size_t> entries;
+
+  /// The mesh file the piece reads.
+  const std::filesystem::path& file() const;
+  /// How many times the file is placed (the instances along the entries, multiplied).
+  std::size_t copies() const;
 };
 
 /// The pieces of `inputs`, in order (the manifests are read here).

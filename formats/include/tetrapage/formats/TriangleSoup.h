@@ -95,7 +95,8 @@ struct ReadReport {
   double seconds = 0.0;
   /// "ascii", "binary", "binary_little_endian", "binary_big_endian"; empty through Assimp.
   std::string encoding;
-  /// The unit of the coordinates the reader returned, empty when the file does not say.
+  /// The unit of the coordinates the reader returned ("mm", a name metres_per_unit knows);
+  /// empty when the file does not say.
   std::string length_unit;
   /// CAD input: the largest chordal deviation the tessellation was asked for, in the
   /// coordinates returned (0: the file held triangles, used as they are).
