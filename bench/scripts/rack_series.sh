@@ -17,7 +17,7 @@
 #   DISPLACEMENT [1] (mm per billiard step)  SEED [1]  PARTS [/usr/share/kicad/3dmodels]
 #   PEERS_MAX [10000000]: larger racks are flown by tetrapage alone (FCL and CGAL hold the whole
 #     model in memory)  COLLIDERS [fcl,cgal,tetrapage,tetrapage-paged]
-#   FLAT [1]: `generate rack --flat` (one manifest of mesh entries; 0: the rack naming one manifest
+#   FLAT [0]: 1 runs `generate rack --flat` (one manifest of mesh entries); 0 the rack naming one manifest
 #     per board type, which needs nested manifests)
 #   GENERATE_FLAGS, PREPROCESS_FLAGS [none]: added to those commands
 #   BUILD [build], TETRAPAGE [$BUILD/tools/tetrapage], BENCH [$BUILD/bench/tetrapage_bench_peers]
@@ -37,7 +37,7 @@ SEED=${SEED:-1}
 PARTS=${PARTS:-/usr/share/kicad/3dmodels}
 PEERS_MAX=${PEERS_MAX:-10000000}
 COLLIDERS=${COLLIDERS:-fcl,cgal,tetrapage,tetrapage-paged}
-FLAT=${FLAT:-1}
+FLAT=${FLAT:-0}
 GENERATE_FLAGS=${GENERATE_FLAGS:-}
 [ "$FLAT" = 0 ] || GENERATE_FLAGS="--flat $GENERATE_FLAGS"
 PREPROCESS_FLAGS=${PREPROCESS_FLAGS:-}
