@@ -17,8 +17,8 @@
 #   DISPLACEMENT [1] (mm per billiard step)  SEED [1]  PARTS [/usr/share/kicad/3dmodels]
 #   PEERS_MAX [10000000]: larger racks are flown by tetrapage alone (FCL and CGAL hold the whole
 #     model in memory)  COLLIDERS [fcl,cgal,tetrapage,tetrapage-paged]
-#   FLAT [0]: 1 runs `generate rack --flat` (one manifest of mesh entries); 0 the rack naming one manifest
-#     per board type, which needs nested manifests)
+#   FLAT [0]: 0 writes the rack as nested manifests (one per board type); 1 runs
+#     `generate rack --flat` (one manifest of mesh entries)
 #   GENERATE_FLAGS, PREPROCESS_FLAGS [none]: added to those commands
 #   BUILD [build], TETRAPAGE [$BUILD/tools/tetrapage], BENCH [$BUILD/bench/tetrapage_bench_peers]
 # Racks, indexes and flights are reused by the next run (delete a size's folder to redo it); the
