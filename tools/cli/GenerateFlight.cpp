@@ -26,6 +26,27 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The judge: the reference oracle over the environment, or the exact runtime over the index
+// (paged under --memory) for models too large for the oracle.
+struct Judge {
+  std::unique_ptr<ReferenceCollider> oracle;
+  std::unique_ptr<CollisionJudge> runtime;
+};
+
+Judge make_judge(const FlightArguments& args, const TriangleSoup& environment,
+                 const TriangleSoup& object) {
+  Judge judge;
+  if (!args.environment.empty()) {
+    judge.oracle = std::make_unique<ReferenceCollider>(environment, object);
+    return judge;
+  }
+  CollisionIndexOptions index_options;
+  index_options.memory_budget_bytes = parse_byte_size(args.memory);
+  judge.runtime = std::make_unique<RuntimeJudge>(
+      std::make_shared<const CollisionIndex>(args.index, index_options), object);
+  return judge;
+}
+
 void run_generate_flight(const FlightArguments& args) {
   check_outputs_writable({args.output, args.answers, args.report}, {args.environment, args.index, args.object});
   if (args.environment.empty() == args.index.empty())
@@ -42,24 +63,15 @@ void run_generate_flight(const FlightArguments& args) {
   const TriangleSoup object = read_mesh(args.object);
   const double read_seconds = seconds_since(start);
 
-  // The judge: the reference oracle over the environment, or the exact runtime over the index
-  // (paged under --memory) for models too large for the oracle.
   const auto build_start = std::chrono::steady_clock::now();
-  std::unique_ptr<ReferenceCollider> oracle;
-  std::unique_ptr<CollisionJudge> judge;
-  if (!args.environment.empty()) {
-    oracle = std::make_unique<ReferenceCollider>(environment, object);
-  } else {
-    CollisionIndexOptions index_options;
-    index_options.memory_budget_bytes = parse_byte_size(args.memory);
-    judge = std::make_unique<RuntimeJudge>(std::make_shared<const CollisionIndex>(args.index, index_options), object);
-  }
+  const Judge judge = make_judge(args, environment, object);
+  const auto& oracle = judge.oracle;
   const double build_seconds = seconds_since(build_start);
 
   Progress flying(oracle ? "flying (reference)" : "flying (runtime)", args.options.steps);
   const auto fly_start = std::chrono::steady_clock::now();
   const Flight flight = oracle ? generate_billiard_flight(*oracle, args.options, flying)
-                               : generate_billiard_flight(*judge, args.options, flying);
+                               : generate_billiard_flight(*judge.runtime, args.options, flying);
   const double fly_seconds = seconds_since(fly_start);
 
   write_poses(args.output, flight.poses);

@@ -143,6 +143,23 @@ Pose free_start(CollisionJudge& judge, const FlightOptions& options, Random& ran
                    std::to_string(options.seed) + ")");
 }
 
+// The motion's random walk: direction and spin perturbed; the speed stays `displacement`,
+// the spin within options.max_rotation.
+void perturb(Vec3& velocity, Vec3& spin, double displacement, const FlightOptions& options,
+             Random& random) {
+  Vec3 v;
+  for (int a = 0; a < 3; ++a)
+    v[a] = velocity[a] + options.perturbation * displacement * random.normal();
+  const double n = norm(v);
+  if (n > 0.0)
+    for (int a = 0; a < 3; ++a) velocity[a] = v[a] / n * displacement;
+  for (int a = 0; a < 3; ++a)
+    spin[a] += options.perturbation * options.max_rotation * random.normal();
+  const double s = norm(spin);
+  if (s > options.max_rotation)
+    for (auto& c : spin) c *= options.max_rotation / s;
+}
+
 }  // namespace
 
 Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& options,
@@ -179,20 +196,7 @@ Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& opt
   std::size_t boundary_streak = 0;
   std::size_t final_attempts = 0;
   while (flight.poses.size() < options.steps) {
-    if (!replay_reverse) {
-      // Perturb the motion: direction and spin random-walk; speed stays `displacement`.
-      Vec3 v;
-      for (int a = 0; a < 3; ++a)
-        v[a] = velocity[a] + options.perturbation * displacement * random.normal();
-      const double n = norm(v);
-      if (n > 0.0)
-        for (int a = 0; a < 3; ++a) velocity[a] = v[a] / n * displacement;
-      for (int a = 0; a < 3; ++a)
-        spin[a] += options.perturbation * options.max_rotation * random.normal();
-      const double s = norm(spin);
-      if (s > options.max_rotation)
-        for (auto& c : spin) c *= options.max_rotation / s;
-    }
+    if (!replay_reverse) perturb(velocity, spin, displacement, options, random);
     replay_reverse = false;
     const Pose candidate = moved(pose, velocity, spin);
     if (!inside_workspace(oracle.object_bounds(candidate), workspace)) {
