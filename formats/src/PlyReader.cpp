@@ -2,8 +2,8 @@
 // scalar properties x, y, z (any PLY scalar type); from the "face" element the list property
 // "vertex_indices" (or "vertex_index"), with any count and index types; from a "part" element
 // (our writer's part table, MeshWriter.h) the integer "faces" and the byte lists "name" and
-// "path". Every other element and property is skipped by walking its
-// declared layout, so it cannot desynchronise the read.
+// "path". Every other element and property is skipped by walking its declared layout, so it
+// cannot desynchronise the read.
 
 #include <type_traits>
 #include <vector>

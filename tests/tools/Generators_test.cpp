@@ -799,7 +799,7 @@ TEST(TerrainGenerator, HeightfieldInTheSlabWithNormalsUp) {
   EXPECT_EQ(summary.samples_per_side, 31u);
   EXPECT_EQ(summary.source_side, 1201u);
   EXPECT_EQ(summary.fractal_side, 2049u);
-  EXPECT_EQ(summary.parts, 1u);
+  EXPECT_EQ(summary.bands, 1u);
 
   const TriangleSoup soup = read_mesh(folder / "terrain.ply");
   ASSERT_EQ(soup.triangle_count(), 2u * 30 * 30);

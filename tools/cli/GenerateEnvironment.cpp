@@ -20,7 +20,7 @@ namespace {
 
 constexpr const char* formats_help =
     "Mesh file to write; the format follows the extension: .ply (binary, double), .obj, .off, "
-    ".stl (binary), .gltf, .glb";
+    ".stl (binary), .gltf, .glb, .json (a manifest, a PLY per part); STL and OFF hold no parts";
 
 struct Common {
   std::filesystem::path output, report, meshes;
