@@ -68,6 +68,7 @@ TriangleSoup SoupBuilder::finish() {
     if (repeated || is_degenerate_triangle(soup_.vertices[tri[0]], soup_.vertices[tri[1]],
                                            soup_.vertices[tri[2]])) {
       ++report_.degenerate_dropped;
+      report_.dropped_positions.push_back(t);
       continue;
     }
     triangles[kept] = tri;
@@ -88,6 +89,16 @@ TriangleSoup SoupBuilder::finish() {
 }
 
 }  // namespace detail
+
+std::uint64_t triangle_position(const ReadReport& report, std::uint64_t id) {
+  // Ascending positions: each one at or before the candidate pushes it one further.
+  std::uint64_t position = id;
+  for (const std::uint64_t dropped : report.dropped_positions) {
+    if (dropped > position) break;
+    ++position;
+  }
+  return position;
+}
 
 namespace {
 

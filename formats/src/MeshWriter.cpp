@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -30,8 +31,14 @@ class MeshWriter::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
-  virtual void add_part(std::span<const Vec3> vertices,
-                        std::span<const TriangleIndices> triangles) = 0;
+  /// What a part is called; `continues`: the triangles go to the part added last.
+  struct Label {
+    std::string_view name;  ///< empty only for an unnamed first part
+    std::string_view path;  ///< empty: the name
+    bool continues = false;
+  };
+  virtual void add_part(std::span<const Vec3> vertices, std::span<const TriangleIndices> triangles,
+                        const Label& label) = 0;
   /// Writes what is left (headers, counts, buffered data) into output_.
   virtual void finish() = 0;
 
@@ -55,6 +62,7 @@ class MeshWriter::Impl {
 
   std::uint64_t triangles = 0;
   std::uint64_t vertices = 0;
+  std::uint64_t parts = 0;
 
  protected:
   static std::filesystem::path temporary(const std::filesystem::path& path, const char* suffix) {
@@ -119,7 +127,8 @@ class ObjWriter final : public MeshWriter::Impl {
   }
 
   void add_part(std::span<const Vec3> part_vertices,
-                std::span<const TriangleIndices> part_triangles) override {
+                std::span<const TriangleIndices> part_triangles, const Label& label) override {
+    if (!label.continues) write_label(label);
     // OBJ indices are global and 1-based: shift by the vertices of the earlier parts.
     const std::uint64_t base = vertices + 1;
     for (const auto& p : part_vertices) {
@@ -133,6 +142,36 @@ class ObjWriter final : public MeshWriter::Impl {
     }
   }
   void finish() override {}
+
+ private:
+  // What ObjReader reads back as this name and path: `o PATH` for a part whose path is its
+  // name, `o OBJECT` and `g NAME` for "OBJECT/NAME", else `o PATH` and `g NAME`.
+  void write_label(const Label& label) {
+    if (label.name.empty()) return;  // an unnamed first part: the reader names it by the stem
+    const std::string_view name = label.name, path = label.path.empty() ? name : label.path;
+    std::string object(path), group;
+    if (path != name) {
+      const bool nested = path.size() > name.size() + 1 && path.ends_with(name) &&
+                          path[path.size() - name.size() - 1] == '/';
+      if (nested) object = path.substr(0, path.size() - name.size() - 1);
+      group = name;
+    }
+    // Two parts the reader would merge (paths "a" named "b" and "a/b" named "b") stay apart.
+    std::string& renamed = group.empty() ? object : group;
+    const std::string original = renamed;
+    for (int k = 2; !written_.insert(object + '\n' + group).second; ++k)
+      renamed = original + "#" + std::to_string(k);
+    output_.write("o " + one_line(object) + "\n");
+    if (!group.empty()) output_.write("g " + one_line(group) + "\n");
+  }
+  // A name is the rest of its line: line breaks inside it become spaces.
+  static std::string one_line(std::string text) {
+    std::replace_if(
+        text.begin(), text.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+    return text;
+  }
+
+  std::set<std::string> written_;
 };
 
 class StlWriter final : public MeshWriter::Impl {
@@ -147,7 +186,7 @@ class StlWriter final : public MeshWriter::Impl {
   }
 
   void add_part(std::span<const Vec3> part_vertices,
-                std::span<const TriangleIndices> part_triangles) override {
+                std::span<const TriangleIndices> part_triangles, const Label&) override {
     if (triangles + part_triangles.size() > std::numeric_limits<std::uint32_t>::max()) {
       throw InputError("writing '" + path_.string() +
                        "': binary STL holds at most 2^32-1 triangles");
@@ -198,24 +237,37 @@ class CountedHeaderWriter : public MeshWriter::Impl {
     output_.write(header());
     output_.append_file(vertex_file_);
     output_.append_file(face_file_);
+    output_.write(trailer());
   }
 
  protected:
   virtual std::string header() const = 0;
+  /// Bytes after the faces.
+  virtual std::string trailer() const { return {}; }
 
   detail::OutputFile vertex_file_;
   detail::OutputFile face_file_;
 };
 
+// Parts go into a `part` element after `face` (Assimp 5.2 fails on an element before it): per
+// part its face count (the parts' faces are consecutive in `face`), name and path (empty: the
+// name) as lists of bytes. A file of one unnamed part has none. PLY readers skip the elements
+// they do not know.
 class PlyWriter final : public CountedHeaderWriter {
  public:
   using CountedHeaderWriter::CountedHeaderWriter;
 
   void add_part(std::span<const Vec3> part_vertices,
-                std::span<const TriangleIndices> part_triangles) override {
+                std::span<const TriangleIndices> part_triangles, const Label& label) override {
     if (vertices + part_vertices.size() > std::numeric_limits<std::uint32_t>::max()) {
       throw InputError("writing '" + path_.string() + "': more than 2^32-1 vertices");
     }
+    if (!label.continues || parts_.empty())
+      parts_.push_back({std::string(label.name), std::string(label.path), 0});
+    if (parts_.back().faces + part_triangles.size() > std::numeric_limits<std::uint32_t>::max())
+      throw InputError("writing '" + path_.string() + "': part '" + parts_.back().name +
+                       "' has more than 2^32-1 triangles, more than a PLY part table counts");
+    parts_.back().faces += part_triangles.size();
     static_assert(std::endian::native == std::endian::little, "written as little-endian");
     for (const auto& p : part_vertices) vertex_file_.write(p.data(), sizeof(double) * 3);
     const auto base = static_cast<std::uint32_t>(vertices);
@@ -230,13 +282,44 @@ class PlyWriter final : public CountedHeaderWriter {
 
  private:
   std::string header() const override {
-    return "ply\nformat binary_little_endian 1.0\ncomment written by tetrapage\n"
-           "element vertex " +
-           std::to_string(vertices) +
-           "\nproperty double x\nproperty double y\nproperty double z\n"
-           "element face " +
-           std::to_string(triangles) + "\nproperty list uchar uint vertex_indices\nend_header\n";
+    std::string text = "ply\nformat binary_little_endian 1.0\ncomment written by tetrapage\n";
+    text += "element vertex " + std::to_string(vertices) +
+            "\nproperty double x\nproperty double y\nproperty double z\n";
+    text +=
+        "element face " + std::to_string(triangles) + "\nproperty list uchar uint vertex_indices\n";
+    if (has_part_table()) {
+      text +=
+          "element part " + std::to_string(parts_.size()) +
+          "\nproperty uint faces\nproperty list uint uchar name\nproperty list uint uchar path\n";
+    }
+    return text + "end_header\n";
   }
+
+  std::string trailer() const override {
+    std::string bytes;
+    if (!has_part_table()) return bytes;
+    const auto put = [&bytes](std::uint32_t value) {
+      bytes.append(reinterpret_cast<const char*>(&value), sizeof value);
+    };
+    for (const auto& part : parts_) {
+      put(static_cast<std::uint32_t>(part.faces));
+      for (const std::string* text : {&part.name, &part.path}) {
+        put(static_cast<std::uint32_t>(text->size()));
+        bytes += *text;
+      }
+    }
+    return bytes;
+  }
+
+  bool has_part_table() const {
+    return parts_.size() > 1 || (parts_.size() == 1 && !parts_[0].name.empty());
+  }
+
+  struct Part {
+    std::string name, path;
+    std::uint64_t faces = 0;
+  };
+  std::vector<Part> parts_;
 };
 
 class OffWriter final : public CountedHeaderWriter {
@@ -244,7 +327,7 @@ class OffWriter final : public CountedHeaderWriter {
   using CountedHeaderWriter::CountedHeaderWriter;
 
   void add_part(std::span<const Vec3> part_vertices,
-                std::span<const TriangleIndices> part_triangles) override {
+                std::span<const TriangleIndices> part_triangles, const Label&) override {
     for (const auto& p : part_vertices) {
       char* line = vertex_file_.reserve(line_room);
       vertex_file_.advance(static_cast<std::size_t>(format_vertex(line, "", p) - line));
@@ -293,9 +376,19 @@ class GltfWriter final : public MeshWriter::Impl {
   GltfWriter(const std::filesystem::path& path, bool binary) : Impl(path), binary_(binary) {}
 
   void add_part(std::span<const Vec3> part_vertices,
-                std::span<const TriangleIndices> part_triangles) override {
+                std::span<const TriangleIndices> part_triangles, const Label& label) override {
+    if (!label.continues) {
+      name_ = label.name.empty() ? "part" + std::to_string(parts) : std::string(label.name);
+      mesh_ = none;
+    }
     if (part_triangles.empty()) return;  // glTF accessors cannot be empty
+    // A part is a mesh (made at its first triangles), each add_part of it a primitive.
+    if (mesh_ == none) {
+      mesh_ = mesh_names_.size();
+      mesh_names_.push_back(name_);
+    }
     Part part;
+    part.mesh = mesh_;
     part.vertex_offset = buffer_.size();
     part.vertex_count = part_vertices.size();
     for (const auto& p : part_vertices) {
@@ -357,15 +450,12 @@ class GltfWriter final : public MeshWriter::Impl {
       primitive["attributes"]["POSITION"] = 2 * k;
       primitive["indices"] = 2 * k + 1;
       primitive["mode"] = 4;  // TRIANGLES
-      json mesh;
-      mesh["primitives"] = json::array({primitive});
-      meshes.push_back(mesh);
-
-      json node;
-      node["mesh"] = k;
-      node["name"] = "part" + std::to_string(k);
-      nodes.push_back(node);
-      scene["nodes"].push_back(k);
+      if (part.mesh == meshes.size()) meshes.push_back({{"primitives", json::array()}});
+      meshes[part.mesh]["primitives"].push_back(primitive);
+    }
+    for (std::size_t m = 0; m < mesh_names_.size(); ++m) {
+      nodes.push_back({{"mesh", m}, {"name", mesh_names_[m]}});
+      scene["nodes"].push_back(m);
     }
     if (parts_.empty()) {
       // A file with no geometry is still valid glTF: one empty scene, no node, mesh or buffer
@@ -411,7 +501,9 @@ class GltfWriter final : public MeshWriter::Impl {
   }
 
  private:
+  // One primitive: a call of add_part with triangles.
   struct Part {
+    std::size_t mesh = 0;
     std::size_t vertex_offset = 0;
     std::size_t vertex_count = 0;
     std::size_t index_offset = 0;
@@ -428,9 +520,14 @@ class GltfWriter final : public MeshWriter::Impl {
     buffer_.insert(buffer_.end(), bytes, bytes + size);
   }
 
+  static constexpr std::size_t none = std::numeric_limits<std::size_t>::max();
+
   bool binary_;
   std::vector<unsigned char> buffer_;
   std::vector<Part> parts_;
+  std::vector<std::string> mesh_names_;  ///< one node per mesh, named by its part
+  std::string name_;                     ///< the part being added
+  std::size_t mesh_ = none;              ///< its mesh, once it has triangles
 };
 
 // An assembly: each part in its own binary PLY in "<stem>.parts/", listed by a JSON manifest
@@ -450,24 +547,35 @@ class ManifestWriter final : public MeshWriter::Impl {
   }
   ~ManifestWriter() override {
     std::error_code ignored;
+    current_.reset();  // its temporaries first
     if (!committed()) std::filesystem::remove_all(temporary_folder_, ignored);
   }
 
-  void add_part(std::span<const Vec3> part_vertices, std::span<const TriangleIndices> part_triangles) override {
-    char name[32];
-    std::snprintf(name, sizeof name, "part-%06zu.ply", parts_.size());
-    MeshWriter part(temporary_folder_ / name);
-    part.add_part(part_vertices, part_triangles);
-    part.commit();
-    parts_.push_back(name);
+  void add_part(std::span<const Vec3> part_vertices,
+                std::span<const TriangleIndices> part_triangles, const Label& label) override {
+    if (!label.continues || !current_) {
+      if (current_) current_->commit();
+      char file[32];
+      std::snprintf(file, sizeof file, "part-%06zu.ply", files_.size());
+      current_ = std::make_unique<MeshWriter>(temporary_folder_ / file);
+      files_.push_back(file);
+      names_.push_back(manifest_name(label, std::filesystem::path(file).stem().string()));
+    }
+    if (current_->parts_written() == 0) {
+      current_->add_part(part_vertices, part_triangles);
+    } else {
+      current_->extend_part(part_vertices, part_triangles);
+    }
   }
 
   void finish() override {
+    if (current_) current_->commit();
+    current_.reset();  // removes its side files before the folder moves
     nlohmann::ordered_json manifest;
     manifest["units"] = "m";
     auto& list = manifest["parts"] = nlohmann::ordered_json::array();
-    for (const auto& name : parts_)
-      list.push_back({{"name", std::filesystem::path(name).stem().string()}, {"file", folder_name_ + "/" + name}});
+    for (std::size_t k = 0; k < files_.size(); ++k)
+      list.push_back({{"name", names_[k]}, {"file", folder_name_ + "/" + files_[k]}});
     output_.write(manifest.dump(1) + "\n");
     std::error_code error;
     std::filesystem::remove_all(final_folder_, error);
@@ -478,9 +586,23 @@ class ManifestWriter final : public MeshWriter::Impl {
   }
 
  private:
+  // The part's path (unique in a soup; a manifest's names must be), else its name, else its
+  // file's; "#2", "#3", ... where one repeats.
+  std::string manifest_name(const Label& label, std::string fallback) {
+    std::string name = !label.path.empty()   ? std::string(label.path)
+                       : !label.name.empty() ? std::string(label.name)
+                                             : std::move(fallback);
+    const std::string original = name;
+    for (int k = 2; !used_names_.insert(name).second; ++k)
+      name = original + "#" + std::to_string(k);
+    return name;
+  }
+
   std::string folder_name_;
   std::filesystem::path final_folder_, temporary_folder_;
-  std::vector<std::string> parts_;
+  std::unique_ptr<MeshWriter> current_;  ///< the part file being written
+  std::vector<std::string> files_, names_;
+  std::set<std::string> used_names_;
 };
 
 }  // namespace
@@ -516,12 +638,32 @@ MeshWriter::MeshWriter(const std::filesystem::path& path) {
 MeshWriter::~MeshWriter() = default;
 
 void MeshWriter::add_part(std::span<const Vec3> vertices,
-                          std::span<const TriangleIndices> triangles) {
+                          std::span<const TriangleIndices> triangles, std::string_view name,
+                          std::string_view path) {
   if (impl_->committed()) {
     throw InputError("'" + impl_->path().string() + "': add_part after commit");
   }
   check_part(impl_->path(), vertices, triangles);
-  impl_->add_part(vertices, triangles);
+  // An unnamed part after the first needs a name, or a reader would merge it with the one
+  // before (OBJ) or name both by the file's stem (PLY).
+  const std::string fallback =
+      name.empty() && impl_->parts > 0 ? "part" + std::to_string(impl_->parts) : std::string();
+  if (!fallback.empty()) name = fallback;
+  if (path == name) path = {};
+  impl_->add_part(vertices, triangles, {name, path, false});
+  impl_->vertices += vertices.size();
+  impl_->triangles += triangles.size();
+  ++impl_->parts;
+}
+
+void MeshWriter::extend_part(std::span<const Vec3> vertices,
+                             std::span<const TriangleIndices> triangles) {
+  if (impl_->committed() || impl_->parts == 0) {
+    throw InputError("'" + impl_->path().string() + "': extend_part " +
+                     (impl_->parts == 0 ? "before add_part" : "after commit"));
+  }
+  check_part(impl_->path(), vertices, triangles);
+  impl_->add_part(vertices, triangles, {{}, {}, true});
   impl_->vertices += vertices.size();
   impl_->triangles += triangles.size();
 }
@@ -536,34 +678,64 @@ std::uint64_t MeshWriter::triangles_written() const {
 std::uint64_t MeshWriter::vertices_written() const {
   return impl_->vertices;
 }
+std::uint64_t MeshWriter::parts_written() const {
+  return impl_->parts;
+}
 
-void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup) {
-  MeshWriter writer(path);
-  if (soup.part_count() <= 1) {
-    writer.add_part(soup.vertices, soup.triangles);
-    writer.commit();
-    return;
-  }
+bool mesh_format_keeps_parts(const std::filesystem::path& path) {
+  const std::string extension = detail::lower_extension(path);
+  return extension != ".stl" && extension != ".off";
+}
+
+namespace {
+
+// The soup's triangles grouped by part, in order within a part (a counting sort): part p's
+// are by_part[first[p] .. first[p + 1]).
+struct PartOrder {
+  std::vector<std::size_t> first, by_part;
+};
+
+PartOrder order_by_part(const std::filesystem::path& path, const TriangleSoup& soup) {
   if (soup.part_of.size() != soup.triangles.size()) {
     throw InputError("writing '" + path.string() + "': the soup has " +
                      std::to_string(soup.triangles.size()) + " triangles but " +
                      std::to_string(soup.part_of.size()) + " part ids");
   }
-  // Group the triangles by part (a counting sort keeps their order within a part).
-  std::vector<std::size_t> first(soup.part_count() + 1, 0);
+  PartOrder order;
+  order.first.assign(soup.part_count() + 1, 0);
   for (const auto part : soup.part_of) {
     if (part >= soup.part_count()) {
       throw InputError("writing '" + path.string() + "': part id " + std::to_string(part) +
                        " but the soup has " + std::to_string(soup.part_count()) + " parts");
     }
-    ++first[part + 1];
+    ++order.first[part + 1];
   }
-  for (std::size_t p = 0; p < soup.part_count(); ++p) first[p + 1] += first[p];
-  std::vector<std::size_t> by_part(soup.triangles.size());
-  {
-    std::vector<std::size_t> next(first.begin(), first.end() - 1);
-    for (std::size_t t = 0; t < soup.triangles.size(); ++t) by_part[next[soup.part_of[t]]++] = t;
+  for (std::size_t p = 0; p < soup.part_count(); ++p) order.first[p + 1] += order.first[p];
+  order.by_part.resize(soup.triangles.size());
+  std::vector<std::size_t> next(order.first.begin(), order.first.end() - 1);
+  for (std::size_t t = 0; t < soup.triangles.size(); ++t)
+    order.by_part[next[soup.part_of[t]]++] = t;
+  return order;
+}
+
+std::string_view path_of(const TriangleSoup& soup, std::size_t part) {
+  return soup.part_paths.empty() ? std::string_view() : std::string_view(soup.part_paths[part]);
+}
+
+}  // namespace
+
+void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup) {
+  MeshWriter writer(path);
+  if (soup.part_count() <= 1) {
+    if (soup.part_count() == 1) {
+      writer.add_part(soup.vertices, soup.triangles, soup.part_names[0], path_of(soup, 0));
+    } else {
+      writer.add_part(soup.vertices, soup.triangles);
+    }
+    writer.commit();
+    return;
   }
+  const PartOrder order = order_by_part(path, soup);
   // Each part with the vertices its triangles use, in first-use order.
   constexpr std::uint32_t unused = std::numeric_limits<std::uint32_t>::max();
   std::vector<std::uint32_t> local(soup.vertices.size(), unused);
@@ -574,14 +746,15 @@ void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup) {
     part_vertices.clear();
     part_triangles.clear();
     used.clear();
-    for (std::size_t i = first[part]; i < first[part + 1]; ++i) {
+    for (std::size_t i = order.first[part]; i < order.first[part + 1]; ++i) {
+      const std::size_t t = order.by_part[i];
       TriangleIndices triangle{};
       for (int k = 0; k < 3; ++k) {
-        const std::uint32_t global = soup.triangles[by_part[i]][k];
+        const std::uint32_t global = soup.triangles[t][k];
         if (global >= soup.vertices.size()) {
-          throw InputError("writing '" + path.string() + "': triangle " +
-                           std::to_string(by_part[i]) + " uses vertex " + std::to_string(global) +
-                           " but the soup has " + std::to_string(soup.vertices.size()));
+          throw InputError("writing '" + path.string() + "': triangle " + std::to_string(t) +
+                           " uses vertex " + std::to_string(global) + " but the soup has " +
+                           std::to_string(soup.vertices.size()));
         }
         if (local[global] == unused) {
           local[global] = static_cast<std::uint32_t>(part_vertices.size());
@@ -593,7 +766,7 @@ void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup) {
       part_triangles.push_back(triangle);
     }
     for (const auto global : used) local[global] = unused;
-    writer.add_part(part_vertices, part_triangles);
+    writer.add_part(part_vertices, part_triangles, soup.part_names[part], path_of(soup, part));
   }
   writer.commit();
 }

@@ -1,7 +1,9 @@
 // PLY (ascii, binary_little_endian, binary_big_endian). From the "vertex" element we keep the
 // scalar properties x, y, z (any PLY scalar type); from the "face" element the list property
-// "vertex_indices" (or "vertex_index"), with any count and index types. Every other element
-// and property is skipped by walking its declared layout, so it cannot desynchronise the read.
+// "vertex_indices" (or "vertex_index"), with any count and index types; from a "part" element
+// (our writer's part table, MeshWriter.h) the integer "faces" and the byte lists "name" and
+// "path". Every other element and property is skipped by walking its declared layout, so it
+// cannot desynchronise the read.
 
 #include <type_traits>
 #include <vector>
@@ -208,12 +210,84 @@ void check_counts_fit(const InputFile& file, const PlyHeader& header) {
   }
 }
 
-/// Where x, y, z and the face corners sit in their elements.
+/// Where x, y, z, the face corners and the part table sit in their elements.
 struct PlyLayout {
   const PlyElement* vertex = nullptr;
   int coordinate[3] = {-1, -1, -1};  ///< property index of x, y, z
   const PlyElement* face = nullptr;
   int corners = -1;  ///< property index of vertex_indices
+  const PlyElement* parts = nullptr;                    ///< the part table, when there is one
+  int part_faces = -1, part_name = -1, part_path = -1;  ///< its property indices (path: -1 if none)
+};
+
+// Our writer's part table: an element "part" with an integer "faces" and lists of bytes
+// "name" (and "path"). Anything else named "part" is some other tool's and skipped.
+void find_part_table(const PlyHeader& header, PlyLayout& layout) {
+  for (const auto& element : header.elements) {
+    if (element.name != "part") continue;
+    int faces = -1, name = -1, path = -1;
+    for (std::size_t p = 0; p < element.properties.size(); ++p) {
+      const auto& property = element.properties[p];
+      const bool bytes = property.is_list && size_of(property.type) == 1;
+      if (property.name == "faces" && !property.is_list && is_integer(property.type))
+        faces = int(p);
+      if (property.name == "name" && bytes) name = int(p);
+      if (property.name == "path" && bytes) path = int(p);
+    }
+    if (faces < 0 || name < 0) return;
+    layout.parts = &element;
+    layout.part_faces = faces;
+    layout.part_name = name;
+    layout.part_path = path;
+    return;
+  }
+}
+
+// The part table's parts, made in the soup as its records are read. The table follows the
+// faces (Assimp 5.2 fails on an element before them), so the triangles get their parts at
+// the end: part k holds the next faces[k] faces, and a face of n corners made n - 2
+// triangles, hence the polygons are noted as the faces go by.
+class PlyPartTable {
+ public:
+  PlyPartTable(const InputFile& file, SoupBuilder& soup, bool present)
+      : file_(file), soup_(soup), present_(present) {}
+
+  void add(std::uint64_t faces, std::string name, std::string path) {
+    if (name.empty()) name = file_.path().stem().string();
+    ids_.push_back(soup_.begin_part(std::move(name), std::move(path)));
+    faces_.push_back(faces);
+  }
+  void note_face(std::uint64_t face, std::int64_t corners) {
+    if (present_ && corners > 3) polygons_.push_back({face, std::uint64_t(corners - 3)});
+  }
+  /// After every element: the table's counts must add up to the face element's.
+  /// @throw FormatError naming both counts when they differ.
+  void apply(std::uint64_t face_count) {
+    if (!present_) return;
+    std::uint64_t counted = 0;  // stops past face_count: a file's counts may overflow a sum
+    for (const auto faces : faces_) counted += std::min(faces, face_count + 1 - counted);
+    if (counted != face_count)
+      throw FormatError(file_.name() + ": the part table counts " +
+                        (counted > face_count ? "more" : std::to_string(counted)) +
+                        " faces, the face element has " + std::to_string(face_count));
+    std::uint64_t face = 0, triangle = 0;
+    auto polygon = polygons_.begin();
+    for (std::size_t k = 0; k < ids_.size(); ++k) {
+      std::uint64_t triangles = faces_[k];
+      for (face += faces_[k]; polygon != polygons_.end() && polygon->first < face; ++polygon)
+        triangles += polygon->second;
+      soup_.assign_part(triangle, triangle + triangles, ids_[k]);
+      triangle += triangles;
+    }
+  }
+
+ private:
+  const InputFile& file_;
+  SoupBuilder& soup_;
+  bool present_;
+  std::vector<std::uint32_t> ids_;
+  std::vector<std::uint64_t> faces_;                               ///< per part
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> polygons_;  ///< (face, corners - 3)
 };
 
 PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
@@ -262,19 +336,23 @@ PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
       throw FormatError(file.name() + ": the face element has no list 'vertex_indices'");
     }
   }
+  find_part_table(header, layout);
   return layout;
 }
 
 class BinaryPlyReader {
  public:
-  BinaryPlyReader(InputFile& file, bool big_endian, SoupBuilder& soup, const PlyLayout& layout)
-      : file_(file), big_endian_(big_endian), soup_(soup), layout_(layout) {}
+  BinaryPlyReader(InputFile& file, bool big_endian, SoupBuilder& soup, const PlyLayout& layout,
+                  PlyPartTable& parts)
+      : file_(file), big_endian_(big_endian), soup_(soup), layout_(layout), parts_(parts) {}
 
   void read_element(const PlyElement& element) {
     if (&element == layout_.vertex) {
       read_vertices(element);
     } else if (&element == layout_.face) {
       read_faces(element);
+    } else if (&element == layout_.parts) {
+      read_parts(element);
     } else {
       skip(element);
     }
@@ -346,6 +424,35 @@ class BinaryPlyReader {
     }
   }
 
+  void read_parts(const PlyElement& element) {
+    for (std::uint64_t r = 0; r < element.count; ++r) {
+      std::uint64_t faces = 0;
+      std::string name, path;
+      for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const auto& property = element.properties[p];
+        const int index = static_cast<int>(p);
+        if (!property.is_list) {
+          const char* bytes = take(size_of(property.type), element, r).data();
+          if (index == layout_.part_faces) faces = read_face_count(property, bytes, r);
+          continue;
+        }
+        std::int64_t count = 0;
+        const auto items = take_list(property, element, r, count);
+        if (index == layout_.part_name) name.assign(items.data(), items.size());
+        if (index == layout_.part_path) path.assign(items.data(), items.size());
+      }
+      parts_.add(faces, std::move(name), std::move(path));
+    }
+  }
+
+  std::uint64_t read_face_count(const PlyProperty& property, const char* bytes, std::uint64_t r) {
+    const std::int64_t faces = load_integer(property.type, bytes, big_endian_);
+    if (faces < 0)
+      throw FormatError(where_element(file_, "part", r) + "negative face count " +
+                        std::to_string(faces));
+    return static_cast<std::uint64_t>(faces);
+  }
+
   void read_faces(const PlyElement& element) {
     const std::uint64_t vertex_count = layout_.vertex->count;
     for (std::uint64_t f = 0; f < element.count; ++f) {
@@ -362,6 +469,7 @@ class BinaryPlyReader {
           throw FormatError(where_element(file_, "face", f) + "face has " + std::to_string(count) +
                             " corners, a face needs at least 3");
         }
+        parts_.note_face(f, count);
         corners_.clear();
         const std::size_t item_size = size_of(property.type);
         for (std::int64_t k = 0; k < count; ++k) {
@@ -417,15 +525,17 @@ class BinaryPlyReader {
   bool big_endian_;
   SoupBuilder& soup_;
   const PlyLayout& layout_;
+  PlyPartTable& parts_;
   std::vector<std::uint32_t> corners_;
 };
 
 class AsciiPlyReader {
  public:
-  AsciiPlyReader(InputFile& file, SoupBuilder& soup, const PlyLayout& layout)
-      : file_(file), tokens_(file), soup_(soup), layout_(layout) {}
+  AsciiPlyReader(InputFile& file, SoupBuilder& soup, const PlyLayout& layout, PlyPartTable& parts)
+      : file_(file), tokens_(file), soup_(soup), layout_(layout), parts_(parts) {}
 
   void read_element(const PlyElement& element) {
+    if (&element == layout_.parts) return read_parts(element);
     if (element.properties.empty()) return;  // records of nothing, however many
     const bool is_vertex = &element == layout_.vertex;
     const bool is_face = &element == layout_.face;
@@ -474,6 +584,37 @@ class AsciiPlyReader {
     return token;
   }
 
+  void read_parts(const PlyElement& element) {
+    for (std::uint64_t r = 0; r < element.count; ++r) {
+      std::int64_t faces = 0;
+      std::string name, path;
+      for (std::size_t p = 0; p < element.properties.size(); ++p) {
+        const auto& property = element.properties[p];
+        const int index = static_cast<int>(p);
+        if (!property.is_list) {
+          const std::string_view token = value_token(property, element, r);
+          if (index == layout_.part_faces && (!parse_integer(token, faces) || faces < 0))
+            throw FormatError(where_line(file_) + "part " + std::to_string(r) +
+                              ": bad face count " + quote_token(token));
+          continue;
+        }
+        const std::int64_t count = parse_count(property, element, r);
+        std::string* text = index == layout_.part_name   ? &name
+                            : index == layout_.part_path ? &path
+                                                         : nullptr;
+        for (std::int64_t k = 0; k < count; ++k) {
+          const std::string_view token = value_token(property, element, r);
+          std::int64_t byte = 0;
+          if (text != nullptr && (!parse_integer(token, byte) || byte < -128 || byte > 255))
+            throw FormatError(where_line(file_) + "part " + std::to_string(r) + ": bad byte " +
+                              quote_token(token) + " in '" + property.name + "'");
+          if (text != nullptr) text->push_back(static_cast<char>(byte));
+        }
+      }
+      parts_.add(static_cast<std::uint64_t>(faces), std::move(name), std::move(path));
+    }
+  }
+
   std::int64_t parse_count(const PlyProperty& property, const PlyElement& element,
                            std::uint64_t r) {
     const std::string_view token = value_token(property, element, r);
@@ -496,6 +637,7 @@ class AsciiPlyReader {
       throw FormatError(where_line(file_) + "face " + std::to_string(r) + ": face has " +
                         std::to_string(count) + " corners, a face needs at least 3");
     }
+    parts_.note_face(r, count);
     corners_.clear();
     const std::uint64_t vertex_count = layout_.vertex->count;
     for (std::int64_t k = 0; k < count; ++k) {
@@ -519,6 +661,7 @@ class AsciiPlyReader {
   TokenReader tokens_;
   SoupBuilder& soup_;
   const PlyLayout& layout_;
+  PlyPartTable& parts_;
   std::vector<std::uint32_t> corners_;
 };
 
@@ -529,18 +672,20 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report) {
   const PlyLayout layout = find_layout(file, header);
   check_counts_fit(file, header);
   SoupBuilder soup(file.name(), report);
-  soup.begin_part(file.path().stem().string());
+  if (layout.parts == nullptr) soup.begin_part(file.path().stem().string());
+  PlyPartTable parts(file, soup, layout.parts != nullptr);
   soup.reserve(layout.vertex->count, layout.face != nullptr ? layout.face->count : 0, file.size());
   if (header.encoding == PlyEncoding::ascii) {
     report.encoding = "ascii";
-    AsciiPlyReader reader(file, soup, layout);
+    AsciiPlyReader reader(file, soup, layout, parts);
     for (const auto& element : header.elements) reader.read_element(element);
   } else {
     const bool big_endian = header.encoding == PlyEncoding::binary_big_endian;
     report.encoding = big_endian ? "binary_big_endian" : "binary_little_endian";
-    BinaryPlyReader reader(file, big_endian, soup, layout);
+    BinaryPlyReader reader(file, big_endian, soup, layout, parts);
     for (const auto& element : header.elements) reader.read_element(element);
   }
+  parts.apply(layout.face != nullptr ? layout.face->count : 0);
   return soup.finish();
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <set>
 #include <span>
 #include <string>
 #include <string_view>
@@ -51,9 +52,26 @@ class SoupBuilder {
   SoupBuilder(std::string file_name, ReadReport& report)
       : file_name_(std::move(file_name)), report_(report) {}
 
-  void begin_part(std::string name) {
-    part_ = static_cast<std::uint32_t>(soup_.part_names.size());
-    soup_.part_names.push_back(std::move(name));
+  /// Starts a part; later triangles go to it. An empty path is the name. A path already
+  /// used gets "#2", "#3", ... appended (a soup's paths are unique). Returns the part's id.
+  std::uint32_t begin_part(std::string name, std::string path = {}) {
+    if (path.empty()) path = name;
+    if (!used_paths_.insert(path).second) {
+      const std::string taken = path + '#';
+      int k = 2;
+      while (!used_paths_.insert(taken + std::to_string(k)).second) ++k;
+      path = taken + std::to_string(k);
+    }
+    if (path == name) path.clear();  // keeps part_paths empty while every path is the name
+    part_ = soup_.add_part(std::move(name), std::move(path));
+    return part_;
+  }
+  /// Sends later triangles to an earlier part again (parts need not be consecutive).
+  void resume_part(std::uint32_t part) { part_ = part; }
+  /// Gives the triangles added [first, end) (counted before finish() drops any) to a part.
+  void assign_part(std::uint64_t first, std::uint64_t end, std::uint32_t part) {
+    std::fill(soup_.part_of.begin() + static_cast<std::ptrdiff_t>(first),
+              soup_.part_of.begin() + static_cast<std::ptrdiff_t>(end), part);
   }
   /// Reserves for the counts a header announces. A header may lie: no format stores a vertex
   /// in fewer than 3 bytes or a face in fewer than 4, so the file size caps the reservation.
@@ -90,6 +108,7 @@ class SoupBuilder {
   ReadReport& report_;
   TriangleSoup soup_;
   std::uint32_t part_ = 0;
+  std::set<std::string> used_paths_;
 };
 
 /// Whitespace-separated tokens of a text file, with the line they came from; a token never

@@ -51,7 +51,9 @@ TEST(ObjReader, VerticesFacesPolygonsAndNegativeIndices) {
   const std::vector<TriangleIndices> triangles = {{0, 1, 2}, {0, 2, 3}, {0, 1, 4}, {0, 1, 4},
                                                   {0, 4, 3}, {1, 2, 4}, {1, 4, 3}, {1, 3, 0}};
   ASSERT_EQ(soup.triangles, triangles);
-  EXPECT_EQ(soup.part_names, std::vector<std::string>{"bracket"});
+  // Every face is in group "group" of object "bracket": one part.
+  EXPECT_EQ(soup.part_names, std::vector<std::string>{"group"});
+  EXPECT_EQ(soup.part_paths, std::vector<std::string>{"bracket/group"});
   EXPECT_EQ(soup.part_of, std::vector<std::uint32_t>(triangles.size(), 0));
   EXPECT_EQ(report.format, "obj");
   EXPECT_EQ(report.encoding, "ascii");
@@ -101,6 +103,101 @@ TEST(ObjReader, ErrorsNameFileLineAndValue) {
   expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "line 4", "'x'"});
   write_file(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
   expect_error<InputError>([&] { read_mesh(path); }, {path.string(), "no triangle"});
+}
+
+TEST(ObjReader, ObjectsAndGroupsBecomeParts) {
+  const auto folder = scratch_folder("obj_parts");
+  const auto path = folder / "assembly.obj";
+  write_file(path,
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+             "f 1 2 3\n"  // t0: before any o/g, the stem's part
+             "o frame\n"
+             "f 1 2 4\n"  // t1: the object's own part
+             "g left\n"
+             "f 1 3 4\n"           // t2: frame/left
+             "g  empty group  \n"  // no face: no part
+             "g right side \n"     // one group, the name trimmed
+             "f 2 3 4\n"           // t3: frame/right side
+             "g left\n"
+             "f 1 2 3 4\n"  // t4, t5: frame/left again (a quad)
+             "g\n"
+             "f 1 2 4\n"  // t6: back to the object's part
+             "o\n"
+             "g loose\n"
+             "f 1 3 4\n"  // t7: a group outside any object
+             "o frame\n"
+             "g left\n"
+             "f 2 3 4\n");  // t8: frame/left once more
+  const TriangleSoup soup = read_mesh(path);
+  EXPECT_EQ(soup.part_names,
+            (std::vector<std::string>{"assembly", "frame", "left", "right side", "loose"}));
+  EXPECT_EQ(soup.part_paths, (std::vector<std::string>{"assembly", "frame", "frame/left",
+                                                       "frame/right side", "loose"}));
+  EXPECT_EQ(soup.part_of, (std::vector<std::uint32_t>{0, 1, 2, 3, 2, 2, 1, 4, 2}));
+
+  // Without o or g: one part named by the stem, as before parts were read.
+  write_file(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\ng\nf 1 2 3\n");
+  const TriangleSoup plain = read_mesh(path);
+  EXPECT_EQ(plain.part_names, std::vector<std::string>{"assembly"});
+  EXPECT_TRUE(plain.part_paths.empty());
+}
+
+// The rule of MeshReader.h, written another way: the (name, path) of each face from the
+// o/g lines above it, parts in the order of their first face.
+TEST(ObjReader, PartsFollowTheRuleOnRandomFiles) {
+  const auto folder = scratch_folder("obj_parts_random");
+  const auto path = folder / "stem.obj";
+  const char* objects[] = {"A", "B", "C d"};
+  const char* groups[] = {"x", "y z", "w"};
+  for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+    Random random(seed);
+    std::string text = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    std::string object, group;
+    std::vector<std::string> names, paths, expected_path_of;
+    const auto face = [&] {
+      text += "f 1 2 3\n";
+      const std::string name = !group.empty() ? group : !object.empty() ? object : "stem";
+      const std::string full = object.empty()  ? name
+                               : group.empty() ? object
+                                               : object + "/" + group;
+      if (std::find(paths.begin(), paths.end(), full) == paths.end()) {
+        paths.push_back(full);
+        names.push_back(name);
+      }
+      expected_path_of.push_back(full);
+    };
+    for (int line = 0; line < 60; ++line) {
+      const double u = random.uniform();
+      const std::string pad(random.below(3), ' ');
+      if (u < 0.1) {
+        object = objects[random.below(3)];
+        group.clear();
+        text += "o " + pad + object + pad + "\n";
+      } else if (u < 0.13) {
+        object.clear();
+        group.clear();
+        text += "o\n";
+      } else if (u < 0.3) {
+        group = groups[random.below(3)];
+        text += "g" + pad + " " + group + pad + "\n";
+      } else if (u < 0.33) {
+        group.clear();
+        text += "g\n";
+      } else {
+        face();
+      }
+    }
+    face();
+    write_file(path, text);
+    const TriangleSoup soup = read_mesh(path);
+    ASSERT_EQ(soup.part_names, names) << "seed " << seed << "\n" << text;
+    ASSERT_EQ(soup.part_count(), paths.size());
+    for (std::size_t p = 0; p < paths.size(); ++p) EXPECT_EQ(soup.part_path(p), paths[p]);
+    ASSERT_EQ(soup.part_of.size(), expected_path_of.size());
+    for (std::size_t t = 0; t < expected_path_of.size(); ++t)
+      ASSERT_EQ(soup.part_path(soup.part_of[t]), expected_path_of[t])
+          << "seed " << seed << " face " << t;
+  }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -429,6 +526,46 @@ TEST(PlyReader, ErrorsNameFileElementAndValue) {
   expect_error<InputError>([&] { read_mesh(path); }, {path.string(), "no triangle"});
 }
 
+// Our writer's part table, in ASCII here (MeshWriter writes it binary: MeshWriter_test), after
+// the faces as MeshWriter places it, or before them.
+TEST(PlyReader, APartTableMakesParts) {
+  const auto folder = scratch_folder("ply_parts");
+  const auto path = folder / "plate.ply";
+  const std::string vertices =
+      "element vertex 4\nproperty double x\nproperty double y\nproperty double z\n";
+  const std::string faces = "element face 3\nproperty list uchar int vertex_indices\n";
+  const std::string table =
+      "element part 3\nproperty uint faces\nproperty list uchar uchar name\n"
+      "property list uchar uchar path\n";
+  const std::string vertex_data = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n";
+  const std::string face_data = "3 0 1 2\n4 0 1 3 2\n3 1 2 3\n";  // a quad between triangles
+  // Parts "a" (1 face), "" (none: named by the stem) and "b" at path "r/b" (2 faces).
+  const std::string table_data = "1 1 97 0\n0 0 0\n2 1 98 3 114 47 98\n";
+  const auto write = [&](const std::string& table_header, const std::string& records, bool after) {
+    write_file(path, "ply\nformat ascii 1.0\n" + vertices +
+                         (after ? faces + table_header : table_header + faces) + "end_header\n" +
+                         vertex_data + (after ? face_data + records : records + face_data));
+  };
+  for (const bool after : {true, false}) {
+    SCOPED_TRACE(after ? "after the faces" : "before the faces");
+    write(table, table_data, after);
+    const TriangleSoup soup = read_mesh(path);
+    EXPECT_EQ(soup.part_names, (std::vector<std::string>{"a", "plate", "b"}));
+    EXPECT_EQ(soup.part_path(2), "r/b");
+    // f0 -> "a"; the quad's two triangles and f2 -> "b".
+    EXPECT_EQ(soup.part_of, (std::vector<std::uint32_t>{0, 2, 2, 2}));
+    // Counts that do not add up to the faces.
+    write(table, "1 1 97 0\n0 0 0\n1 1 98 0\n", after);
+    expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "counts 2 faces", "has 3"});
+    write(table, "4294967295 1 97 0\n0 0 0\n4294967295 1 98 0\n", after);
+    expect_error<FormatError>([&] { read_mesh(path); }, {path.string(), "counts more faces"});
+  }
+  // An element "part" of another shape is some other tool's: skipped.
+  write("element part 1\nproperty float faces\nproperty list uchar uchar name\n", "3.5 1 97\n",
+        true);
+  EXPECT_EQ(read_mesh(path).part_names, std::vector<std::string>{"plate"});
+}
+
 // ---------------------------------------------------------------------------------------
 // OFF
 
@@ -505,6 +642,81 @@ TEST(MeshReader, DegenerateTrianglesAreDroppedAndCounted) {
   write_file(path, "OFF\n3 2 0\n0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n3 0 0 1\n");
   expect_error<InputError>([&] { read_mesh(path); },
                            {path.string(), "no triangle left", "2 degenerate"});
+}
+
+// A triangle id maps back to the file's face: the faces fan-triangulated in order give the
+// positions, triangle_position() skips the dropped ones. The expectation is built here from
+// the faces, with degeneracy decided by this test's own integer cross products.
+TEST(MeshReader, TriangleIdsMapBackToTheFilesFaces) {
+  const auto folder = scratch_folder("triangle_ids");
+  const std::vector<std::array<int, 3>> points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                                                  {2, 0, 0}, {1, 3, 0}, {0, 0, 1}};
+  // A triangle, a quad, a collinear triangle, a pentagon, a repeated corner, a triangle.
+  const std::vector<std::vector<int>> faces = {{0, 1, 2},       {0, 1, 2, 3}, {0, 1, 4},
+                                               {0, 1, 2, 5, 3}, {0, 0, 6},    {1, 2, 6}};
+  struct Fan {
+    std::size_t face;
+    std::array<int, 3> corners;
+    bool degenerate;
+  };
+  std::vector<Fan> fans;
+  for (std::size_t f = 0; f < faces.size(); ++f) {
+    for (std::size_t j = 1; j + 1 < faces[f].size(); ++j) {
+      const std::array<int, 3> c = {faces[f][0], faces[f][j], faces[f][j + 1]};
+      std::array<int, 3> u{}, v{};
+      for (int a = 0; a < 3; ++a) {
+        u[a] = points[c[1]][a] - points[c[0]][a];
+        v[a] = points[c[2]][a] - points[c[0]][a];
+      }
+      const bool flat =
+          u[1] * v[2] == u[2] * v[1] && u[2] * v[0] == u[0] * v[2] && u[0] * v[1] == u[1] * v[0];
+      fans.push_back({f, c, flat});
+    }
+  }
+  std::vector<std::uint64_t> dropped;
+  for (std::size_t r = 0; r < fans.size(); ++r)
+    if (fans[r].degenerate) dropped.push_back(r);
+  ASSERT_EQ(dropped.size(), 2u);  // the collinear triangle and the repeated corner
+
+  std::string obj,
+      off = "OFF\n" + std::to_string(points.size()) + " " + std::to_string(faces.size()) + " 0\n";
+  for (const auto& p : points) {
+    const std::string xyz =
+        std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "\n";
+    obj += "v " + xyz;
+    off += xyz;
+  }
+  for (const auto& face : faces) {
+    obj += "f";
+    off += std::to_string(face.size());
+    for (int corner : face) {
+      obj += " " + std::to_string(corner + 1);
+      off += " " + std::to_string(corner);
+    }
+    obj += "\n";
+    off += "\n";
+  }
+  write_file(folder / "faces.obj", obj);
+  write_file(folder / "faces.off", off);
+  for (const char* name : {"faces.obj", "faces.off"}) {
+    SCOPED_TRACE(name);
+    ReadReport report;
+    const TriangleSoup soup = read_mesh(folder / name, &report);
+    EXPECT_EQ(report.triangles_read, fans.size());
+    EXPECT_EQ(report.dropped_positions, dropped);
+    ASSERT_EQ(soup.triangle_count(), fans.size() - dropped.size());
+    for (std::size_t id = 0; id < soup.triangle_count(); ++id) {
+      const std::uint64_t r = triangle_position(report, id);
+      ASSERT_LT(r, fans.size());
+      EXPECT_FALSE(fans[r].degenerate) << "id " << id;
+      const auto corners = soup.corners(id);
+      for (int k = 0; k < 3; ++k) {
+        const auto& p = points[fans[r].corners[k]];
+        EXPECT_EQ(corners[k], (Vec3{double(p[0]), double(p[1]), double(p[2])}))
+            << "id " << id << " is a triangle of face " << fans[r].face;
+      }
+    }
+  }
 }
 
 TEST(MeshReader, IsDegenerateTriangleAgreesWithExactRationalArithmetic) {

@@ -5,7 +5,10 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/IO/polygon_soup_io.h>
 
+#include <fstream>
 #include <map>
+
+#include <nlohmann/json.hpp>
 
 #include "../FileSizeLimit.h"
 #include "TestSupport.h"
@@ -40,11 +43,17 @@ TEST_P(WriterRoundTrip, RandomSoupsReadBackEqual) {
         for (auto& corner : expected) corner = to_float(corner);
       ASSERT_EQ(back.corners(t), expected) << "seed " << seed << " triangle " << t;
     }
-    if (extension == ".gltf" || extension == ".glb") {
-      // One node per part, so parts survive.
+    if (mesh_format_keeps_parts(path)) {
       ASSERT_EQ(back.part_count(), soup.part_count()) << "seed " << seed;
       for (std::size_t t = 0; t < soup.triangle_count(); ++t)
         EXPECT_EQ(back.part_of[t], soup.part_of[t]) << "seed " << seed;
+      // OBJ and PLY keep the names; Assimp names glTF nodes "stem/node" when there are several.
+      for (std::size_t p = 0; p < soup.part_count(); ++p) {
+        const bool assimp = extension == ".gltf" || extension == ".glb";
+        EXPECT_EQ(back.part_names[p], !assimp                  ? soup.part_names[p]
+                                      : soup.part_count() == 1 ? std::string("mesh")
+                                                               : "mesh/" + soup.part_names[p]);
+      }
     } else {
       EXPECT_EQ(back.part_names, std::vector<std::string>{"mesh"});
     }
@@ -170,6 +179,104 @@ TEST(MeshWriter, AManifestHoldsOnePlyPerPartAndReadsBackAsTheAssembly) {
   for (std::size_t t = 0; t < second.triangle_count(); ++t)
     EXPECT_EQ(back.corners(first.triangle_count() + t), second.corners(t));
   EXPECT_EQ(back.part_of.back(), 1u);
+}
+
+// Names and instance paths through the formats that hold parts: OBJ (o/g lines), PLY (the part
+// table), manifests (the names listed are the paths, unique); STL and OFF hold one part.
+TEST(MeshWriter, PartNamesAndPathsSurvive) {
+  const auto folder = scratch_folder("part_names");
+  TriangleSoup soup = random_soup(21, 6, 12);
+  soup.part_names = {"frame", "U7", "U7", "bolt", "a b", "frame"};
+  soup.part_paths = {"frame", "rack/board#3/U7", "rack/board#4/U7", "kit", "a b", "spare/frame"};
+  for (const std::string extension : {".obj", ".ply", ".stl", ".off", ".json"}) {
+    SCOPED_TRACE(extension);
+    const auto path = folder / ("parts" + extension);
+    write_mesh(path, soup);
+    if (extension == ".json") {
+      std::ifstream in(path);
+      const auto manifest = nlohmann::json::parse(in);
+      ASSERT_EQ(manifest.at("parts").size(), soup.part_count());
+      for (std::size_t p = 0; p < soup.part_count(); ++p)
+        EXPECT_EQ(manifest["parts"][p]["name"].get<std::string>(), soup.part_path(p));
+      const TriangleSoup back = load_assembly(read_manifest(path));
+      EXPECT_EQ(back.part_of, soup.part_of);
+      continue;
+    }
+    const TriangleSoup back = read_mesh(path);
+    ASSERT_EQ(back.triangle_count(), soup.triangle_count());
+    if (!mesh_format_keeps_parts(path)) {
+      EXPECT_EQ(back.part_names, std::vector<std::string>{"parts"});
+      continue;
+    }
+    // Another reader skips what it does not know (the part table, o and g lines).
+    EXPECT_EQ(read_mesh_with_assimp(path).triangle_count(), soup.triangle_count());
+    EXPECT_EQ(back.part_names, soup.part_names);
+    EXPECT_EQ(back.part_of, soup.part_of);
+    for (std::size_t p = 0; p < soup.part_count(); ++p) {
+      // OBJ cannot say that "bolt" sits at "kit": it reads back as "kit/bolt".
+      const bool reshaped = extension == ".obj" && soup.part_names[p] == "bolt";
+      EXPECT_EQ(back.part_path(p), reshaped ? "kit/bolt" : soup.part_path(p)) << "part " << p;
+    }
+  }
+}
+
+// A part streamed in pieces (extend_part) is one part for every reader; unnamed parts after
+// the first are "part<k>", the first takes the file's stem.
+TEST(MeshWriter, ExtendPartContinuesThePartAddedLast) {
+  const auto folder = scratch_folder("extend_part");
+  const TriangleSoup pieces = random_soup(31, 4, 10);  // four pieces of 10 triangles
+  const auto piece = [&](std::size_t k) {
+    return std::span<const TriangleIndices>(pieces.triangles).subspan(10 * k, 10);
+  };
+  for (const std::string extension : {".obj", ".ply", ".gltf", ".glb", ".stl", ".off"}) {
+    SCOPED_TRACE(extension);
+    const auto path = folder / ("streamed" + extension);
+    MeshWriter writer(path);
+    expect_error<InputError>([&] { writer.extend_part(pieces.vertices, piece(0)); },
+                             {path.string(), "before add_part"});
+    writer.add_part(pieces.vertices, piece(0));
+    writer.extend_part(pieces.vertices, piece(1));
+    writer.add_part(pieces.vertices, piece(2));
+    writer.extend_part(pieces.vertices, piece(3));
+    EXPECT_EQ(writer.parts_written(), 2u);
+    writer.commit();
+    const TriangleSoup back = read_mesh(path);
+    ASSERT_EQ(back.triangle_count(), 40u);
+    if (!mesh_format_keeps_parts(path)) {
+      EXPECT_EQ(back.part_count(), 1u);
+      continue;
+    }
+    ASSERT_EQ(back.part_count(), 2u);
+    for (std::size_t t = 0; t < 40; ++t) EXPECT_EQ(back.part_of[t], t < 20 ? 0u : 1u) << t;
+    if (extension == ".obj" || extension == ".ply") {
+      EXPECT_EQ(back.part_names, (std::vector<std::string>{"streamed", "part1"}));
+    }
+  }
+}
+
+// An OBJ file that returns to an earlier group: its parts are not consecutive. Written part
+// by part, every part keeps its triangles in their order.
+TEST(MeshWriter, PartsThatInterleaveAreWrittenPartByPart) {
+  const auto folder = scratch_folder("interleaved");
+  write_file(folder / "in.obj",
+             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+             "g a\nf 1 2 3\ng b\nf 1 2 4\ng a\nf 1 3 4\ng b\nf 2 3 4\ng a\nf 1 4 2\n");
+  const TriangleSoup soup = read_mesh(folder / "in.obj");
+  ASSERT_EQ(soup.part_count(), 2u);
+  for (const std::string extension : {".obj", ".ply"}) {
+    write_mesh(folder / ("out" + extension), soup);
+    const TriangleSoup back = read_mesh(folder / ("out" + extension));
+    ASSERT_EQ(back.part_names, soup.part_names) << extension;
+    for (std::uint32_t p = 0; p < 2; ++p) {
+      std::vector<std::array<Vec3, 3>> before, after;
+      for (std::size_t t = 0; t < soup.triangle_count(); ++t)
+        if (soup.part_of[t] == p) before.push_back(soup.corners(t));
+      for (std::size_t t = 0; t < back.triangle_count(); ++t)
+        if (back.part_of[t] == p) after.push_back(back.corners(t));
+      EXPECT_EQ(after, before) << extension << " part " << p;
+    }
+    EXPECT_TRUE(std::is_sorted(back.part_of.begin(), back.part_of.end())) << extension;
+  }
 }
 
 TEST(MeshWriter, EmptyFilesAreValidAndReadAsEmpty) {

@@ -23,6 +23,7 @@
 #include "tetrapage/tools/RuntimeJudge.h"
 
 #include "BoxSoup.h"
+#include "RunCli.h"
 
 namespace tetrapage {
 namespace {
@@ -213,7 +214,57 @@ TEST_P(BilliardFlight, KeepsItsPromises) {
   EXPECT_FALSE(flight.collides.back());
   EXPECT_EQ(collisions, flight.collisions);
   EXPECT_GT(collisions, 0u) << "a cluttered scene should produce bounces";
-  EXPECT_NEAR(travelled / double(options.steps - 1), options.displacement, 1e-9);
+  EXPECT_NEAR(travelled / double(options.steps - 1), flight.displacement, 1e-9);
+}
+
+// `generate flight` moves in the model's units: the same environment and object scaled by 1000
+// give steps 1000 times as long, measured on the poses written; an explicit --displacement is
+// kept as given.
+TEST(BilliardFlight, DefaultStepsScaleWithTheModel) {
+  const std::filesystem::path folder =
+      std::filesystem::path(TETRAPAGE_TEST_TMP) / ("flight-units-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  const auto scaled = [](TriangleSoup soup, double factor) {
+    for (auto& v : soup.vertices)
+      for (double& c : v) c *= factor;
+    return soup;
+  };
+  const auto step_lengths = [&](const std::string& name, const std::string& env,
+                                const std::string& object, const std::string& extra) {
+    std::string out;
+    EXPECT_EQ(test::run_cli("generate flight --env " + (folder / env).string() + " --object " +
+                                (folder / object).string() + " --steps 300 --seed 3 -o " +
+                                (folder / name).string() + " " + extra,
+                            out),
+              0);
+    const std::vector<Pose> poses = read_poses(folder / name);
+    std::vector<double> lengths;
+    for (std::size_t i = 1; i < poses.size(); ++i) {
+      double d2 = 0;
+      for (int a = 0; a < 3; ++a)
+        d2 += std::pow(poses[i].translation[a] - poses[i - 1].translation[a], 2);
+      lengths.push_back(std::sqrt(d2));
+    }
+    return lengths;
+  };
+  const TriangleSoup environment = boxes_environment(3, 12);
+  const TriangleSoup object = tetra_object(0.02);
+  write_mesh(folder / "env.ply", environment);
+  write_mesh(folder / "object.ply", object);
+  write_mesh(folder / "env-mm.ply", scaled(environment, 1000));
+  write_mesh(folder / "object-mm.ply", scaled(object, 1000));
+  const auto metres = step_lengths("m.csv", "env.ply", "object.ply", "");
+  const auto millimetres = step_lengths("mm.csv", "env-mm.ply", "object-mm.ply", "");
+  ASSERT_EQ(metres.size(), 299u);
+  ASSERT_EQ(millimetres.size(), metres.size());
+  for (std::size_t i = 0; i < metres.size(); ++i) {
+    ASSERT_GT(metres[i], 0.0);
+    EXPECT_NEAR(millimetres[i] / metres[i], 1000.0, 1e-6) << "step " << i;
+  }
+  for (const double length :
+       step_lengths("given.csv", "env-mm.ply", "object-mm.ply", "--displacement 2.5"))
+    EXPECT_NEAR(length, 2.5, 1e-9);
+  std::filesystem::remove_all(folder);
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, BilliardFlight, ::testing::Values(1, 2, 3));

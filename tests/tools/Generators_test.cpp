@@ -634,6 +634,57 @@ TEST(SceneGenerator, CommandDefaultsToAMixAndReportsIt) {
   EXPECT_NE(out.find("0.25"), std::string::npos) << out;
 }
 
+// What `generate scene` says it wrote and what `mesh info` reads back agree on the parts: one
+// per copy (the report's count) where the format holds parts, one where it merges them (and
+// says so); `mesh convert` keeps them or says it merged them.
+TEST(SceneGenerator, PartsSurviveTheFileAndConversions) {
+  const auto folder = test_folder("scene_parts");
+  const auto parts_of = [&](const std::filesystem::path& file) {
+    std::string out;
+    const auto report = folder / "info.json";
+    EXPECT_EQ(test::run_cli("mesh info " + file.string() + " --report " + report.string(), out), 0);
+    std::ifstream in(report);
+    return nlohmann::json::parse(in).at("files").at(0).at("parts").get<std::size_t>();
+  };
+  const auto said = [](const std::string& out) {  // "scene: N triangles, V vertices, P parts"
+    const auto end = out.find(" parts", out.find("scene: "));
+    const auto begin = out.rfind(", ", end) + 2;
+    return std::stoul(out.substr(begin, end - begin));
+  };
+  std::size_t copies = 0;
+  for (const std::string extension : {".ply", ".obj", ".glb", ".stl", ".off"}) {
+    SCOPED_TRACE(extension);
+    const auto scene = folder / ("scene" + extension), report = folder / "scene.json";
+    std::string out;
+    ASSERT_EQ(test::run_cli("generate scene --triangles 3000 --seed 4 -o " + scene.string() +
+                                " --report " + report.string(),
+                            out),
+              0);
+    std::ifstream in(report);
+    copies = nlohmann::json::parse(in).at("copies").get<std::size_t>();
+    ASSERT_GT(copies, 1u);
+    const bool merged = extension == ".stl" || extension == ".off";
+    EXPECT_EQ(said(out), merged ? 1u : copies) << out;
+    EXPECT_EQ(parts_of(scene), merged ? 1u : copies);
+    EXPECT_EQ(out.find("merged into one") != std::string::npos, merged) << out;
+  }
+  std::string out;
+  ASSERT_EQ(test::run_cli("mesh convert " + (folder / "scene.ply").string() + " -o " +
+                              (folder / "back.obj").string(),
+                          out),
+            0);
+  EXPECT_EQ(out.find("merged"), std::string::npos) << out;
+  EXPECT_EQ(parts_of(folder / "back.obj"), copies);
+  ASSERT_EQ(test::run_cli("mesh convert " + (folder / "back.obj").string() + " -o " +
+                              (folder / "flat.off").string(),
+                          out),
+            0);
+  EXPECT_NE(out.find("the " + std::to_string(copies) + " parts were merged into one"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(parts_of(folder / "flat.off"), 1u);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Tetras
 
@@ -748,7 +799,7 @@ TEST(TerrainGenerator, HeightfieldInTheSlabWithNormalsUp) {
   EXPECT_EQ(summary.samples_per_side, 31u);
   EXPECT_EQ(summary.source_side, 1201u);
   EXPECT_EQ(summary.fractal_side, 2049u);
-  EXPECT_EQ(summary.parts, 1u);
+  EXPECT_EQ(summary.bands, 1u);
 
   const TriangleSoup soup = read_mesh(folder / "terrain.ply");
   ASSERT_EQ(soup.triangle_count(), 2u * 30 * 30);
@@ -792,11 +843,12 @@ TEST(TerrainGenerator, LargeTerrainIsWrittenInBandsThatMeetExactly) {
   }
   const std::size_t s = 761;
   ASSERT_EQ(summary.samples_per_side, s);
-  EXPECT_EQ(summary.parts, 2u);
+  EXPECT_EQ(summary.bands, 2u);
   // The second band repeats the row the first one ends with.
   EXPECT_EQ(summary.vertices, s * s + s);
   const TriangleSoup soup = read_mesh(folder / "terrain.ply");
   ASSERT_EQ(soup.triangle_count(), 2u * 760 * 760);
+  EXPECT_EQ(soup.part_names, std::vector<std::string>{"terrain"});  // one surface, one part
   std::map<std::pair<double, double>, double> height;
   for (const auto& v : soup.vertices) {
     const auto [it, inserted] = height.emplace(std::make_pair(v[0], v[1]), v[2]);

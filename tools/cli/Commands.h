@@ -20,6 +20,11 @@ CLI::Validator whole_number_check(long long lowest, long long highest);
 /// A CLI11 check of an image size "WIDTHxHEIGHT", each 1 to 16384.
 CLI::Validator image_size_check();
 
+/// The parts a mesh file written from `parts` parts holds: all of them, or one where its
+/// format holds none (STL, OFF), in which case one line on stdout says they were merged
+/// (tools/cli/MeshCommands.cpp).
+std::size_t parts_in_file(const std::filesystem::path& output, std::size_t parts);
+
 /// `generate scene|tetras|terrain|object` (tools/cli/GenerateEnvironment.cpp)
 void add_generate_environment_commands(CLI::App& generate);
 /// `generate rack` (tools/cli/GenerateRack.cpp)

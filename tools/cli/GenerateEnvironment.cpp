@@ -20,7 +20,7 @@ namespace {
 
 constexpr const char* formats_help =
     "Mesh file to write; the format follows the extension: .ply (binary, double), .obj, .off, "
-    ".stl (binary), .gltf, .glb";
+    ".stl (binary), .gltf, .glb, .json (a manifest, a PLY per part); STL and OFF hold no parts";
 
 struct Common {
   std::filesystem::path output, report, meshes;
@@ -56,20 +56,21 @@ void finish(const Common& common, const Outcome& outcome, const nlohmann::json& 
   const std::uint64_t rss = peak_resident_bytes();
   const auto& lo = outcome.bounds.lo;
   const auto& hi = outcome.bounds.hi;
+  const std::size_t parts = parts_in_file(common.output, outcome.parts);  // as a reader sees them
   std::printf(
       "%s: %llu triangles, %llu vertices, %llu parts%s, bounds [%.4g %.4g %.4g]-[%.4g %.4g %.4g], "
       "%.2f s, peak RSS %.1f MB, wrote %s\n",
       outcome.command.c_str(), static_cast<unsigned long long>(outcome.triangles),
-      static_cast<unsigned long long>(outcome.vertices),
-      static_cast<unsigned long long>(outcome.parts), outcome.note.c_str(), lo[0], lo[1], lo[2],
-      hi[0], hi[1], hi[2], seconds, double(rss) / 1e6, common.output.c_str());
+      static_cast<unsigned long long>(outcome.vertices), static_cast<unsigned long long>(parts),
+      outcome.note.c_str(), lo[0], lo[1], lo[2], hi[0], hi[1], hi[2], seconds, double(rss) / 1e6,
+      common.output.c_str());
   if (common.report.empty()) return;
   nlohmann::json report = {{"command", "generate " + outcome.command},
                            {"output", common.output.string()},
                            {"seed", seed},
                            {"triangles", outcome.triangles},
                            {"vertices", outcome.vertices},
-                           {"parts", outcome.parts},
+                           {"parts", parts},
                            {"bounds", {{"lo", lo}, {"hi", hi}}},
                            {"seconds", seconds},
                            {"peak_rss_bytes", rss}};
@@ -79,7 +80,9 @@ void finish(const Common& common, const Outcome& outcome, const nlohmann::json& 
 
 void add_common_options(CLI::App& command, Common& common, bool with_seed) {
   command.add_option("-o,--output", common.output, formats_help)->required();
-  if (with_seed) command.add_option("--seed", common.seed, "Random seed")->capture_default_str();
+  if (with_seed)
+    command.add_option("--seed", common.seed, "Random seed (a whole number)")
+        ->capture_default_str();
   command.add_option("--report", common.report, "Also write the figures as JSON to this file");
 }
 
@@ -98,16 +101,17 @@ void add_scene(CLI::App& generate) {
   auto options = std::make_shared<SceneOptions>();
   auto* command = generate.add_subcommand(
       "scene",
-      "The study's \"scenes\": a random BSP tree cuts the unit cube into boxes (2 per copy;\n"
-      "no side shorter than alpha = 0.4 (1/leaves)^(1/3)); a random half of the boxes each get\n"
-      "one randomly rotated copy of a real mesh, scaled to fill 90% of its box along the\n"
-      "tightest axis and centred. Meshes are drawn until the total is about --triangles.\n"
-      "As in real CAD exports, closed solids and open shells share the file: a fraction of\n"
-      "the copies (--open-fraction) lose their triangles above a random plane, leaving one\n"
-      "connected shell with a hole; the others stay closed.\n"
-      "Each copy is streamed to the file as its own part: memory stays small for any size.\n"
+      "The study's \"scenes\": a random BSP tree cuts the unit cube [0,1]^3 (model units) into\n"
+      "boxes (2 per copy; no side shorter than alpha = 0.4 (1/leaves)^(1/3)); a random half of\n"
+      "the boxes each get one randomly rotated copy of a real mesh, scaled to fill 90% of its\n"
+      "box along the tightest axis and centred. Meshes are drawn until the total is about\n"
+      "--triangles. As in real CAD exports, closed solids and open shells share the file: a\n"
+      "fraction of the copies (--open-fraction) lose their triangles above a random plane,\n"
+      "leaving one connected shell with a hole; the others stay closed.\n"
+      "Each copy is streamed to the file as its own part (\"<mesh>#<n>\"; STL and OFF hold no\n"
+      "parts): memory stays small for any size.\n"
       "The same seed and meshes give the same file.");
-  command->add_option("--triangles", options->triangles, "Target number of triangles")
+  command->add_option("--triangles", options->triangles, "Target number of triangles (a count)")
       ->capture_default_str()
       ->check(CLI::Range(std::uint64_t{1}, max_scene_triangles));
   options->open_fraction = default_scene_open_fraction;
@@ -163,11 +167,14 @@ void add_tetras(CLI::App& generate) {
   auto options = std::make_shared<TetrasOptions>();
   auto* command = generate.add_subcommand(
       "tetras",
-      "The study's \"tetras\": a random BSP tree cuts the unit cube into 2 boxes per\n"
-      "tetrahedron; a random half of the boxes each get one tetrahedron with random corners\n"
-      "(redrawn while its volume is below 0.5% of its box), outward oriented: each is a\n"
-      "closed 4-triangle part. --triangles/4 tetrahedra (the study: 100 to 16,000 triangles).");
-  command->add_option("--triangles", options->triangles, "Number of triangles (4 per tetrahedron)")
+      "The study's \"tetras\": a random BSP tree cuts the unit cube [0,1]^3 (model units) into\n"
+      "2 boxes per tetrahedron; a random half of the boxes each get one tetrahedron with\n"
+      "random corners (redrawn while its volume is below 0.5% of its box), outward oriented:\n"
+      "each is a closed 4-triangle part (\"tetra#<k>\"). --triangles/4 tetrahedra (the study:\n"
+      "100 to 16,000 triangles).");
+  command
+      ->add_option("--triangles", options->triangles,
+                   "Number of triangles (a count, 4 per tetrahedron)")
       ->capture_default_str()
       ->check(CLI::Range(std::uint64_t{1}, max_tetras_triangles));
   add_common_options(*command, *common, true);
@@ -204,13 +211,15 @@ void add_terrain(CLI::App& generate) {
       "The study's \"terrains\": a fractal heightfield (diamond-square, cropped to the study's\n"
       "1201 x 1201 DEM grid) sampled to s x s points with 2 (s-1)^2 close to --triangles\n"
       "(default: the study's 120 x 120; 2880000 gives the full 1201 x 1201), over [0,1]^2 with\n"
-      "heights in [0.05, 0.45]; each grid cell split into two triangles. An open surface.");
-  command->add_option("--triangles", options->triangles, "Target number of triangles")
+      "heights in [0.05, 0.45] (model units); each grid cell split into two triangles. One open\n"
+      "surface, one part.");
+  command->add_option("--triangles", options->triangles, "Target number of triangles (a count)")
       ->capture_default_str()
       ->check(CLI::Range(std::uint64_t{1}, max_terrain_triangles));
   command
-      ->add_option("--roughness", options->roughness,
-                   "Fractal roughness H: amplitude ratio 2^-H between levels (1 smooth, 0 noise)")
+      ->add_option(
+          "--roughness", options->roughness,
+          "Fractal roughness H, no unit: amplitude ratio 2^-H between levels (1 smooth, 0 noise)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 4.0));
   add_common_options(*command, *common, true);
@@ -226,13 +235,14 @@ void add_terrain(CLI::App& generate) {
     Outcome outcome{"terrain",
                     summary.triangles,
                     summary.vertices,
-                    summary.parts,
+                    1,
                     summary.bounds,
                     " (" + std::to_string(summary.samples_per_side) + " x " +
                         std::to_string(summary.samples_per_side) + " samples)",
                     {}};
     outcome.details = {{"target_triangles", options->triangles},
                        {"samples_per_side", summary.samples_per_side},
+                       {"bands", summary.bands},
                        {"source_side", summary.source_side},
                        {"fractal_side", summary.fractal_side},
                        {"roughness", options->roughness}};
@@ -246,16 +256,25 @@ void add_object(CLI::App& generate) {
   auto seed = std::make_shared<std::optional<std::uint64_t>>();
   auto* command = generate.add_subcommand(
       "object",
-      "A flying object fitted into a cube of side 0.05 centred at the origin (its own frame):\n"
+      "A flying object fitted into a cube of side --size (model units; the default 0.05 is a\n"
+      "twentieth of the study's unit cube), centred at the origin (its own frame):\n"
       "up to 4 triangles a tetrahedron, up to 200 a UV sphere (116: the study's sphere), above\n"
       "that a real mesh simplified by CGAL edge collapses to about --triangles (the study:\n"
       "4, 116, 496, 2094, 5152, 14643). Without --seed the mesh with the fewest triangles\n"
       "at or above the request is used; with --seed a random one of those.");
-  command->add_option("--triangles", options->triangles, "Number of triangles (about)")
+  command->add_option("--triangles", options->triangles, "Number of triangles (a count, about)")
       ->capture_default_str()
       ->check(CLI::Range(std::uint64_t{1}, max_object_triangles));
+  command
+      ->add_option("--size", options->size,
+                   "Side of the cube the object is fitted into, in model units (match the "
+                   "environment's: e.g. 65 for a 1300 mm assembly)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   command->add_option("-o,--output", common->output, formats_help)->required();
-  command->add_option("--seed", *seed, "Pick a random real mesh (large objects only)");
+  command->add_option("--seed", *seed,
+                      "Pick a random real mesh (large objects only; a whole number). Default: "
+                      "the mesh with the fewest triangles at or above the request");
   command->add_option("--report", common->report, "Also write the figures as JSON to this file");
   add_meshes_option(*command, *common);
   command->callback([common, options, seed] {

@@ -1,5 +1,6 @@
 // `tetrapage mesh info|convert`: look at mesh files and convert between formats.
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -7,10 +8,10 @@
 
 #include "Commands.h"
 #include "TessellationArguments.h"
-#include "tetrapage/formats/FileChecks.h"
-#include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/MemoryUsage.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 
@@ -147,10 +148,11 @@ void run_convert(const ConvertArguments& args) {
   const double write_seconds = seconds_since(write_start);
   std::uint64_t degenerate = 0;
   for (const auto& report : reports) degenerate += report.degenerate_dropped;
+  const std::size_t parts = parts_in_file(args.output, soup.part_count());
   std::printf(
       "wrote %s: %zu triangles, %zu vertices, %zu parts (%llu degenerate dropped); "
       "read %.3f s, write %.3f s\n",
-      args.output.c_str(), soup.triangle_count(), soup.vertices.size(), soup.part_count(),
+      args.output.c_str(), soup.triangle_count(), soup.vertices.size(), parts,
       static_cast<unsigned long long>(degenerate), read_seconds, write_seconds);
   if (!args.report.empty()) {
     nlohmann::json inputs = nlohmann::json::array();
@@ -162,7 +164,8 @@ void run_convert(const ConvertArguments& args) {
                                {"output", args.output.string()},
                                {"triangles", soup.triangle_count()},
                                {"vertices", soup.vertices.size()},
-                               {"parts", soup.part_count()},
+                               {"parts", parts},
+                               {"input_parts", soup.part_count()},
                                {"degenerate_dropped", degenerate},
                                {"read_seconds", read_seconds},
                                {"write_seconds", write_seconds},
@@ -173,6 +176,15 @@ void run_convert(const ConvertArguments& args) {
 }
 
 }  // namespace
+
+std::size_t parts_in_file(const std::filesystem::path& output, std::size_t parts) {
+  if (parts <= 1 || mesh_format_keeps_parts(output)) return parts;
+  std::string format = output.extension().string().substr(1);
+  for (char& c : format) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  std::printf("%s: %s holds no parts: the %zu parts were merged into one\n", output.c_str(),
+              format.c_str(), parts);
+  return 1;
+}
 
 void add_mesh_commands(CLI::App& app) {
   auto* mesh = app.add_subcommand("mesh", "Inspect and convert mesh files and assembly manifests");
@@ -198,8 +210,10 @@ void add_mesh_commands(CLI::App& app) {
       "convert",
       "Read a mesh file (or an assembly manifest, .json) and write it in the format named by\n"
       "the output's extension: .obj, .ply (binary, double), .off (exact doubles), .stl\n"
-      "(binary, float), .gltf/.glb (float; one node per part). The output appears only when\n"
-      "complete.");
+      "(binary, float), .gltf/.glb (float), .json (a manifest, a PLY per part). Parts keep\n"
+      "their names in OBJ (`o`/`g`), PLY (a part table), glTF (a node each) and manifests;\n"
+      "STL and OFF hold none: a line says so when parts are merged. Triangles go part by\n"
+      "part. The output appears only when complete.");
   convert->add_option("input", convert_args->input, "Mesh file, STEP or IGES file, or manifest (.json)")
       ->required()
       ->check(CLI::ExistingFile);

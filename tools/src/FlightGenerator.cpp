@@ -1,9 +1,10 @@
 #include "tetrapage/tools/FlightGenerator.h"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "tetrapage/formats/Error.h"
@@ -35,6 +36,12 @@ Quaternion exp_map(const Vec3& w) {
 }
 
 double norm(const Vec3& v) { return std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]); }
+
+// The shortest text that reads back as the same double (a millimetre model's sizes survive).
+std::string number_text(double value) {
+  char text[32];
+  return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
+}
 
 Vec3 random_direction(Random& random) {
   for (;;) {
@@ -83,45 +90,91 @@ class OracleJudge final : public CollisionJudge {
 
 }  // namespace
 
+double flight_displacement(const FlightOptions& options, const BoundingBox& workspace) {
+  if (options.displacement) return *options.displacement;
+  return default_displacement_per_diagonal * norm(workspace.size());
+}
+
 Flight generate_billiard_flight(const ReferenceCollider& oracle, const FlightOptions& options,
                                 Progress& progress) {
   OracleJudge judge(oracle);
   return generate_billiard_flight(judge, options, progress);
 }
 
-Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& options, Progress& progress) {
-  if (options.steps == 0) throw InputError("flight: --steps must be at least 1");
-  if (!(options.displacement > 0.0) || !(options.max_rotation >= 0.0))
-    throw InputError("flight: displacement must be positive and rotation non-negative");
-  Random random(options.seed);
-  const BoundingBox& workspace = oracle.environment_bounds();
-  const double radius = oracle.object_radius();
+namespace {
+
+// The step length, once the object is known to fit the workspace.
+// @throw InputError when it does not, or for a step or rotation out of range.
+double checked_displacement(const CollisionJudge& judge, const FlightOptions& options) {
+  const BoundingBox& workspace = judge.environment_bounds();
+  const double radius = judge.object_radius();
   for (int a = 0; a < 3; ++a) {
     if (workspace.hi[a] - workspace.lo[a] <= 2.0 * radius)
-      throw InputError("flight: the object (radius " + std::to_string(radius) +
+      throw InputError("flight: the object (radius " + number_text(radius) +
                        ") does not fit inside the environment's bounding box along axis " +
-                       std::to_string(a));
+                       std::to_string(a) + " (" + number_text(workspace.hi[a] - workspace.lo[a]) +
+                       " wide)");
   }
+  const double displacement = flight_displacement(options, workspace);
+  if (!(displacement > 0.0) || !std::isfinite(displacement) || !(options.max_rotation >= 0.0))
+    throw InputError("flight: the displacement (" + number_text(displacement) +
+                     ") must be positive and the rotation (" + number_text(options.max_rotation) +
+                     ") non-negative");
+  return displacement;
+}
 
-  Flight flight;
-  flight.poses.reserve(options.steps);
-  flight.collides.reserve(options.steps);
-  flight.query_seconds.reserve(options.steps);
-
-  // A free start: random placements (centre at least the object's radius from the walls).
+// A free start: random placements (centre at least the object's radius from the walls).
+// @throw InputError when none is found within options.start_attempts.
+Pose free_start(CollisionJudge& judge, const FlightOptions& options, Random& random,
+                std::uint64_t& attempts) {
+  const BoundingBox& workspace = judge.environment_bounds();
+  const double radius = judge.object_radius();
   Pose pose;
-  bool found = false;
-  while (!found && flight.start_attempts < options.start_attempts) {
-    ++flight.start_attempts;
+  while (attempts < options.start_attempts) {
+    ++attempts;
     for (int a = 0; a < 3; ++a)
       pose.translation[a] = random.uniform(workspace.lo[a] + radius, workspace.hi[a] - radius);
     pose.rotation = random_rotation(random);
-    found = inside_workspace(oracle.object_bounds(pose), workspace) && !oracle.collides(pose);
+    if (inside_workspace(judge.object_bounds(pose), workspace) && !judge.collides(pose))
+      return pose;
   }
-  if (!found)
-    throw InputError("flight: no collision-free start placement found in " +
-                     std::to_string(options.start_attempts) + " random attempts (seed " +
-                     std::to_string(options.seed) + ")");
+  throw InputError("flight: no collision-free start placement found in " +
+                   std::to_string(options.start_attempts) + " random attempts (seed " +
+                   std::to_string(options.seed) + ")");
+}
+
+// The motion's random walk: direction and spin perturbed; the speed stays `displacement`,
+// the spin within options.max_rotation.
+void perturb(Vec3& velocity, Vec3& spin, double displacement, const FlightOptions& options,
+             Random& random) {
+  Vec3 v;
+  for (int a = 0; a < 3; ++a)
+    v[a] = velocity[a] + options.perturbation * displacement * random.normal();
+  const double n = norm(v);
+  if (n > 0.0)
+    for (int a = 0; a < 3; ++a) velocity[a] = v[a] / n * displacement;
+  for (int a = 0; a < 3; ++a)
+    spin[a] += options.perturbation * options.max_rotation * random.normal();
+  const double s = norm(spin);
+  if (s > options.max_rotation)
+    for (auto& c : spin) c *= options.max_rotation / s;
+}
+
+}  // namespace
+
+Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& options,
+                                Progress& progress) {
+  if (options.steps == 0) throw InputError("flight: --steps must be at least 1");
+  Random random(options.seed);
+  const BoundingBox& workspace = oracle.environment_bounds();
+  const double displacement = checked_displacement(oracle, options);
+
+  Flight flight;
+  flight.displacement = displacement;
+  flight.poses.reserve(options.steps);
+  flight.collides.reserve(options.steps);
+  flight.query_seconds.reserve(options.steps);
+  Pose pose = free_start(oracle, options, random, flight.start_attempts);
 
   const auto record = [&](const Pose& p, bool collides, double seconds) {
     flight.poses.push_back(p);
@@ -133,8 +186,8 @@ Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& opt
   record(pose, false, 0.0);
 
   Vec3 direction = random_direction(random);
-  Vec3 velocity{direction[0] * options.displacement, direction[1] * options.displacement,
-                direction[2] * options.displacement};
+  Vec3 velocity{direction[0] * displacement, direction[1] * displacement,
+                direction[2] * displacement};
   Vec3 spin = random_direction(random);
   const double initial_spin = random.uniform(0.0, options.max_rotation);
   for (auto& s : spin) s *= initial_spin;
@@ -143,20 +196,7 @@ Flight generate_billiard_flight(CollisionJudge& oracle, const FlightOptions& opt
   std::size_t boundary_streak = 0;
   std::size_t final_attempts = 0;
   while (flight.poses.size() < options.steps) {
-    if (!replay_reverse) {
-      // Perturb the motion: direction and spin random-walk; speed stays `displacement`.
-      Vec3 v;
-      for (int a = 0; a < 3; ++a)
-        v[a] = velocity[a] + options.perturbation * options.displacement * random.normal();
-      const double n = norm(v);
-      if (n > 0.0)
-        for (int a = 0; a < 3; ++a) velocity[a] = v[a] / n * options.displacement;
-      for (int a = 0; a < 3; ++a)
-        spin[a] += options.perturbation * options.max_rotation * random.normal();
-      const double s = norm(spin);
-      if (s > options.max_rotation)
-        for (auto& c : spin) c *= options.max_rotation / s;
-    }
+    if (!replay_reverse) perturb(velocity, spin, displacement, options, random);
     replay_reverse = false;
     const Pose candidate = moved(pose, velocity, spin);
     if (!inside_workspace(oracle.object_bounds(candidate), workspace)) {

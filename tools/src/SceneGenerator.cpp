@@ -204,6 +204,7 @@ SceneSummary generate_scene(const MeshLibrary& library, const SceneOptions& opti
   // Scratch, reused: the largest mesh's size at most, whatever the number of copies.
   std::vector<Vec3> placed, opened_vertices;
   std::vector<TriangleIndices> opened_triangles;
+  std::vector<std::size_t> copies_of(library.size(), 0);
   for (std::size_t k = 0; k < plan.size(); ++k) {
     const TriangleSoup& soup = library[plan[k].mesh].soup;
     std::span<const Vec3> vertices = soup.vertices;
@@ -221,7 +222,8 @@ SceneSummary generate_scene(const MeshLibrary& library, const SceneOptions& opti
     copy.placed = place_copy(vertices, copy.leaf, options.fill, random, placed);
     copy.triangles = triangles.size();
     copy.open = plan[k].open;
-    writer.add_part(placed, triangles);
+    writer.add_part(placed, triangles,
+                    library[copy.mesh].name + "#" + std::to_string(copies_of[copy.mesh]++));
 
     summary.triangles += copy.triangles;
     summary.vertices += placed.size();

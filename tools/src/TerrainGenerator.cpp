@@ -185,11 +185,16 @@ TerrainSummary generate_terrain(const TerrainOptions& options, MeshWriter& write
         triangles.push_back({index(i, j), index(i + 1, j), index(i + 1, j + 1)});
         triangles.push_back({index(i, j), index(i + 1, j + 1), index(i, j + 1)});
       }
-    writer.add_part(vertices, triangles);
+    // One surface, so one part: a reader finds its components across the bands' seams.
+    if (first_row == 0) {
+      writer.add_part(vertices, triangles, "terrain");
+    } else {
+      writer.extend_part(vertices, triangles);
+    }
     for (const auto& v : vertices) summary.bounds.extend(v);
     summary.vertices += vertices.size();
     summary.triangles += triangles.size();
-    summary.parts += 1;
+    summary.bands += 1;
     progress.advance(triangles.size());
   }
   return summary;

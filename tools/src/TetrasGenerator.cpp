@@ -91,7 +91,7 @@ TetrasSummary generate_tetras(const TetrasOptions& options, MeshWriter& writer,
     }
     // The volume is a fixed fraction of the box, far above rounding, so the sign is exact.
     if (six_volume < 0.0) std::swap(corners[0], corners[1]);
-    writer.add_part(corners, faces);
+    writer.add_part(corners, faces, "tetra#" + std::to_string(t));
 
     BoundingBox tetra_bounds;
     for (const auto& corner : corners) tetra_bounds.extend(corner);

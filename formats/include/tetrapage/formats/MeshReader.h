@@ -17,9 +17,21 @@ enum class MeshFormat { obj, stl, ply, off, gltf, glb, step, iges, assimp_other 
 /// @throw InputError if no reader handles that extension.
 MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 
-/// Reads one mesh file as one part (named by the file's stem; a glTF file gives one part per
-/// mesh node; a STEP or IGES file one per placed shape, tessellated as `tessellation` says:
-/// read_cad). Degenerate triangles (repeated indices, or exactly collinear corners) are
+/// Reads one mesh file. Parts: OBJ objects and groups (`o`, `g`) and the part table our PLY
+/// writer adds (MeshWriter.h) are parts, as are glTF mesh nodes and the placed shapes of a
+/// STEP or IGES file (tessellated as `tessellation` says: read_cad); anything else is one part
+/// named by the file's stem. OBJ: `o NAME` starts an object, `g NAME` a group in it; a face
+/// belongs to the part of its group (named by the group, path "object/group", or the group
+/// alone outside any object), else of its object (named by it), else to the part named by
+/// the file's stem. The same object and group met again continue their part, so a part's
+/// triangles need not be consecutive; a part exists from its first face on (a group without
+/// faces makes none); a name is the rest of its line, trimmed (`g a b` is one group "a b");
+/// `o` or `g` with no name ends the object or the group. Paths are made unique by appending
+/// "#2", "#3", ... Triangles keep the file's order: the id of a triangle is its position among
+/// the faces' triangles (each face fan-triangulated around its first corner: a face of n
+/// corners gives n - 2 consecutive triangles) less the degenerate triangles dropped before it
+/// (triangle_position() undoes that).
+/// Degenerate triangles (repeated indices, or exactly collinear corners) are
 /// dropped and counted in the report; polygons are fan-triangulated. Vertices are kept as the
 /// file stores them (STL corners are not merged; unused vertices stay). OBJ faces may only
 /// use vertices defined above them (as every OBJ exporter writes them). The report, if
@@ -41,6 +53,11 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = n
 /// @throw IoError if the file cannot be opened; FormatError if Assimp cannot import it
 ///        (its message is included); InputError as read_mesh.
 TriangleSoup read_mesh_with_assimp(const std::filesystem::path& path, ReadReport* report = nullptr);
+
+/// The position, among the triangles the reader made (the faces in file order, each
+/// fan-triangulated), of the kept triangle `id` of the soup read with `report`: `id` plus the
+/// dropped triangles at or before that position (report.dropped_positions).
+std::uint64_t triangle_position(const ReadReport& report, std::uint64_t id);
 
 /// True when the three corners are exactly collinear (or coincide): an exact predicate.
 bool is_degenerate_triangle(const Vec3& a, const Vec3& b, const Vec3& c);

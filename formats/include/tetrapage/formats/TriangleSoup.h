@@ -90,6 +90,10 @@ struct ReadReport {
   std::string format;                       ///< "obj", "stl", "ply", "off", "assimp:gltf", ...
   std::uint64_t triangles_read = 0;         ///< after fan-triangulating, degenerate ones included
   std::uint64_t degenerate_dropped = 0;     ///< zero area (exactly) or repeated indices
+  /// The dropped triangles' 0-based positions among the triangles_read (the file's faces in
+  /// order, each fan-triangulated), ascending; triangle_position() (MeshReader.h) maps a kept
+  /// triangle's id back to its position.
+  std::vector<std::uint64_t> dropped_positions;
   std::uint64_t polygons_triangulated = 0;  ///< faces with more than three corners
   std::uint64_t bytes = 0;                  ///< file size
   double seconds = 0.0;

@@ -6,6 +6,7 @@
 /// environment's bounding box (the workspace).
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "tetrapage/formats/Pose.h"
@@ -14,16 +15,27 @@
 
 namespace tetrapage {
 
+/// The default distance moved per step as a fraction of the diagonal of the environment's
+/// bounding box: the study's 0.005 in its unit cube (whose diagonal is sqrt(3)), about 1/346.
+inline constexpr double default_displacement_per_diagonal = 0.005 / 1.7320508075688772;
+
 struct FlightOptions {
   std::size_t steps = 10000;
   std::uint64_t seed = 1;
-  double displacement = 0.005;    ///< distance moved per step (the study's mean displacement)
+  /// Distance moved per step, in model units; by default default_displacement_per_diagonal
+  /// times the diagonal of the environment's bounding box, so that a model in millimetres
+  /// gets the steps it would in metres.
+  std::optional<double> displacement;
   double max_rotation = 0.05;     ///< radians per step at most
   double perturbation = 0.3;      ///< relative random change of the motion per step
   std::size_t start_attempts = 100000;  ///< random placements tried for a free start
 };
 
+/// The distance moved per step: options.displacement, else the default for the workspace.
+double flight_displacement(const FlightOptions& options, const BoundingBox& workspace);
+
 struct Flight {
+  double displacement = 0;  ///< the distance moved per step (flight_displacement)
   std::vector<Pose> poses;
   std::vector<std::uint8_t> collides;  ///< the oracle's answer for each pose
   std::uint64_t collisions = 0;

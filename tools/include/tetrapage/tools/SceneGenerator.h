@@ -92,7 +92,8 @@ std::vector<PlannedCopy> plan_scene_copies(const MeshLibrary& library, std::uint
 void check_scene_options(const SceneOptions& options);
 
 /// Generates a scene and appends its copies to `writer` (one part per copy, in the order of
-/// SceneSummary::copies); the caller commits. Deterministic: the same library, options and
+/// SceneSummary::copies, named "<mesh>#<n>" for the n-th copy of a mesh, from 0); the caller
+/// commits. Deterministic: the same library, options and
 /// seed give the same parts.
 /// @throw InputError for options out of range (names the option and the value).
 /// @throw IoError if the writer fails.

@@ -40,7 +40,7 @@ struct TerrainSummary {
   std::size_t fractal_side = 0;      ///< 2^k + 1, the diamond-square grid
   std::uint64_t triangles = 0;       ///< 2 (s-1)^2
   std::uint64_t vertices = 0;        ///< s^2 plus the rows repeated where bands meet
-  std::size_t parts = 0;             ///< bands of rows (one for s up to 725)
+  std::size_t bands = 0;             ///< bands of rows written (one for s up to 725), one part
   BoundingBox bounds;
 };
 
@@ -49,10 +49,10 @@ std::size_t terrain_samples_per_side(std::uint64_t triangles);
 
 /// Generates a terrain over [0,1]^2 with heights in [slab_low, slab_high] and appends it to
 /// `writer`; the caller commits. Each grid cell is split into two triangles along the same
-/// diagonal, every normal pointing up (+z). The surface is written in bands of at most 2^20
-/// triangles, each its own part (a band repeats the last row of vertices of the band below,
-/// so bands meet along identical edges without sharing vertex indices), so memory stays at
-/// the fractal grid plus one band (~24 MB). Deterministic.
+/// diagonal, every normal pointing up (+z). The surface is one part, "terrain", written in
+/// bands of at most 2^20 triangles (MeshWriter::extend_part; a band repeats the last row of
+/// vertices of the band below, so bands meet along identical edges without sharing vertex
+/// indices), so memory stays at the fractal grid plus one band (~24 MB). Deterministic.
 /// @throw InputError for options out of range (names the option and the value).
 /// @throw IoError if the writer fails.
 TerrainSummary generate_terrain(const TerrainOptions& options, MeshWriter& writer,

@@ -38,9 +38,9 @@ struct TetrasSummary {
   BoundingBox bounds;
 };
 
-/// Generates the tetras and appends them to `writer`, one part (4 vertices, 4 triangles) per
-/// tetrahedron; the caller commits. Each part's corners v0..v3 satisfy
-/// orient3d(v0, v1, v2, v3) > 0 and its faces face outward. Deterministic.
+/// Generates the tetras and appends them to `writer`, one part (4 vertices, 4 triangles,
+/// named "tetra#<k>", k from 0) per tetrahedron; the caller commits. Each part's corners v0..v3
+/// satisfy orient3d(v0, v1, v2, v3) > 0 and its faces face outward. Deterministic.
 /// @throw InputError for options out of range (names the option and the value).
 /// @throw IoError if the writer fails.
 TetrasSummary generate_tetras(const TetrasOptions& options, MeshWriter& writer,
