@@ -97,7 +97,7 @@ demo: build
 	$(TETRAPAGE) generate scene --triangles 1000000 --seed 1 -o $(DEMO_DIR)/scene.ply
 	$(TETRAPAGE) generate object --triangles 2000 -o $(DEMO_DIR)/object.ply
 	$(TETRAPAGE) generate flight --env $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
-	  --steps 10000 --seed 1 -o $(DEMO_DIR)/flight.csv --answers $(DEMO_DIR)/answers.csv \
+	  --steps 10000 --seed 1 --displacement 0.005 -o $(DEMO_DIR)/flight.csv --answers $(DEMO_DIR)/answers.csv \
 	  --report $(DEMO_DIR)/flight.json
 	$(TETRAPAGE) replay $(DEMO_DIR)/scene.ply --object $(DEMO_DIR)/object.ply \
 	  --path $(DEMO_DIR)/flight.csv --report $(DEMO_DIR)/replay.json

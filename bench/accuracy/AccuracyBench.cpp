@@ -373,6 +373,7 @@ int run(int argc, char** argv) {
   FlightOptions flight_options;
   flight_options.steps = steps;
   flight_options.seed = seed;
+  flight_options.displacement = 0.005;  // the study's step, as every published run used
   const Flight billiard = generate_billiard_flight(reference, flight_options);
   const Flight grazing = generate_grazing_flight(reference, billiard);
   std::cout << "billiard flight: " << billiard.poses.size() << " poses, " << billiard.collisions

@@ -32,7 +32,7 @@ ALL=$(python3 -c "print(int($SHARD_BYTES * 2 + (64 << 20)))")
 for SIZE in 4 116 500 2000 5000 15000; do
   [ -f "$OUT/object$SIZE.ply" ] || "$TETRAPAGE" generate object --triangles $SIZE -o "$OUT/object$SIZE.ply"
   [ -f "$OUT/flight$SIZE.csv" ] || "$TETRAPAGE" generate flight --env "$OUT/scene.ply" --object "$OUT/object$SIZE.ply" \
-    --steps "$STEPS" --seed $SIZE -o "$OUT/flight$SIZE.csv" --answers "$OUT/answers$SIZE.csv"
+    --steps "$STEPS" --seed $SIZE --displacement 0.005 -o "$OUT/flight$SIZE.csv" --answers "$OUT/answers$SIZE.csv"
   "$TETRAPAGE" replay "$OUT/scene.ply" --object "$OUT/object$SIZE.ply" --path "$OUT/flight$SIZE.csv" \
     --report "$OUT/replay$SIZE.json" > /dev/null 2>&1
   "$TETRAPAGE" fly "$OUT/scene.tpi" --object "$OUT/object$SIZE.ply" --path "$OUT/flight$SIZE.csv" \

@@ -216,7 +216,7 @@ for env in "${envs[@]}"; do
     if [ ! -f "$F.csv" ] || [ ! -f "$F.answers.csv" ]; then
       say "$name: flight of object $N, $STEPS steps (the oracle answers)"
       run "$F.log" "$TETRAPAGE" generate flight --env "$D/model.ply" --object "$OUT/objects/object$N.ply" \
-        --steps "$STEPS" --seed 1 -o "$F.tmp.csv" --answers "$F.answers.tmp.csv" --report "$F.json"
+        --steps "$STEPS" --seed 1 --displacement 0.005 -o "$F.tmp.csv" --answers "$F.answers.tmp.csv" --report "$F.json"
       mv "$F.answers.tmp.csv" "$F.answers.csv" && mv "$F.tmp.csv" "$F.csv"
     fi
   done

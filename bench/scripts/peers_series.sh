@@ -25,7 +25,7 @@ mkdir -p "$OUT"
 for SIZE in $SIZES; do
   [ -f "$OUT/object$SIZE.ply" ] || "$TETRAPAGE" generate object --triangles "$SIZE" -o "$OUT/object$SIZE.ply"
   [ -f "$OUT/flight$SIZE.csv" ] || "$TETRAPAGE" generate flight --env "$SCENE_DIR/scene.ply" \
-    --object "$OUT/object$SIZE.ply" --steps "$STEPS" --seed 1 -o "$OUT/flight$SIZE.csv" \
+    --object "$OUT/object$SIZE.ply" --steps "$STEPS" --seed 1 --displacement 0.005 -o "$OUT/flight$SIZE.csv" \
     --answers "$OUT/answers$SIZE.csv" --report "$OUT/flight$SIZE.json"
   for R in $(seq 1 "$REPEATS"); do
     "$BENCH" "$SCENE_DIR/scene.ply" "$OUT/object$SIZE.ply" "$OUT/flight$SIZE.csv" "$OUT/answers$SIZE.csv" \

@@ -51,7 +51,7 @@ for model in "${models[@]}"; do
   for size in $OBJECTS; do
     [ -f "$OUT/object$size.ply" ] || "$TETRAPAGE" generate object --triangles "$size" -o "$OUT/object$size.ply" > /dev/null
     [ -f "$D/flight$size.csv" ] || "$TETRAPAGE" generate flight --index "$D/model.tpi" --memory 1G \
-      --object "$OUT/object$size.ply" --steps "$STEPS" --seed "$size" -o "$D/flight$size.csv" \
+      --object "$OUT/object$size.ply" --steps "$STEPS" --seed "$size" --displacement 0.005 -o "$D/flight$size.csv" \
       --answers "$D/answers$size.csv" > "$D/flight$size.log" 2>&1
     fly() {  # fly NAME MEMORY [flags...]
       local name=$1 memory=$2; shift 2

@@ -238,6 +238,7 @@ json run_pair(Environment& env, const fs::path& object_file, std::uint64_t objec
   FlightOptions flight_options;
   flight_options.steps = o.steps;
   flight_options.seed = o.seed + object_triangles;
+  flight_options.displacement = 0.005;  // the study's step in its unit cube
   const Flight flight = generate_billiard_flight(oracle, flight_options);
   std::vector<std::uint8_t> surfaces(flight.poses.size());
   for (std::size_t i = 0; i < flight.poses.size(); ++i) surfaces[i] = oracle.surfaces_touch(flight.poses[i]) ? 1 : 0;

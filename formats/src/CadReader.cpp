@@ -38,6 +38,7 @@
 
 #include "PathSupport.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
 
@@ -51,22 +52,15 @@ std::mutex& translation_mutex() {
   return mutex;
 }
 
-// Rows of x -> R x + t, as a manifest's instances (the last row 0 0 0 1 left out).
-using Placement = std::array<double, 12>;
+// x -> R x + t, as a manifest's instances.
+using Placement = Transform;
 
 Placement placement_of(const TopLoc_Location& location) {
   const gp_Trsf transform = location.Transformation();
-  Placement rows{};
+  Placement rows = identity_transform();
   for (int row = 0; row < 3; ++row)
     for (int column = 0; column < 4; ++column) rows[4 * row + column] = transform.Value(row + 1, column + 1);
   return rows;
-}
-
-Vec3 place(const Placement& m, const Vec3& p) {
-  Vec3 out;
-  for (int row = 0; row < 3; ++row)
-    out[row] = (m[4 * row] * p[0] + m[4 * row + 1] * p[1] + m[4 * row + 2] * p[2]) + m[4 * row + 3];
-  return out;
 }
 
 std::string name_of(const TDF_Label& label) {
@@ -223,13 +217,6 @@ void tessellate_all(std::vector<Prototype>& prototypes, const TessellationOption
   progress.finish();
 }
 
-double scale_of(const Placement& m) {
-  double largest = 0;
-  for (int column = 0; column < 3; ++column)
-    largest = std::max(largest, std::hypot(m[column], m[4 + column], m[8 + column]));
-  return largest;
-}
-
 // Every instance placed: a part each (instances of a shape that failed are skipped or fail).
 TriangleSoup place_instances(const std::vector<Prototype>& prototypes, const std::vector<Instance>& instances,
                              const TessellationOptions& options, const std::string& file, ReadReport& report) {
@@ -248,9 +235,9 @@ TriangleSoup place_instances(const std::vector<Prototype>& prototypes, const std
       throw InputError(file + ": more vertices than a soup can index at part '" + instance.path + "'");
     const std::uint32_t part = soup.add_part(prototype.name, instance.path);
     const auto base = static_cast<std::uint32_t>(soup.vertices.size());
-    for (const Vec3& p : prototype.vertices) soup.vertices.push_back(place(instance.placement, p));
+    for (const Vec3& p : prototype.vertices) soup.vertices.push_back(apply_transform(instance.placement, p));
     report.tessellation_deflection =
-        std::max(report.tessellation_deflection, prototype.deflection * scale_of(instance.placement));
+        std::max(report.tessellation_deflection, prototype.deflection * largest_stretch(instance.placement));
     for (const TriangleIndices& t : prototype.triangles) {
       ++report.triangles_read;
       const TriangleIndices placed{t[0] + base, t[1] + base, t[2] + base};

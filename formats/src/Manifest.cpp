@@ -28,6 +28,32 @@ Transform identity_transform() {
   return {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
 }
 
+Transform compose_transforms(const Transform& a, const Transform& b) {
+  Transform result = identity_transform();
+  for (int row = 0; row < 3; ++row) {
+    for (int column = 0; column < 4; ++column) {
+      double sum = column == 3 ? a[4 * row + 3] : 0.0;
+      for (int k = 0; k < 3; ++k) sum += a[4 * row + k] * b[4 * k + column];
+      result[4 * row + column] = sum;
+    }
+  }
+  return result;
+}
+
+double largest_stretch(const Transform& m) {
+  double largest = 0;
+  for (int column = 0; column < 3; ++column)
+    largest = std::max(largest, std::hypot(m[column], m[4 + column], m[8 + column]));
+  return largest;
+}
+
+Vec3 apply_transform(const Transform& m, const Vec3& s) {
+  Vec3 p;
+  for (int row = 0; row < 3; ++row)
+    p[row] = (m[4 * row] * s[0] + m[4 * row + 1] * s[1] + m[4 * row + 2] * s[2]) + m[4 * row + 3];
+  return p;
+}
+
 double metres_per_unit(const std::string& unit) {
   static const std::map<std::string, double, std::less<>> units = {
       {"m", 1.0}, {"cm", 0.01}, {"mm", 0.001}, {"um", 1e-6}, {"in", 0.0254}, {"ft", 0.3048}};
@@ -413,19 +439,6 @@ struct PlacedEntry {
   std::vector<std::string> paths;      ///< each placement's instance path
 };
 
-/// a b, both affine.
-Transform compose(const Transform& a, const Transform& b) {
-  Transform result = identity_transform();
-  for (int row = 0; row < 3; ++row) {
-    for (int column = 0; column < 4; ++column) {
-      double sum = column == 3 ? a[4 * row + 3] : 0.0;
-      for (int k = 0; k < 3; ++k) sum += a[4 * row + k] * b[4 * k + column];
-      result[4 * row + column] = sum;
-    }
-  }
-  return result;
-}
-
 /// The mesh entry `entries` of `top` (InputPiece::entries), placed: from the top down, each
 /// level's instances compose with the placements above; a sub-assembly's unit scale is folded
 /// in after its instance. A top-level entry's instances are taken as they are.
@@ -439,7 +452,7 @@ PlacedEntry place_entry(const Manifest& top, std::span<const std::size_t> entrie
     for (std::size_t p = 0; p < placed.placements.size(); ++p) {
       for (std::size_t k = 0; k < part.instances.size(); ++k) {
         Transform t =
-            level == 0 ? part.instances[k] : compose(placed.placements[p], part.instances[k]);
+            level == 0 ? part.instances[k] : compose_transforms(placed.placements[p], part.instances[k]);
         if (part.assembly) {
           for (int row = 0; row < 3; ++row)
             for (int column = 0; column < 3; ++column) t[4 * row + column] *= part.unit_scale;
@@ -499,10 +512,7 @@ void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const 
       assembly.add_part(node(source.part_names[p]), path + "/" + node(source.part_path(p)));
   }
   for (const Vec3& v : source.vertices) {
-    const Vec3 s{v[0] * scale, v[1] * scale, v[2] * scale};
-    Vec3 p;
-    for (int row = 0; row < 3; ++row)
-      p[row] = (m[4 * row] * s[0] + m[4 * row + 1] * s[1] + m[4 * row + 2] * s[2]) + m[4 * row + 3];
+    const Vec3 p = apply_transform(m, {v[0] * scale, v[1] * scale, v[2] * scale});
     if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
       throw InputError(where + ": placing it overflows the coordinates");
     assembly.vertices.push_back(p);
@@ -519,14 +529,6 @@ void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const 
     assembly.triangles.push_back(p);
     assembly.part_of.push_back(part_base + source.part_of[t]);
   }
-}
-
-/// The largest factor by which a placement stretches a length.
-double largest_stretch(const Transform& m) {
-  double largest = 0;
-  for (int column = 0; column < 3; ++column)
-    largest = std::max(largest, std::hypot(m[column], m[4 + column], m[8 + column]));
-  return largest;
 }
 
 /// Reads the file of mesh entry `entries` once and appends all its placements; a

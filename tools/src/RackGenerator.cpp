@@ -138,12 +138,6 @@ BoundingBox placed_box(const BoundingBox& box, const Transform& m) {
   return out;
 }
 
-Vec3 apply_transform(const Transform& m, const Vec3& s) {
-  Vec3 p;
-  for (int row = 0; row < 3; ++row)
-    p[row] = (m[4 * row] * s[0] + m[4 * row + 1] * s[1] + m[4 * row + 2] * s[2]) + m[4 * row + 3];
-  return p;
-}
 
 RackPart read_rack_part(const std::filesystem::path& file,
                         const TessellationOptions& tessellation) {

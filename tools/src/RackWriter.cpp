@@ -29,19 +29,6 @@ std::array<double, 4> hamilton(const std::array<double, 4>& a, const std::array<
           a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
 }
 
-/// a b, both affine.
-Transform compose(const Transform& a, const Transform& b) {
-  Transform result = identity_transform();
-  for (int row = 0; row < 3; ++row) {
-    for (int column = 0; column < 4; ++column) {
-      double sum = column == 3 ? a[4 * row + 3] : 0.0;
-      for (int k = 0; k < 3; ++k) sum += a[4 * row + k] * b[4 * k + column];
-      result[4 * row + column] = sum;
-    }
-  }
-  return result;
-}
-
 std::string type_name(std::size_t type) {
   return type < 26 ? std::string("board_") + char('a' + type) : "board_" + std::to_string(type);
 }
@@ -104,7 +91,7 @@ nlohmann::json entries_json(const std::vector<BoardEntry>& entries, const std::s
     std::vector<Transform> placements;
     if (outer.empty()) placements = entry.instances;
     for (const Transform& o : outer)
-      for (const Transform& m : entry.instances) placements.push_back(compose(o, m));
+      for (const Transform& m : entry.instances) placements.push_back(compose_transforms(o, m));
     const std::filesystem::path file = entry.file.is_absolute() ? entry.file : folder / entry.file;
     parts.push_back({{"name", prefix + entry.name},
                      {"file", file.generic_string()},

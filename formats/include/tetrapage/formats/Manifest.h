@@ -44,6 +44,13 @@ namespace tetrapage {
 using Transform = std::array<double, 16>;
 /// The 4x4 identity.
 Transform identity_transform();
+/// a b (b applied first), both affine.
+Transform compose_transforms(const Transform& a, const Transform& b);
+/// (m0 sx + m1 sy + m2 sz) + m3 per row, in double without fused multiply-adds: the placement
+/// every loader uses, so that one point placed by one transform gives the same bits anywhere.
+Vec3 apply_transform(const Transform& m, const Vec3& s);
+/// The largest factor by which `m` stretches a length (its linear part's largest column norm).
+double largest_stretch(const Transform& m);
 
 struct Manifest;
 

@@ -112,8 +112,6 @@ struct RackSummary {
   std::uint64_t plug_triangles = 0;
 };
 
-/// (m0 sx + m1 sy + m2 sz) + m3 per row: the manifest loader's arithmetic.
-Vec3 apply_transform(const Transform& m, const Vec3& s);
 /// The box of `box`'s corners placed by `m`; for a quarter turn about z and a translation, the
 /// box of the placed vertices themselves (each coordinate is one negated or not, plus a term).
 BoundingBox placed_box(const BoundingBox& box, const Transform& m);
