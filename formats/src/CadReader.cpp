@@ -59,7 +59,8 @@ Placement placement_of(const TopLoc_Location& location) {
   const gp_Trsf transform = location.Transformation();
   Placement rows = identity_transform();
   for (int row = 0; row < 3; ++row)
-    for (int column = 0; column < 4; ++column) rows[4 * row + column] = transform.Value(row + 1, column + 1);
+    for (int column = 0; column < 4; ++column)
+      rows[4 * row + column] = transform.Value(row + 1, column + 1);
   return rows;
 }
 
@@ -88,7 +89,8 @@ struct Instance {
 // The document's free shapes walked depth first into prototypes and placed instances.
 class AssemblyWalk {
  public:
-  AssemblyWalk(const Handle(XCAFDoc_ShapeTool)& tool, std::string stem) : tool_(tool), stem_(std::move(stem)) {}
+  AssemblyWalk(const Handle(XCAFDoc_ShapeTool) & tool, std::string stem)
+      : tool_(tool), stem_(std::move(stem)) {}
 
   void walk_free_shapes() {
     TDF_LabelSequence roots;
@@ -96,7 +98,8 @@ class AssemblyWalk {
     std::vector<TDF_Label> labels;
     for (Standard_Integer i = 1; i <= roots.Length(); ++i) labels.push_back(roots.Value(i));
     const auto segments = sibling_segments(labels, {});
-    for (std::size_t i = 0; i < labels.size(); ++i) walk(labels[i], TopLoc_Location(), segments[i], 0);
+    for (std::size_t i = 0; i < labels.size(); ++i)
+      walk(labels[i], TopLoc_Location(), segments[i], 0);
   }
 
   std::vector<Prototype> prototypes;
@@ -122,8 +125,11 @@ class AssemblyWalk {
     return names;
   }
 
-  void walk(const TDF_Label& label, const TopLoc_Location& location, const std::string& path, int depth) {
-    if (depth > kMaxDepth) throw FormatError("assembly nested deeper than " + std::to_string(kMaxDepth) + " at '" + path + "'");
+  void walk(const TDF_Label& label, const TopLoc_Location& location, const std::string& path,
+            int depth) {
+    if (depth > kMaxDepth)
+      throw FormatError("assembly nested deeper than " + std::to_string(kMaxDepth) + " at '" +
+                        path + "'");
     if (!XCAFDoc_ShapeTool::IsAssembly(label)) {
       instances.push_back({prototype_of(label, path), placement_of(location), path});
       return;
@@ -139,7 +145,8 @@ class AssemblyWalk {
     }
     const auto segments = sibling_segments(children, referred);
     for (std::size_t i = 0; i < children.size(); ++i)
-      walk(referred[i], location * XCAFDoc_ShapeTool::GetLocation(children[i]), path + "/" + segments[i], depth + 1);
+      walk(referred[i], location * XCAFDoc_ShapeTool::GetLocation(children[i]),
+           path + "/" + segments[i], depth + 1);
   }
 
   std::size_t prototype_of(const TDF_Label& label, const std::string& path) {
@@ -164,7 +171,8 @@ void tessellate(Prototype& prototype, const TessellationOptions& options) {
   BRepBndLib::Add(prototype.shape, box);
   if (box.IsVoid()) return;  // no geometry: points or empty compounds
   const double diagonal = std::sqrt(box.SquareExtent());
-  prototype.deflection = options.relative_deflection ? options.deflection * diagonal : options.deflection;
+  prototype.deflection =
+      options.relative_deflection ? options.deflection * diagonal : options.deflection;
   if (!(prototype.deflection > 0)) {
     prototype.error = "its size gives a deflection of " + std::to_string(prototype.deflection);
     return;
@@ -176,7 +184,8 @@ void tessellate(Prototype& prototype, const TessellationOptions& options) {
     return;
   }
   std::size_t face_number = 0;
-  for (TopExp_Explorer faces(prototype.shape, TopAbs_FACE); faces.More(); faces.Next(), ++face_number) {
+  for (TopExp_Explorer faces(prototype.shape, TopAbs_FACE); faces.More();
+       faces.Next(), ++face_number) {
     const TopoDS_Face& face = TopoDS::Face(faces.Current());
     TopLoc_Location location;
     const Handle(Poly_Triangulation) mesh = BRep_Tool::Triangulation(face, location);
@@ -196,14 +205,16 @@ void tessellate(Prototype& prototype, const TessellationOptions& options) {
       Standard_Integer a = 0, b = 0, c = 0;
       mesh->Triangle(i).Get(a, b, c);
       if (reversed) std::swap(b, c);
-      prototype.triangles.push_back({base + std::uint32_t(a - 1), base + std::uint32_t(b - 1), base + std::uint32_t(c - 1)});
+      prototype.triangles.push_back(
+          {base + std::uint32_t(a - 1), base + std::uint32_t(b - 1), base + std::uint32_t(c - 1)});
     }
   }
 }
 
 void tessellate_all(std::vector<Prototype>& prototypes, const TessellationOptions& options,
                     const std::filesystem::path& path) {
-  Progress progress("tessellating " + path.filename().string(), prototypes.size(), options.show_progress);
+  Progress progress("tessellating " + path.filename().string(), prototypes.size(),
+                    options.show_progress);
   std::mutex progress_mutex;
   tbb::parallel_for(std::size_t(0), prototypes.size(), [&](std::size_t i) {
     try {
@@ -218,31 +229,38 @@ void tessellate_all(std::vector<Prototype>& prototypes, const TessellationOption
 }
 
 // Every instance placed: a part each (instances of a shape that failed are skipped or fail).
-TriangleSoup place_instances(const std::vector<Prototype>& prototypes, const std::vector<Instance>& instances,
-                             const TessellationOptions& options, const std::string& file, ReadReport& report) {
+TriangleSoup place_instances(const std::vector<Prototype>& prototypes,
+                             const std::vector<Instance>& instances,
+                             const TessellationOptions& options, const std::string& file,
+                             ReadReport& report) {
   TriangleSoup soup;
   for (const Instance& instance : instances) {
     const Prototype& prototype = prototypes[instance.prototype];
     if (!prototype.error.empty()) {
       if (!options.skip_bad_parts)
-        throw InputError(file + ": part '" + instance.path + "' (" + prototype.name + ") failed to tessellate: " +
-                         prototype.error + " (--skip-bad-parts leaves it out)");
+        throw InputError(file + ": part '" + instance.path + "' (" + prototype.name +
+                         ") failed to tessellate: " + prototype.error +
+                         " (--skip-bad-parts leaves it out)");
       report.skipped_parts.push_back(instance.path + ": " + prototype.error);
       continue;
     }
     if (prototype.triangles.empty()) continue;
-    if (soup.vertices.size() + prototype.vertices.size() > std::numeric_limits<std::uint32_t>::max())
-      throw InputError(file + ": more vertices than a soup can index at part '" + instance.path + "'");
+    if (soup.vertices.size() + prototype.vertices.size() >
+        std::numeric_limits<std::uint32_t>::max())
+      throw InputError(file + ": more vertices than a soup can index at part '" + instance.path +
+                       "'");
     const std::uint32_t part = soup.add_part(prototype.name, instance.path);
     const auto base = static_cast<std::uint32_t>(soup.vertices.size());
-    for (const Vec3& p : prototype.vertices) soup.vertices.push_back(apply_transform(instance.placement, p));
-    report.tessellation_deflection =
-        std::max(report.tessellation_deflection, prototype.deflection * largest_stretch(instance.placement));
+    for (const Vec3& p : prototype.vertices)
+      soup.vertices.push_back(apply_transform(instance.placement, p));
+    report.tessellation_deflection = std::max(
+        report.tessellation_deflection, prototype.deflection * largest_stretch(instance.placement));
     for (const TriangleIndices& t : prototype.triangles) {
       ++report.triangles_read;
       const TriangleIndices placed{t[0] + base, t[1] + base, t[2] + base};
       if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] ||
-          is_degenerate_triangle(soup.vertices[placed[0]], soup.vertices[placed[1]], soup.vertices[placed[2]])) {
+          is_degenerate_triangle(soup.vertices[placed[0]], soup.vertices[placed[1]],
+                                 soup.vertices[placed[2]])) {
         ++report.degenerate_dropped;
         continue;
       }
@@ -258,29 +276,28 @@ bool is_iges_path(const std::filesystem::path& path) {
   return extension == ".iges" || extension == ".igs";
 }
 
+// Reads the file with one of OCCT's XCAF readers and transfers it into `document`.
+template <class Reader>
+bool transfer(const std::string& file, const char* kind, Handle(TDocStd_Document) & document) {
+  Reader reader;
+  reader.SetNameMode(Standard_True);
+  if (reader.ReadFile(file.c_str()) != IFSelect_RetDone)
+    throw FormatError(file + ": OpenCASCADE cannot read it as " + kind);
+  return reader.Transfer(document);
+}
+
 // Translates the file into an XCAF document (under the translation lock).
 Handle(TDocStd_Document) translate(const std::filesystem::path& path, ReadReport& report) {
   const std::string file = path.string();
   Handle(XCAFApp_Application) application = XCAFApp_Application::GetApplication();
   Handle(TDocStd_Document) document;
   application->NewDocument("MDTV-XCAF", document);
-  bool translated = false;
-  if (is_iges_path(path)) {
-    report.format = "iges";
-    IGESCAFControl_Reader reader;
-    reader.SetNameMode(Standard_True);
-    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone)
-      throw FormatError(file + ": OpenCASCADE cannot read it as IGES");
-    translated = reader.Transfer(document);
-  } else {
-    report.format = "step";
-    STEPCAFControl_Reader reader;
-    reader.SetNameMode(Standard_True);
-    if (reader.ReadFile(file.c_str()) != IFSelect_RetDone)
-      throw FormatError(file + ": OpenCASCADE cannot read it as STEP");
-    translated = reader.Transfer(document);
-  }
-  if (!translated) throw FormatError(file + ": OpenCASCADE read it but could not translate its shapes");
+  report.format = is_iges_path(path) ? "iges" : "step";
+  const bool translated = is_iges_path(path)
+                              ? transfer<IGESCAFControl_Reader>(file, "IGES", document)
+                              : transfer<STEPCAFControl_Reader>(file, "STEP", document);
+  if (!translated)
+    throw FormatError(file + ": OpenCASCADE read it but could not translate its shapes");
   return document;
 }
 
@@ -299,7 +316,8 @@ bool is_cad_path(const std::filesystem::path& path) {
   return extension == ".step" || extension == ".stp" || extension == ".p21" || is_iges_path(path);
 }
 
-TriangleSoup read_cad(const std::filesystem::path& path, const TessellationOptions& options, ReadReport* report) {
+TriangleSoup read_cad(const std::filesystem::path& path, const TessellationOptions& options,
+                      ReadReport* report) {
   const auto start = std::chrono::steady_clock::now();
   ReadReport local;
   ReadReport& out = report != nullptr ? *report : local;
@@ -307,7 +325,8 @@ TriangleSoup read_cad(const std::filesystem::path& path, const TessellationOptio
   out.path = path.string();
   const std::string file = path.string();
   if (!(options.deflection > 0) || !std::isfinite(options.deflection))
-    throw InputError(file + ": the deflection must be a positive number, not " + std::to_string(options.deflection));
+    throw InputError(file + ": the deflection must be a positive number, not " +
+                     std::to_string(options.deflection));
   if (!(options.angular_deflection > 0) || !(options.angular_deflection <= 3.14159265358979))
     throw InputError(file + ": the angular deflection must be in (0, pi] radians, not " +
                      std::to_string(options.angular_deflection));
@@ -328,8 +347,8 @@ TriangleSoup read_cad(const std::filesystem::path& path, const TessellationOptio
       double metres_per_unit = 0.001;
       XCAFDoc_DocumentTool::GetLengthUnit(document, metres_per_unit);
       if (std::fabs(metres_per_unit - 0.001) > 1e-12)
-        throw FormatError(file + ": OpenCASCADE translated it into units of " + std::to_string(metres_per_unit) +
-                          " m, not millimetres");
+        throw FormatError(file + ": OpenCASCADE translated it into units of " +
+                          std::to_string(metres_per_unit) + " m, not millimetres");
       AssemblyWalk walk(XCAFDoc_DocumentTool::ShapeTool(document->Main()), path.stem().string());
       walk.walk_free_shapes();
       prototypes = std::move(walk.prototypes);
@@ -343,7 +362,8 @@ TriangleSoup read_cad(const std::filesystem::path& path, const TessellationOptio
   if (instances.empty()) throw InputError(file + ": the file holds no shape");
   tessellate_all(prototypes, options, path);
   TriangleSoup soup = place_instances(prototypes, instances, options, file, out);
-  if (soup.triangles.empty()) throw InputError(file + ": no triangle (no shape with faces was tessellated)");
+  if (soup.triangles.empty())
+    throw InputError(file + ": no triangle (no shape with faces was tessellated)");
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return soup;
 }

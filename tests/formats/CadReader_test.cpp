@@ -3,10 +3,10 @@
 // this test writes itself through OCCT's XCAF writer, whose placements and names it knows.
 
 #include <BRepBndLib.hxx>
-#include <BRepGProp.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepGProp.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <Bnd_Box.hxx>
@@ -52,7 +52,8 @@ double soup_area(const TriangleSoup& soup) {
   for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
     const auto [a, b, c] = soup.corners(t);
     const Vec3 u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-    area += 0.5 * std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]);
+    area += 0.5 * std::hypot(u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                             u[0] * v[1] - u[1] * v[0]);
   }
   return area;
 }
@@ -111,13 +112,12 @@ TEST_P(CadSamples, TessellationLiesWithinTheDeflectionOfTheExactShape) {
   EXPECT_EQ(soup.part_of.size(), soup.triangles.size());
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    OcctAndFreecadSamples, CadSamples,
-    ::testing::Values(SampleCase{kOcctData / "step" / "screw.step", true},
-                      SampleCase{kOcctData / "step" / "linkrods.step", true},
-                      SampleCase{kOcctData / "iges" / "bearing.iges", false},
-                      SampleCase{kFreecadIdf / "SOT23.stp", false},
-                      SampleCase{kFreecadIdf / "0603_SMD.stp", false}));
+INSTANTIATE_TEST_SUITE_P(OcctAndFreecadSamples, CadSamples,
+                         ::testing::Values(SampleCase{kOcctData / "step" / "screw.step", true},
+                                           SampleCase{kOcctData / "step" / "linkrods.step", true},
+                                           SampleCase{kOcctData / "iges" / "bearing.iges", false},
+                                           SampleCase{kFreecadIdf / "SOT23.stp", false},
+                                           SampleCase{kFreecadIdf / "0603_SMD.stp", false}));
 
 TEST(CadReader, AFinerDeflectionGivesMoreTrianglesCloserToTheArea) {
   const auto path = kOcctData / "step" / "screw.step";
@@ -132,7 +132,8 @@ TEST(CadReader, AFinerDeflectionGivesMoreTrianglesCloserToTheArea) {
   const TriangleSoup fine_soup = read_cad(path, fine, &fine_report);
   EXPECT_GT(fine_soup.triangle_count(), coarse_soup.triangle_count());
   EXPECT_LT(fine_report.tessellation_deflection, coarse_report.tessellation_deflection);
-  EXPECT_LT(std::fabs(soup_area(fine_soup) - properties.Mass()), std::fabs(soup_area(coarse_soup) - properties.Mass()));
+  EXPECT_LT(std::fabs(soup_area(fine_soup) - properties.Mass()),
+            std::fabs(soup_area(coarse_soup) - properties.Mass()));
   // An absolute deflection is used as given.
   TessellationOptions absolute;
   absolute.relative_deflection = false;
@@ -149,7 +150,8 @@ struct WrittenAssembly {
   std::vector<gp_Trsf> box_placements;  // world placements of the box instances, in mm
 };
 
-TDF_Label add_named(const Handle(XCAFDoc_ShapeTool)& tool, const TopoDS_Shape& shape, const char* name) {
+TDF_Label add_named(const Handle(XCAFDoc_ShapeTool) & tool, const TopoDS_Shape& shape,
+                    const char* name) {
   const TDF_Label label = tool->AddShape(shape, Standard_False);
   TDataStd_Name::Set(label, name);
   return label;
@@ -173,7 +175,8 @@ WrittenAssembly write_rack(const std::filesystem::path& folder, const char* unit
   const gp_Trsf u7_a = placement(0, 5, 5, 0), u7_b = placement(M_PI / 2, 60, 5, 0);
   TDataStd_Name::Set(tool->AddComponent(board, box, TopLoc_Location(u7_a)), "U7");
   TDataStd_Name::Set(tool->AddComponent(board, box, TopLoc_Location(u7_b)), "U7");
-  TDataStd_Name::Set(tool->AddComponent(board, cylinder, TopLoc_Location(placement(0, 30, 40, 0))), "J1");
+  TDataStd_Name::Set(tool->AddComponent(board, cylinder, TopLoc_Location(placement(0, 30, 40, 0))),
+                     "J1");
   tool->UpdateAssemblies();
   const TDF_Label rack = tool->NewShape();
   TDataStd_Name::Set(rack, "rack");
@@ -205,8 +208,9 @@ TEST(CadReader, AnAssemblyGivesEveryInstanceWithItsNamePathAndPlacement) {
     paths.insert(soup.part_path(p));
     if (soup.part_names[p] == "CHIP_10x20") boxes.push_back(p);
   }
-  EXPECT_EQ(paths, (std::set<std::string>{"rack/board_0/U7#0", "rack/board_0/U7#1", "rack/board_0/J1",
-                                          "rack/board_1/U7#0", "rack/board_1/U7#1", "rack/board_1/J1"}));
+  EXPECT_EQ(paths,
+            (std::set<std::string>{"rack/board_0/U7#0", "rack/board_0/U7#1", "rack/board_0/J1",
+                                   "rack/board_1/U7#0", "rack/board_1/U7#1", "rack/board_1/J1"}));
   ASSERT_EQ(boxes.size(), 4u);
   // Each box instance's vertices are the box's corners moved by the placement we wrote.
   for (std::size_t k = 0; k < boxes.size(); ++k) {
@@ -215,7 +219,8 @@ TEST(CadReader, AnAssemblyGivesEveryInstanceWithItsNamePathAndPlacement) {
       for (double y : {0.0, 20.0})
         for (double z : {0.0, 5.0}) {
           const gp_Pnt p = gp_Pnt(x, y, z).Transformed(written.box_placements[k]);
-          expected.insert({std::lround(p.X() * 1e6), std::lround(p.Y() * 1e6), std::lround(p.Z() * 1e6)});
+          expected.insert(
+              {std::lround(p.X() * 1e6), std::lround(p.Y() * 1e6), std::lround(p.Z() * 1e6)});
         }
     for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
       if (soup.part_of[t] != boxes[k]) continue;
@@ -252,7 +257,9 @@ std::filesystem::path write_with_bad_part(const std::filesystem::path& folder) {
   BRepBuilderAPI_MakeWire open_wire;
   open_wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(10, 0, 0)).Edge());
   open_wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(10, 0, 0), gp_Pnt(10, 10, 0)).Edge());
-  add_named(tool, BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ()), open_wire.Wire(), Standard_True).Shape(),
+  add_named(tool,
+            BRepBuilderAPI_MakeFace(gp_Pln(gp::Origin(), gp::DZ()), open_wire.Wire(), Standard_True)
+                .Shape(),
             "OPEN_FACE");
   STEPCAFControl_Writer writer;
   const auto path = folder / "bad_part.step";
@@ -269,14 +276,16 @@ TEST(CadReader, APartThatFailsToTessellateIsNamedOrSkipped) {
     ADD_FAILURE() << "read";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("OPEN_FACE"), std::string::npos) << error.what();
-    EXPECT_NE(std::string(error.what()).find("--skip-bad-parts"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("--skip-bad-parts"), std::string::npos)
+        << error.what();
   }
   TessellationOptions skip;
   skip.skip_bad_parts = true;
   ReadReport report;
   const TriangleSoup soup = read_cad(path, skip, &report);
   ASSERT_EQ(report.skipped_parts.size(), 1u);
-  EXPECT_NE(report.skipped_parts[0].find("OPEN_FACE"), std::string::npos) << report.skipped_parts[0];
+  EXPECT_NE(report.skipped_parts[0].find("OPEN_FACE"), std::string::npos)
+      << report.skipped_parts[0];
   ASSERT_EQ(soup.part_count(), 1u);
   EXPECT_EQ(soup.part_names[0], "GOOD");
   EXPECT_EQ(soup.triangle_count(), 12u);  // a box's six faces, two triangles each

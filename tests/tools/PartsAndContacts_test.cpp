@@ -31,7 +31,8 @@ namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 
 std::filesystem::path fresh_folder(const std::string& name) {
-  const auto folder = std::filesystem::path(TETRAPAGE_TEST_TMP) / (name + "-" + std::to_string(::getpid()));
+  const auto folder =
+      std::filesystem::path(TETRAPAGE_TEST_TMP) / (name + "-" + std::to_string(::getpid()));
   std::filesystem::remove_all(folder);
   std::filesystem::create_directories(folder);
   return folder;
@@ -68,10 +69,14 @@ std::vector<std::string> split_csv(const std::string& line) {
   bool quoted = false;
   for (std::size_t i = 0; i < line.size(); ++i) {
     const char c = line[i];
-    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"') fields.back() += '"', ++i;
-    else if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) fields.emplace_back();
-    else fields.back() += c;
+    if (quoted && c == '"' && i + 1 < line.size() && line[i + 1] == '"')
+      fields.back() += '"', ++i;
+    else if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted)
+      fields.emplace_back();
+    else
+      fields.back() += c;
   }
   return fields;
 }
@@ -86,8 +91,13 @@ std::vector<ContactRow> read_contacts(const std::filesystem::path& path) {
     const auto f = split_csv(line);
     EXPECT_EQ(f.size(), 10u) << line;
     if (f.size() != 10 || f[1] != "surface") continue;
-    rows.push_back({std::stoull(f[0]), std::stoull(f[5]), std::uint32_t(std::stoul(f[2])),
-                    std::uint32_t(std::stoul(f[6])), f[3], f[4], {std::stod(f[7]), std::stod(f[8]), std::stod(f[9])}});
+    rows.push_back({std::stoull(f[0]),
+                    std::stoull(f[5]),
+                    std::uint32_t(std::stoul(f[2])),
+                    std::uint32_t(std::stoul(f[6])),
+                    f[3],
+                    f[4],
+                    {std::stod(f[7]), std::stod(f[8]), std::stod(f[9])}});
   }
   return rows;
 }
@@ -103,18 +113,25 @@ TEST(PartsAndContacts, ContactsNameTheirPartsAndMatchBruteForce) {
   test::add_box(object, {-0.04, -0.04, -0.04}, {0.04, 0.04, 0.04});
   write_mesh(folder / "object.ply", object);
   std::string out;
-  ASSERT_EQ(test::run_cli("preprocess " + manifest.string() + " -o " + (folder / "a.tpi").string(), out), 0) << out;
-  ASSERT_EQ(test::run_cli("generate flight --env " + manifest.string() + " --object " + (folder / "object.ply").string() +
-                              " --steps 400 --seed 3 --displacement 0.02 -o " + (folder / "flight.csv").string() +
-                              " --answers " + (folder / "answers.csv").string(),
-                          out),
-            0)
+  ASSERT_EQ(
+      test::run_cli("preprocess " + manifest.string() + " -o " + (folder / "a.tpi").string(), out),
+      0)
       << out;
-  ASSERT_EQ(test::run_cli("fly " + (folder / "a.tpi").string() + " --object " + (folder / "object.ply").string() +
-                              " --path " + (folder / "flight.csv").string() + " --all-contacts --contacts " +
-                              (folder / "contacts.csv").string() + " --check " + (folder / "answers.csv").string(),
-                          out),
-            0)
+  ASSERT_EQ(
+      test::run_cli(
+          "generate flight --env " + manifest.string() + " --object " +
+              (folder / "object.ply").string() + " --steps 400 --seed 3 --displacement 0.02 -o " +
+              (folder / "flight.csv").string() + " --answers " + (folder / "answers.csv").string(),
+          out),
+      0)
+      << out;
+  ASSERT_EQ(
+      test::run_cli(
+          "fly " + (folder / "a.tpi").string() + " --object " + (folder / "object.ply").string() +
+              " --path " + (folder / "flight.csv").string() + " --all-contacts --contacts " +
+              (folder / "contacts.csv").string() + " --check " + (folder / "answers.csv").string(),
+          out),
+      0)
       << out;
 
   const TriangleSoup environment = load_inputs({manifest});
@@ -132,7 +149,9 @@ TEST(PartsAndContacts, ContactsNameTheirPartsAndMatchBruteForce) {
     std::array<Vec3, 3> placed = object.corners(row.object_triangle);
     for (Vec3& p : placed) p = apply_pose(poses[row.step], p);
     const Kernel::Point_3 point(row.point[0], row.point[1], row.point[2]);
-    EXPECT_LT(CGAL::squared_distance(point, to_kernel(environment.corners(row.environment_triangle))), 1e-24);
+    EXPECT_LT(
+        CGAL::squared_distance(point, to_kernel(environment.corners(row.environment_triangle))),
+        1e-24);
     EXPECT_LT(CGAL::squared_distance(point, to_kernel(placed)), 1e-24);
   }
   std::size_t steps_with_contacts = 0;
@@ -143,7 +162,8 @@ TEST(PartsAndContacts, ContactsNameTheirPartsAndMatchBruteForce) {
       for (Vec3& p : placed) p = apply_pose(poses[step], p);
       const auto placed_triangle = to_kernel(placed);
       for (std::uint64_t e = 0; e < environment.triangle_count(); ++e)
-        if (CGAL::do_intersect(placed_triangle, to_kernel(environment.corners(e)))) expected.insert({e, o});
+        if (CGAL::do_intersect(placed_triangle, to_kernel(environment.corners(e))))
+          expected.insert({e, o});
     }
     steps_with_contacts += !expected.empty();
     EXPECT_EQ(written[step], expected) << "step " << step;
@@ -180,11 +200,14 @@ TEST(PartsAndContacts, TheIndexKeepsPartsAndFindsTrianglesById) {
       EXPECT_EQ(index.component_part(stored->component), soup.part_of[id]) << id;
     }
     EXPECT_FALSE(index.stored_triangle(soup.triangle_count()));
-    ASSERT_EQ(test::run_cli("inspect " + (folder / "a.tpi").string() + " --stabbing-segments 0 --parts 0", out), 0);
+    ASSERT_EQ(
+        test::run_cli("inspect " + (folder / "a.tpi").string() + " --stabbing-segments 0 --parts 0",
+                      out),
+        0);
     EXPECT_NE(out.find("unit: mm"), std::string::npos) << out;
     for (std::uint32_t p = 0; p < soup.part_count(); ++p)
-      EXPECT_NE(out.find(soup.part_path(p) + " (" + soup.part_names[p] + "), " + std::to_string(triangles[p]) +
-                         " triangles"),
+      EXPECT_NE(out.find(soup.part_path(p) + " (" + soup.part_names[p] + "), " +
+                         std::to_string(triangles[p]) + " triangles"),
                 std::string::npos)
           << out;
   }
@@ -213,14 +236,16 @@ TEST(PartsAndContacts, TheIndexKeepsPartsAndFindsTrianglesById) {
   {
     const hid_t file = H5Fopen((folder / "a.tpi").c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
     ASSERT_GE(file, 0);
-    EXPECT_GE(H5Ldelete(file, schema::table_path(schema::table::part_triangles).c_str(), H5P_DEFAULT), 0);
+    EXPECT_GE(
+        H5Ldelete(file, schema::table_path(schema::table::part_triangles).c_str(), H5P_DEFAULT), 0);
     H5Fclose(file);
   }
   try {
     const CollisionIndex index(folder / "a.tpi");
     ADD_FAILURE() << "opened";
   } catch (const FormatError& error) {
-    EXPECT_NE(std::string(error.what()).find("rebuild the index"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("rebuild the index"), std::string::npos)
+        << error.what();
   }
 }
 

@@ -17,14 +17,18 @@ Epeck::Triangle_3 to_epeck(const std::array<Vec3, 3>& t) {
   return {{t[0][0], t[0][1], t[0][2]}, {t[1][0], t[1][1], t[1][2]}, {t[2][0], t[2][1], t[2][2]}};
 }
 
-Vec3 to_double(const Epeck::Point_3& p) { return {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())}; }
+Vec3 to_double(const Epeck::Point_3& p) {
+  return {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+}
 
 // A representative point of whatever the intersection is: a point, a segment's midpoint, the
 // centroid of a triangle or of a polygon's corners.
 struct RepresentativePoint {
   using result_type = Vec3;
   Vec3 operator()(const Epeck::Point_3& p) const { return to_double(p); }
-  Vec3 operator()(const Epeck::Segment_3& s) const { return to_double(CGAL::midpoint(s.source(), s.target())); }
+  Vec3 operator()(const Epeck::Segment_3& s) const {
+    return to_double(CGAL::midpoint(s.source(), s.target()));
+  }
   Vec3 operator()(const Epeck::Triangle_3& t) const { return to_double(CGAL::centroid(t)); }
   Vec3 operator()(const std::vector<Epeck::Point_3>& points) const {
     Epeck::FT x = 0, y = 0, z = 0;
@@ -50,7 +54,8 @@ std::string number_field(double value) {
 
 }  // namespace
 
-std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b) {
+std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a,
+                                                const std::array<Vec3, 3>& b) {
   const Epeck::Triangle_3 ta = to_epeck(a), tb = to_epeck(b);
   if (ta.is_degenerate() || tb.is_degenerate()) return std::nullopt;
   const auto result = CGAL::intersection(ta, tb);
@@ -58,7 +63,8 @@ std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a, co
   return boost::apply_visitor(RepresentativePoint{}, *result);
 }
 
-ContactFile::ContactFile(const std::filesystem::path& path, const CollisionIndex& index, const TriangleSoup& object)
+ContactFile::ContactFile(const std::filesystem::path& path, const CollisionIndex& index,
+                         const TriangleSoup& object)
     : path_(path), temporary_(path.string() + ".tmp"), index_(index), object_(object) {
   check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
   guard_.emplace(temporary_);
@@ -74,7 +80,8 @@ ContactFile::~ContactFile() {
   std::filesystem::remove(temporary_, ignored);
 }
 
-void ContactFile::write_row(std::uint64_t step, const char* kind, std::uint32_t part, const std::string& rest) {
+void ContactFile::write_row(std::uint64_t step, const char* kind, std::uint32_t part,
+                            const std::string& rest) {
   const IndexParts& parts = index_.parts();
   out_ << step << ',' << kind << ',' << part << ',' << csv_field(parts.name(part)) << ','
        << csv_field(parts.path(part)) << ',' << rest << '\n';
@@ -83,7 +90,9 @@ void ContactFile::write_row(std::uint64_t step, const char* kind, std::uint32_t 
 
 void ContactFile::write_step(std::uint64_t step, const Pose& pose, const QueryResult& result) {
   if (result.containment != Containment::none) {
-    write_row(step, result.containment == Containment::object_inside_obstacle ? "object_inside" : "obstacle_inside",
+    write_row(step,
+              result.containment == Containment::object_inside_obstacle ? "object_inside"
+                                                                        : "obstacle_inside",
               result.containing_part, ",,,,");
   }
   for (const Contact& contact : result.contacts) {
@@ -98,7 +107,8 @@ void ContactFile::write_step(std::uint64_t step, const Pose& pose, const QueryRe
       std::array<Vec3, 3> placed = object_.corners(contact.object_triangle);
       for (Vec3& p : placed) p = apply_pose(pose, p);
       if (const auto meet = triangle_intersection_point(stored->corners, placed))
-        point = number_field((*meet)[0]) + "," + number_field((*meet)[1]) + "," + number_field((*meet)[2]);
+        point = number_field((*meet)[0]) + "," + number_field((*meet)[1]) + "," +
+                number_field((*meet)[2]);
     }
     write_row(step, "surface", contact.environment_part,
               environment + "," + std::to_string(contact.object_triangle) + "," + point);
@@ -106,11 +116,13 @@ void ContactFile::write_step(std::uint64_t step, const Pose& pose, const QueryRe
 }
 
 void ContactFile::commit() {
-  if (!out_.flush()) throw IoError("cannot write contacts file '" + temporary_.string() + "' (disk full?)");
+  if (!out_.flush())
+    throw IoError("cannot write contacts file '" + temporary_.string() + "' (disk full?)");
   out_.close();
   std::error_code error;
   std::filesystem::rename(temporary_, path_, error);
-  if (error) throw IoError("cannot rename contacts file to '" + path_.string() + "': " + error.message());
+  if (error)
+    throw IoError("cannot rename contacts file to '" + path_.string() + "': " + error.message());
   committed_ = true;
 }
 

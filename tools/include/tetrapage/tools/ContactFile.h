@@ -23,12 +23,14 @@ namespace tetrapage {
 
 /// One point where two triangles meet (both closed), computed with CGAL's exact constructions
 /// and rounded to double; nullopt when they do not meet.
-std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a, const std::array<Vec3, 3>& b);
+std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a,
+                                                const std::array<Vec3, 3>& b);
 
 class ContactFile {
  public:
   /// Opens `path` under a temporary name. @throw IoError.
-  ContactFile(const std::filesystem::path& path, const CollisionIndex& index, const TriangleSoup& object);
+  ContactFile(const std::filesystem::path& path, const CollisionIndex& index,
+              const TriangleSoup& object);
   /// Removes the temporary unless commit() ran.
   ~ContactFile();
   ContactFile(const ContactFile&) = delete;
@@ -41,7 +43,8 @@ class ContactFile {
   void commit();
 
  private:
-  void write_row(std::uint64_t step, const char* kind, std::uint32_t part, const std::string& triangle_fields);
+  void write_row(std::uint64_t step, const char* kind, std::uint32_t part,
+                 const std::string& triangle_fields);
 
   std::filesystem::path path_, temporary_;
   std::optional<TemporaryFileGuard> guard_;
