@@ -461,6 +461,48 @@ TEST_F(CApiTest, BoundsAreTheModelsBox) {
   }
 }
 
+// Parts by name and path, the model's unit, and stored triangles by id, as the soup read back
+// holds them; strings are cut to fit and always terminated.
+TEST_F(CApiTest, PartsUnitAndTrianglesByIdAreTheModels) {
+  std::uint32_t parts = 0;
+  ASSERT_EQ(tetrapage_index_part_count(index_, &parts), TETRAPAGE_OK);
+  ASSERT_EQ(parts, environment_.part_count());
+  char text[256];
+  std::size_t length = 0;
+  for (std::uint32_t p = 0; p < parts; ++p) {
+    ASSERT_EQ(tetrapage_index_part_name(index_, p, text, sizeof text, &length), TETRAPAGE_OK);
+    EXPECT_EQ(std::string(text), environment_.part_names[p]);
+    EXPECT_EQ(length, environment_.part_names[p].size());
+    ASSERT_EQ(tetrapage_index_part_path(index_, p, text, sizeof text, &length), TETRAPAGE_OK);
+    EXPECT_EQ(std::string(text), environment_.part_path(p));
+  }
+  const std::string name = environment_.part_names[0];
+  ASSERT_GT(name.size(), 3u);
+  char small[4] = {'x', 'x', 'x', 'x'};
+  ASSERT_EQ(tetrapage_index_part_name(index_, 0, small, sizeof small, &length), TETRAPAGE_OK);
+  EXPECT_EQ(std::string(small), name.substr(0, 3));
+  EXPECT_EQ(length, name.size());
+  EXPECT_EQ(tetrapage_index_part_name(index_, 0, nullptr, 0, &length), TETRAPAGE_OK);
+  EXPECT_EQ(length, name.size());
+  EXPECT_EQ(tetrapage_index_part_name(index_, 0, text, sizeof text, nullptr), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(tetrapage_index_part_name(index_, parts, text, sizeof text, &length), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("no part"), std::string::npos) << tetrapage_last_error();
+  ASSERT_EQ(tetrapage_index_length_unit(index_, text, sizeof text, &length), TETRAPAGE_OK);
+  EXPECT_EQ(std::string(text), "");  // a plain mesh preprocessed without --unit
+
+  double corners[9];
+  std::uint32_t part = 0;
+  for (std::uint64_t id = 0; id < environment_.triangle_count(); ++id) {
+    ASSERT_EQ(tetrapage_index_triangle(index_, id, corners, &part), TETRAPAGE_OK) << tetrapage_last_error();
+    const auto expected = environment_.corners(id);
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) EXPECT_EQ(corners[3 * k + a], expected[k][a]) << id;
+    EXPECT_EQ(part, environment_.part_of[id]);
+  }
+  EXPECT_EQ(tetrapage_index_triangle(index_, environment_.triangle_count(), corners, &part), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_index_triangle(index_, 0, nullptr, &part), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+}
+
 // The answers of the C API are the C++ API's, and both are the brute force's, on random poses,
 // for the exact mode (first hit and all contacts) and a clearance.
 TEST_F(CApiTest, AnswersEqualTheCppApiAndBruteForce) {
