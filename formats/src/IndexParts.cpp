@@ -73,10 +73,4 @@ std::string IndexParts::path(std::uint32_t part) const {
   return slice(path_offsets_, paths_, part);
 }
 
-std::uint32_t IndexParts::find_path(const std::string& wanted) const {
-  for (std::uint32_t p = 0; p < count_; ++p)
-    if (path(p) == wanted) return p;
-  return std::uint32_t(count_);
-}
-
 }  // namespace tetrapage

@@ -96,9 +96,12 @@ nlohmann::json part_figures(const IndexReader& reader, std::size_t listed) {
   const std::size_t shown = listed == 0 ? parts.count() : std::min(listed, parts.count());
   nlohmann::json list = nlohmann::json::array();
   for (std::uint32_t p = 0; p < shown; ++p) {
-    std::printf("  part %u: %s (%s), %llu triangles\n", p, parts.path(p).c_str(), parts.name(p).c_str(),
-                (unsigned long long)parts.triangles(p));
-    list.push_back({{"part", p}, {"path", parts.path(p)}, {"name", parts.name(p)}, {"triangles", parts.triangles(p)}});
+    if (parts.named())
+      std::printf("  part %u: %s (%s), %llu triangles\n", p, parts.path(p).c_str(), parts.name(p).c_str(),
+                  (unsigned long long)parts.triangles(p));
+    else
+      std::printf("  part %u: %s (triangles not recorded)\n", p, parts.path(p).c_str());
+    list.push_back({{"part", p}, {"path", parts.path(p)}, {"name", parts.name(p)}, {"triangles", parts.named() ? nlohmann::json(parts.triangles(p)) : nlohmann::json(nullptr)}});
   }
   if (shown < parts.count()) std::printf("  ... %zu more (--parts 0 lists every part)\n", parts.count() - shown);
   return {{"length_unit", header.length_unit},

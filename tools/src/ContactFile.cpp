@@ -102,7 +102,11 @@ void ContactFile::write_step(std::uint64_t step, const Pose& pose, const QueryRe
       continue;
     }
     std::string point = ",,";
-    const auto stored = index_.stored_triangle(contact.environment_triangle);
+    if (contact.environment_triangle != last_id_) {
+      last_triangle_ = index_.stored_triangle(contact.environment_triangle);
+      last_id_ = contact.environment_triangle;
+    }
+    const auto& stored = last_triangle_;
     if (stored) {
       std::array<Vec3, 3> placed = object_.corners(contact.object_triangle);
       for (Vec3& p : placed) p = apply_pose(pose, p);

@@ -30,8 +30,6 @@ class IndexParts {
   std::uint64_t triangles(std::uint32_t part) const {
     return part < triangles_.size() ? triangles_[part] : 0;
   }
-  /// The first part whose path is `path`, or count() when none is.
-  std::uint32_t find_path(const std::string& path) const;
 
  private:
   std::size_t count_ = 0;

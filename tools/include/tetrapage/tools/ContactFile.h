@@ -51,6 +51,10 @@ class ContactFile {
   std::ofstream out_;
   const CollisionIndex& index_;
   const TriangleSoup& object_;
+  // The environment triangle of the last surface row: all_contacts lists one triangle's pairs
+  // together, and looking it up pages shards in.
+  std::uint64_t last_id_ = ~std::uint64_t{0};
+  std::optional<CollisionIndex::StoredTriangle> last_triangle_;
   std::uint64_t rows_ = 0;
   bool committed_ = false;
 };
