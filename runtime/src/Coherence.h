@@ -4,6 +4,7 @@
 /// pose and world box (swept motion, the motion's direction), and the free box, a box that
 /// meets no environment triangle, around the box of a free step.
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -47,6 +48,15 @@ class Coherence {
     return free_box_valid_ && box.lo[0] > free_box_.lo[0] && box.lo[1] > free_box_.lo[1] &&
            box.lo[2] > free_box_.lo[2] && box.hi[0] < free_box_.hi[0] &&
            box.hi[1] < free_box_.hi[1] && box.hi[2] < free_box_.hi[2];
+  }
+  /// How deep `box` lies inside the free box (its least distance to the free box's faces,
+  /// rounded down): no environment triangle is nearer to any point of `box`. 0 outside it.
+  double free_gap(const geometry::Box& box) const {
+    if (!in_free_box(box)) return 0;
+    double gap = box.lo[0] - free_box_.lo[0];
+    for (int a = 0; a < 3; ++a)
+      gap = std::min({gap, box.lo[a] - free_box_.lo[a], free_box_.hi[a] - box.hi[a]});
+    return gap * (1 - 0x1p-50);
   }
   /// The object turned out inside an obstacle: the free box is not free space.
   void drop_free_box() { free_box_valid_ = false; }

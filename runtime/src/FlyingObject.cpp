@@ -3,13 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "Coherence.h"
-#include "ContainmentCheck.h"
-#include "ObjectSolid.h"
+#include "FlyingObjectParts.h"
 #include "PhaseTwo.h"
-#include "PlacedObject.h"
-#include "PruningShapes.h"
-#include "SearchedRegion.h"
 #include "StepClock.h"
 #include "tetrapage/formats/Error.h"
 
@@ -59,18 +54,6 @@ double grow_to_phase_one_box(geometry::Box& box, const QueryOptions& options,
 }
 
 }  // namespace
-
-struct FlyingObject::Parts {
-  Parts(const CollisionIndex& index, const ObjectModel& model)
-      : object(model), region(index), containment(index, model) {}
-  PlacedObject object;           ///< step 1: the pose, the placed vertices, the world box
-  SearchedRegion region;         ///< steps 2 to 4: the walk, the box search, the shards' pins
-  Coherence coherence;           ///< the previous pose and box, and the free box
-  PruningShapes shapes;          ///< phase I's shapes, placed per step
-  ObjectSolid solid;             ///< per-step scratch: the object as a solid
-  ContainmentCheck containment;  ///< one body inside the other, for a step without contact
-  TriangleIdSet met_triangles;   ///< the triangles phase I has met this step
-};
 
 FlyingObject::FlyingObject(std::shared_ptr<const CollisionIndex> index, TriangleSoup object)
     : FlyingObject(std::move(index), std::make_shared<const ObjectModel>(std::move(object))) {}

@@ -24,6 +24,8 @@
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/BoxSearch.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DistanceQuery.h"
+#include "tetrapage/runtime/ImpactQuery.h"
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
 #include "tetrapage/runtime/TriangleIdSet.h"
@@ -164,6 +166,28 @@ class FlyingObject {
     query(pose, options, result);
     return result;
   }
+
+  /// The distance from the object at `pose` to the environment, with its closest points and
+  /// triangles (DistanceQuery.h). Whether it touches is decided first, exactly, as query()
+  /// decides it with the default options (contacts, and containment with the index's
+  /// interiors): then the distance is 0. Otherwise the search starts from the last step's
+  /// closest pair, and a free box farther than max_distance answers "farther" at once.
+  /// This is a step of the object like query(): it is the next step's previous pose.
+  /// @throw InputError for a negative or NaN max_distance, and what query() throws.
+  void distance(const Pose& pose, const DistanceOptions& options, DistanceResult& result);
+  DistanceResult distance(const Pose& pose, const DistanceOptions& options = {}) {
+    DistanceResult result;
+    distance(pose, options, result);
+    return result;
+  }
+
+  /// The first time in [0, 1] at which the object moving from `from` to `to` (PoseMotion.h)
+  /// touches the environment, by conservative advancement: distance queries along the motion,
+  /// each certifying the time the object needs to cover its lower bound at its speed bound,
+  /// and an exact collision query at the end of the bracket (ImpactQuery.h). Leaves the
+  /// object at the last pose it examined.
+  /// @throw InputError for a tolerance not in (0, 1], and what query() throws.
+  ImpactResult time_of_impact(const Pose& from, const Pose& to, const ImpactOptions& options = {});
 
   /// The world box of the object at `pose` (hill-climbing on the hull), slightly enlarged to
   /// cover the rounding of the placement.

@@ -10,6 +10,7 @@
 /// query answers exactly what the brute-force reference (the same test on every triangle)
 /// answers, in every accuracy mode.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -101,6 +102,65 @@ class ObjectBVH {
       }
       if (overlaps(nodes_[node.first])) stack[top++] = node.first;
       if (overlaps(nodes_[index + 1])) stack[top++] = index + 1;
+    }
+    if (counters) {
+      counters->nodes_visited += visited;
+      counters->triangle_tests += tests;
+    }
+  }
+
+  /// Calls visit(index) (index in the input) for every triangle whose box lies within
+  /// `reach()` of the closed `box` (object coordinates), nearer nodes first, until visit
+  /// returns false. `reach()` is asked again before each node and triangle: a visitor that
+  /// finds closer triangles shrinks it, and what lies beyond is pruned. Conservative: node
+  /// boxes are rounded outwards, and gaps are compared 2^-40 short of `reach()`.
+  template <class Reach, class Visit>
+  void for_each_near(const Box& box, Reach&& reach, Visit&& visit,
+                     QueryCounters* counters = nullptr) const {
+    auto squared_gap = [&box](const auto& lo, const auto& hi) {
+      double sum = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double gap = std::max({0.0, double(lo[k]) - box.hi[k], box.lo[k] - double(hi[k])});
+        sum += gap * gap;
+      }
+      return sum;
+    };
+    auto beyond = [&reach](double squared) {
+      const double r = reach();
+      return squared * (1 - 0x1p-40) > r * r;
+    };
+    std::uint64_t visited = 0, tests = 0;
+    struct Entry {
+      std::uint32_t node;
+      double squared_gap;
+    };
+    Entry stack[kMaxStack];
+    int top = 0;
+    stack[top++] = {0, squared_gap(nodes_[0].lo, nodes_[0].hi)};
+    while (top > 0) {
+      const Entry entry = stack[--top];
+      if (beyond(entry.squared_gap)) continue;
+      const Node& node = nodes_[entry.node];
+      ++visited;
+      if (node.count > 0) {
+        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
+          ++tests;
+          const Box own = box_of(triangles_[i]);
+          if (!beyond(squared_gap(own.lo, own.hi)) && !visit(original_[i])) {
+            top = 0;
+            break;
+          }
+        }
+        continue;
+      }
+      // The nearer child on top of the stack: it is searched first, and shrinks the reach.
+      const std::uint32_t left = entry.node + 1, right = node.first;
+      const Entry a{left, squared_gap(nodes_[left].lo, nodes_[left].hi)};
+      const Entry b{right, squared_gap(nodes_[right].lo, nodes_[right].hi)};
+      const Entry& near = a.squared_gap <= b.squared_gap ? a : b;
+      const Entry& far = a.squared_gap <= b.squared_gap ? b : a;
+      if (!beyond(far.squared_gap)) stack[top++] = far;
+      if (!beyond(near.squared_gap)) stack[top++] = near;
     }
     if (counters) {
       counters->nodes_visited += visited;

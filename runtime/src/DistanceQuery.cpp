@@ -1,0 +1,60 @@
+// FlyingObject::distance: the collision step decides touching; the distance search measures
+// the rest (DistanceSearch.h).
+
+#include <cmath>
+#include <string>
+
+#include "FlyingObjectParts.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/geometry/TriangleContact.h"
+
+namespace tetrapage {
+
+namespace {
+
+// A touching step's answer: distance 0, and for a contact a point both triangles share.
+void report_touching(const QueryResult& touch, const CollisionIndex& index, PlacedObject& object,
+                     DistanceResult& result) {
+  result.separation = Separation::touching;
+  result.distance = result.lower_bound = result.upper_bound = 0;
+  result.containment = touch.containment;
+  result.containing_part = touch.containing_part;
+  if (touch.contacts.empty()) return;
+  const Contact& contact = touch.contacts.front();
+  result.environment_triangle = contact.environment_triangle;
+  result.environment_part = contact.environment_part;
+  result.object_triangle = contact.object_triangle;
+  if (contact.object_triangle == Contact::kNoObjectTriangle) return;
+  const auto stored = index.stored_triangle(contact.environment_triangle);
+  if (!stored) return;
+  const geometry::ContactGeometry shared =
+      geometry::contact_geometry(stored->corners, object.world_triangle(contact.object_triangle));
+  if (shared.count == 0) return;
+  result.on_environment = result.on_object = shared.points[0];
+}
+
+}  // namespace
+
+void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,
+                            DistanceResult& result) {
+  if (!(options.max_distance >= 0))
+    throw InputError("distance query: max_distance must be >= 0, not " +
+                     std::to_string(options.max_distance));
+  Parts& parts = *parts_;
+  result = DistanceResult{};
+  // Touching is the collision query's exact answer (contacts and containment).
+  query(pose, QueryOptions{}, parts.touch);
+  if (parts.touch.collides) return report_touching(parts.touch, *index_, parts.object, result);
+  const geometry::Box& box = parts.coherence.current_box();
+  // In free space, the free box's depth bounds the distance: planners' "farther" is free.
+  if (const double gap = parts.coherence.free_gap(box); gap > options.max_distance) {
+    result.separation = Separation::farther;
+    result.distance = result.lower_bound = gap;
+    result.from_free_box = true;
+    return;
+  }
+  parts.distance.measure(*model_, parts.object, box, options.max_distance, result);
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,155 @@
+#include "DistanceSearch.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "tetrapage/runtime/Shard.h"
+
+namespace tetrapage {
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Far beyond the rounding of a gap computed in double: what the pruning tests leave out.
+bool beyond(double lower_bound, double reach) { return lower_bound * (1 - 0x1p-40) > reach; }
+
+}  // namespace
+
+void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
+                             const geometry::Box& world_box, double max_distance,
+                             DistanceResult& result) {
+  model_ = &model;
+  object_ = &object;
+  world_box_ = world_box;
+  result_ = &result;
+  reach_ = max_distance;
+  lowest_bound_ = kInfinity;
+  lowest_upper_ = kInfinity;
+  found_ = false;
+  if (has_last_) {
+    // The last closest pair, at this pose: an upper bound that usually confines the search to
+    // a thin shell around the object.
+    result.from_last_pair = true;
+    ++result.pair_tests;
+    const Pair last = last_;
+    offer(geometry::triangle_distance(last.environment, object.world_triangle(last.object_triangle)),
+          last.environment, last.environment_triangle, last.environment_part, last.object_triangle);
+  }
+  // Without a bound yet, a radius grown until it holds some triangle; then the triangles
+  // within the best distance found.
+  double radius = std::isfinite(reach_)
+                      ? reach_
+                      : std::max(0.25 * geometry::extent(world_box), std::numeric_limits<double>::min());
+  for (;;) {
+    const geometry::Box search_box = geometry::inflated(world_box, radius);
+    measure_within(search_box);
+    if (reach_ <= radius || geometry::box_contains(search_box, index_->mesh_bounds())) break;
+    radius = found_ ? reach_ : 2 * radius;
+  }
+  report(max_distance);
+}
+
+void DistanceSearch::report(double max_distance) {
+  DistanceResult& result = *result_;
+  if (!found_ || lowest_bound_ > max_distance) {
+    // Every pair within max_distance was measured: none is.
+    result.separation = Separation::farther;
+    result.distance = result.lower_bound = max_distance;
+    result.upper_bound = kInfinity;
+    has_last_ = found_;
+    if (found_) last_ = best_;
+    return;
+  }
+  result.separation = Separation::apart;
+  result.distance = best_.distance.distance;
+  result.lower_bound = std::min(lowest_bound_, result.distance);
+  result.upper_bound = std::max(lowest_upper_, result.distance);
+  result.on_environment = best_.distance.on_first;
+  result.on_object = best_.distance.on_second;
+  result.environment_triangle = best_.environment_triangle;
+  result.environment_part = best_.environment_part;
+  result.object_triangle = best_.object_triangle;
+  has_last_ = true;
+  last_ = best_;
+}
+
+void DistanceSearch::measure_within(const geometry::Box& search_box) {
+  met_.clear();
+  if (!geometry::boxes_overlap(search_box, index_->mesh_bounds())) return;
+  StepCounters ignored;
+  const bool located = region_.contains(search_box) || region_.search(search_box, std::nullopt, ignored);
+  if (!located) {
+    // The box's centre lies beyond the convex coarse mesh: its shards, by their bounds.
+    for (std::uint32_t shard = 0; shard < index_->shard_count(); ++shard) {
+      const geometry::Box& bounds = index_->shard_bounds(shard);
+      if (!geometry::boxes_overlap(search_box, bounds) ||
+          beyond(geometry::box_distance_lower_bound(bounds, world_box_), reach_))
+        continue;
+      const ShardPin pin = index_->cache().acquire(shard);
+      measure_shard(*pin, search_box);
+    }
+    return;
+  }
+  for (std::size_t k = 0; k < region_.size(); ++k) {
+    if (!geometry::boxes_overlap(search_box, region_.reach(k)) ||
+        beyond(geometry::box_distance_lower_bound(region_.reach(k), world_box_), reach_))
+      continue;
+    ShardPin local_pin;
+    measure_shard(region_.acquire(k, local_pin, ignored), search_box);
+  }
+}
+
+void DistanceSearch::measure_shard(const Shard& shard, const geometry::Box& search_box) {
+  // Exact and double copies of a triangle are the same in every shard: measured once.
+  const bool same_copies =
+      index_->stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
+  auto near = [this](const geometry::Box& node_box, std::uint32_t) {
+    return !beyond(geometry::box_distance_lower_bound(node_box, world_box_), reach_);
+  };
+  auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
+    const std::uint64_t id = shard.triangle_id(local);
+    if (same_copies && !met_.insert(id)) return;
+    if (beyond(geometry::box_distance_lower_bound(geometry::box_of(environment), world_box_), reach_))
+      return;
+    measure_triangle(environment, id, index_->component_part(shard.component_id(local)));
+  };
+  shard.for_each_box_candidate(search_box, near, visit);
+}
+
+void DistanceSearch::measure_triangle(const geometry::Triangle& environment, std::uint64_t id,
+                                      std::uint32_t part) {
+  ++result_->candidates;
+  // The triangle in the object's frame, its box grown far beyond the frame change's rounding:
+  // the BVH prunes by distances there, and every pair is measured on world coordinates.
+  geometry::Box framed;
+  double margin = 0;
+  for (const geometry::Point& corner : environment) {
+    framed.extend(object_->to_object_frame(corner));
+    margin = std::max(margin, object_->frame_margin(corner));
+  }
+  framed = geometry::inflated(framed, margin);
+  model_->bvh.for_each_near(
+      framed, [this] { return reach_; },
+      [&](std::uint32_t object_triangle) {
+        ++result_->pair_tests;
+        offer(geometry::triangle_distance(environment, object_->world_triangle(object_triangle)),
+              environment, id, part, object_triangle);
+        return true;
+      });
+}
+
+void DistanceSearch::offer(const geometry::TriangleDistance& distance,
+                           const geometry::Triangle& environment, std::uint64_t id,
+                           std::uint32_t part, std::uint32_t object_triangle) {
+  lowest_bound_ = std::min(lowest_bound_, distance.lower_bound);
+  lowest_upper_ = std::min(lowest_upper_, distance.upper_bound);
+  // No pair farther than a pair's upper bound can be the closest.
+  reach_ = std::min(reach_, distance.upper_bound);
+  if (found_ && distance.distance >= best_.distance.distance) return;
+  found_ = true;
+  best_ = {distance, environment, id, part, object_triangle};
+}
+
+}  // namespace tetrapage

@@ -1,0 +1,32 @@
+#pragma once
+/// @file FlyingObjectParts.h (private)
+/// The parts of a FlyingObject's runtime step, shared by its queries (collision, distance,
+/// time of impact).
+
+#include "Coherence.h"
+#include "ContainmentCheck.h"
+#include "DistanceSearch.h"
+#include "ObjectSolid.h"
+#include "PlacedObject.h"
+#include "PruningShapes.h"
+#include "SearchedRegion.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/TriangleIdSet.h"
+
+namespace tetrapage {
+
+struct FlyingObject::Parts {
+  Parts(const CollisionIndex& index, const ObjectModel& model)
+      : object(model), region(index), containment(index, model), distance(index) {}
+  PlacedObject object;           ///< step 1: the pose, the placed vertices, the world box
+  SearchedRegion region;         ///< steps 2 to 4: the walk, the box search, the shards' pins
+  Coherence coherence;           ///< the previous pose and box, and the free box
+  PruningShapes shapes;          ///< phase I's shapes, placed per step
+  ObjectSolid solid;             ///< per-step scratch: the object as a solid
+  ContainmentCheck containment;  ///< one body inside the other, for a step without contact
+  TriangleIdSet met_triangles;   ///< the triangles phase I has met this step
+  DistanceSearch distance;       ///< the closest pair, and the last one (coherence)
+  QueryResult touch;             ///< scratch: the collision step of a distance query
+};
+
+}  // namespace tetrapage
