@@ -537,3 +537,91 @@ tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
 }
 
 }  // extern "C"
+
+namespace {
+
+tetrapage::Pose pose_of(const double pose[7]) {
+  tetrapage::Pose placed;
+  placed.translation = {pose[0], pose[1], pose[2]};
+  placed.rotation = {pose[3], pose[4], pose[5], pose[6]};
+  return placed;
+}
+
+void copy_point(const tetrapage::geometry::Point& from, double to[3]) {
+  for (int a = 0; a < 3; ++a) to[a] = from[a];
+}
+
+}  // namespace
+
+extern "C" {
+
+tetrapage_status tetrapage_get_contact_geometry(tetrapage_object* object, size_t contact,
+                                                tetrapage_contact_geometry* geometry) {
+  return guarded(__func__, [&] {
+    const auto state = object_state(object);
+    require(geometry, "geometry");
+    *geometry = tetrapage_contact_geometry{};
+    const std::size_t count = state->has_result ? state->result.contacts.size() : 0;
+    if (contact >= count)
+      throw tetrapage::InputError("contact " + std::to_string(contact) + " of a query with " +
+                                  std::to_string(count) + " contacts");
+    const tetrapage::geometry::ContactGeometry meet =
+        state->flying.contact_geometry(state->result.contacts[contact]);
+    geometry->shape = int(meet.shape);
+    geometry->point_count = meet.count;
+    for (std::uint8_t i = 0; i < meet.count; ++i) copy_point(meet.points[i], geometry->points[i]);
+    copy_point(meet.first_normal, geometry->environment_normal);
+    copy_point(meet.second_normal, geometry->object_normal);
+  });
+}
+
+tetrapage_status tetrapage_distance_query(tetrapage_object* object, const double pose[7],
+                                          double max_distance, tetrapage_distance* result) {
+  return guarded(__func__, [&] {
+    const auto state = object_state(object);
+    state->has_result = false;
+    require(pose, "pose");
+    require(result, "result");
+    *result = tetrapage_distance{};
+    const tetrapage::DistanceResult found =
+        state->flying.distance(pose_of(pose), tetrapage::DistanceOptions{max_distance});
+    result->separation = int(found.separation);
+    result->distance = found.distance;
+    result->lower_bound = found.lower_bound;
+    result->upper_bound = found.upper_bound;
+    copy_point(found.on_environment, result->on_environment);
+    copy_point(found.on_object, result->on_object);
+    result->environment_triangle = found.environment_triangle;
+    result->environment_part = found.environment_part;
+    result->object_triangle = found.object_triangle;
+    result->containment = int(found.containment);
+    result->containing_part = found.containing_part;
+    result->pair_tests = found.pair_tests;
+  });
+}
+
+tetrapage_status tetrapage_time_of_impact(tetrapage_object* object, const double from[7],
+                                          const double to[7], double tolerance,
+                                          tetrapage_impact* result) {
+  return guarded(__func__, [&] {
+    const auto state = object_state(object);
+    state->has_result = false;
+    require(from, "from");
+    require(to, "to");
+    require(result, "result");
+    *result = tetrapage_impact{};
+    tetrapage::ImpactOptions options;
+    options.tolerance = tolerance;
+    const tetrapage::ImpactResult found = state->flying.time_of_impact(pose_of(from), pose_of(to), options);
+    result->impact = int(found.impact);
+    result->free_until = found.free_until;
+    result->contact_at = found.contact_at;
+    result->has_contact = found.has_contact ? 1 : 0;
+    result->environment_triangle = found.environment_triangle;
+    result->environment_part = found.environment_part;
+    result->object_triangle = found.object_triangle;
+    result->iterations = found.iterations;
+  });
+}
+
+}  // extern "C"

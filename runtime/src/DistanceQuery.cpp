@@ -13,9 +13,8 @@ namespace tetrapage {
 
 namespace {
 
-// A touching step's answer: distance 0, and for a contact a point both triangles share.
-void report_touching(const QueryResult& touch, const CollisionIndex& index, PlacedObject& object,
-                     DistanceResult& result) {
+// A touching step's answer: distance 0, and the first contact's pair.
+void report_touching(const QueryResult& touch, DistanceResult& result) {
   result.separation = Separation::touching;
   result.distance = result.lower_bound = result.upper_bound = 0;
   result.containment = touch.containment;
@@ -25,16 +24,22 @@ void report_touching(const QueryResult& touch, const CollisionIndex& index, Plac
   result.environment_triangle = contact.environment_triangle;
   result.environment_part = contact.environment_part;
   result.object_triangle = contact.object_triangle;
-  if (contact.object_triangle == Contact::kNoObjectTriangle) return;
-  const auto stored = index.stored_triangle(contact.environment_triangle);
-  if (!stored) return;
-  const geometry::ContactGeometry shared =
-      geometry::contact_geometry(stored->corners, object.world_triangle(contact.object_triangle));
-  if (shared.count == 0) return;
-  result.on_environment = result.on_object = shared.points[0];
 }
 
 }  // namespace
+
+geometry::ContactGeometry FlyingObject::contact_geometry(const Contact& contact) {
+  if (contact.object_triangle == Contact::kNoObjectTriangle) return {};
+  const auto stored = index_->stored_triangle(contact.environment_triangle);
+  if (!stored)
+    throw InputError("contact geometry: the index holds no triangle " +
+                     std::to_string(contact.environment_triangle));
+  if (contact.object_triangle >= model_->mesh.triangles.size())
+    throw InputError("contact geometry: the object has no triangle " +
+                     std::to_string(contact.object_triangle));
+  return geometry::contact_geometry(stored->corners,
+                                    parts_->object.world_triangle(contact.object_triangle));
+}
 
 void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,
                             DistanceResult& result) {
@@ -45,7 +50,15 @@ void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,
   result = DistanceResult{};
   // Touching is the collision query's exact answer (contacts and containment).
   query(pose, QueryOptions{}, parts.touch);
-  if (parts.touch.collides) return report_touching(parts.touch, *index_, parts.object, result);
+  if (parts.touch.collides) {
+    report_touching(parts.touch, result);
+    // The closest points: a point both triangles share.
+    if (!parts.touch.contacts.empty()) {
+      const geometry::ContactGeometry shared = contact_geometry(parts.touch.contacts.front());
+      if (shared.count > 0) result.on_environment = result.on_object = shared.points[0];
+    }
+    return;
+  }
   const geometry::Box& box = parts.coherence.current_box();
   // In free space, the free box's depth bounds the distance: planners' "farther" is free.
   if (const double gap = parts.coherence.free_gap(box); gap > options.max_distance) {

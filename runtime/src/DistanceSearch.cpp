@@ -28,6 +28,10 @@ void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
   lowest_bound_ = kInfinity;
   lowest_upper_ = kInfinity;
   found_ = false;
+  // The bounding ball prunes far better than the world box when the object is far away.
+  ball_centre_ = apply_pose(object.rotation(), object.translation(), model.ball_centre);
+  ball_radius_ = model.ball_radius * (1 + 0x1p-30) +
+                 (model.radius + model.ball_radius + object.translation_magnitude()) * 0x1p-40;
   if (has_last_) {
     // The last closest pair, at this pose: an upper bound that usually confines the search to
     // a thin shell around the object.
@@ -88,7 +92,8 @@ void DistanceSearch::measure_within(const geometry::Box& search_box) {
           beyond(geometry::box_distance_lower_bound(bounds, world_box_), reach_))
         continue;
       const ShardPin pin = index_->cache().acquire(shard);
-      measure_shard(*pin, search_box);
+      collect_shard(*pin, search_box);
+      measure_pending();
     }
     return;
   }
@@ -97,23 +102,43 @@ void DistanceSearch::measure_within(const geometry::Box& search_box) {
         beyond(geometry::box_distance_lower_bound(region_.reach(k), world_box_), reach_))
       continue;
     ShardPin local_pin;
-    measure_shard(region_.acquire(k, local_pin, ignored), search_box);
+    collect_shard(region_.acquire(k, local_pin, ignored), search_box);
+    measure_pending();
   }
 }
 
-void DistanceSearch::measure_shard(const Shard& shard, const geometry::Box& search_box) {
+double DistanceSearch::lower_bound_to(const geometry::Box& box) const {
+  geometry::Box ball;
+  for (int a = 0; a < 3; ++a) ball.lo[a] = ball.hi[a] = ball_centre_[a];
+  return std::max(geometry::box_distance_lower_bound(box, world_box_),
+                  geometry::box_distance_lower_bound(box, ball) - ball_radius_);
+}
+
+void DistanceSearch::measure_pending() {
+  // Nearest first: the reach shrinks soonest, and the rest is cut off at once.
+  std::sort(pending_.begin(), pending_.end(),
+            [](const Pending& a, const Pending& b) { return a.lower_bound < b.lower_bound; });
+  for (const Pending& candidate : pending_) {
+    if (beyond(candidate.lower_bound, reach_)) break;
+    if (geometry::triangle_outside_ball(candidate.environment, ball_centre_, ball_radius_ + reach_)) continue;
+    measure_triangle(candidate.environment, candidate.id, candidate.part);
+  }
+  pending_.clear();
+}
+
+void DistanceSearch::collect_shard(const Shard& shard, const geometry::Box& search_box) {
   // Exact and double copies of a triangle are the same in every shard: measured once.
   const bool same_copies =
       index_->stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
   auto near = [this](const geometry::Box& node_box, std::uint32_t) {
-    return !beyond(geometry::box_distance_lower_bound(node_box, world_box_), reach_);
+    return !beyond(lower_bound_to(node_box), reach_);
   };
   auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
     const std::uint64_t id = shard.triangle_id(local);
     if (same_copies && !met_.insert(id)) return;
-    if (beyond(geometry::box_distance_lower_bound(geometry::box_of(environment), world_box_), reach_))
-      return;
-    measure_triangle(environment, id, index_->component_part(shard.component_id(local)));
+    const double lower_bound = lower_bound_to(geometry::box_of(environment));
+    if (beyond(lower_bound, reach_)) return;
+    pending_.push_back({lower_bound, environment, id, index_->component_part(shard.component_id(local))});
   };
   shard.for_each_box_candidate(search_box, near, visit);
 }
@@ -133,9 +158,10 @@ void DistanceSearch::measure_triangle(const geometry::Triangle& environment, std
   model_->bvh.for_each_near(
       framed, [this] { return reach_; },
       [&](std::uint32_t object_triangle) {
+        const geometry::Triangle placed = object_->world_triangle(object_triangle);
+        if (geometry::farther_than_cheaply(environment, placed, reach_)) return true;
         ++result_->pair_tests;
-        offer(geometry::triangle_distance(environment, object_->world_triangle(object_triangle)),
-              environment, id, part, object_triangle);
+        offer(geometry::triangle_distance(environment, placed), environment, id, part, object_triangle);
         return true;
       });
 }

@@ -6,6 +6,7 @@
 /// grows its reach until a triangle is found.
 
 #include <cstdint>
+#include <vector>
 
 #include "PlacedObject.h"
 #include "SearchedRegion.h"
@@ -47,11 +48,25 @@ class DistanceSearch {
                         std::uint32_t part);
   void offer(const geometry::TriangleDistance& distance, const geometry::Triangle& environment,
              std::uint64_t id, std::uint32_t part, std::uint32_t object_triangle);
-  void measure_shard(const Shard& shard, const geometry::Box& search_box);
+  // Collects the shard's triangles that may lie within reach into pending_.
+  void collect_shard(const Shard& shard, const geometry::Box& search_box);
+  // Measures pending_ nearest first, until the next lies beyond the reach.
+  void measure_pending();
+  // A lower bound on the distance from the object to a box (its world box's and its ball's).
+  double lower_bound_to(const geometry::Box& box) const;
 
   const CollisionIndex* index_;
   SearchedRegion region_;
   TriangleIdSet met_;
+  struct Pending {
+    double lower_bound;
+    geometry::Triangle environment;
+    std::uint64_t id;
+    std::uint32_t part;
+  };
+  std::vector<Pending> pending_;  ///< the candidates of a search, measured nearest first
+  geometry::Point ball_centre_{};  ///< the object's bounding ball, placed
+  double ball_radius_ = 0;         ///< with the placement's rounding
   // The query in progress.
   const ObjectModel* model_ = nullptr;
   PlacedObject* object_ = nullptr;

@@ -163,12 +163,12 @@ TriangleDistance triangle_distance(const Triangle& a, const Triangle& b) {
   return result;
 }
 
-bool within_distance(const Triangle& a, const Triangle& b, double d) {
+bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d) {
   // Separated boxes: fl(lo - hi) (1 - 2u) is below the true axis gap.
   const Box box_a = box_of(a), box_b = box_of(b);
   for (int k = 0; k < 3; ++k) {
-    if ((box_b.lo[k] - box_a.hi[k]) * (1 - 2 * kUnit) > d) return false;
-    if ((box_a.lo[k] - box_b.hi[k]) * (1 - 2 * kUnit) > d) return false;
+    if ((box_b.lo[k] - box_a.hi[k]) * (1 - 2 * kUnit) > d) return true;
+    if ((box_a.lo[k] - box_b.hi[k]) * (1 - 2 * kUnit) > d) return true;
   }
   const Translated t = translate(a, b);
   // The triangles' own planes often separate by more than d: cheap and rigorous.
@@ -177,8 +177,12 @@ bool within_distance(const Triangle& a, const Triangle& b, double d) {
   const Vector minus_a{-normal_a[0], -normal_a[1], -normal_a[2]};
   const Vector minus_b{-normal_b[0], -normal_b[1], -normal_b[2]};
   for (const Vector* n : {&normal_a, &minus_a, &normal_b, &minus_b})
-    if (separation_lower_bound(t, *n) > d) return false;
-  return triangle_distance(a, b).lower_bound <= d;
+    if (separation_lower_bound(t, *n) > d) return true;
+  return false;
+}
+
+bool within_distance(const Triangle& a, const Triangle& b, double d) {
+  return !farther_than_cheaply(a, b, d) && triangle_distance(a, b).lower_bound <= d;
 }
 
 bool triangle_outside_ball(const Triangle& triangle, const Point& centre, double radius) {

@@ -581,6 +581,82 @@ TEST_F(CApiTest, AnswersEqualTheCppApiAndBruteForce) {
   tetrapage_object_destroy(object);
 }
 
+TEST_F(CApiTest, DistanceImpactAndContactGeometryEqualTheCppApi) {
+  Uniform uniform(27);
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  auto shared = std::make_shared<const CollisionIndex>(index_path_, CollisionIndexOptions{kBudget, true, 1});
+  FlyingObject reference(shared, small_object());
+  int touching = 0, apart = 0, geometries = 0;
+  std::array<double, 7> previous = random_pose(uniform);
+  for (int k = 0; k < 150; ++k) {
+    const auto p = random_pose(uniform);
+    SCOPED_TRACE("pose " + std::to_string(k));
+    tetrapage_distance distance;
+    ASSERT_EQ(tetrapage_distance_query(object, p.data(), INFINITY, &distance), TETRAPAGE_OK) << tetrapage_last_error();
+    const DistanceResult cpp = reference.distance(to_pose(p));
+    EXPECT_EQ(distance.separation, int(cpp.separation));
+    EXPECT_EQ(distance.distance, cpp.distance);
+    EXPECT_EQ(distance.lower_bound, cpp.lower_bound);
+    EXPECT_EQ(distance.upper_bound, cpp.upper_bound);
+    EXPECT_EQ(distance.environment_triangle, cpp.environment_triangle);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(distance.on_object[a], cpp.on_object[a]);
+    touching += distance.separation == 0;
+    apart += distance.separation == 1;
+    // Touching is what the collision query says; its contacts' geometry is the C++ API's.
+    int collides = -1;
+    ASSERT_EQ(tetrapage_query(object, p.data(), TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), TETRAPAGE_OK);
+    EXPECT_EQ(collides, distance.separation == 0 ? 1 : 0);
+    const QueryResult contacts = reference.query(to_pose(p), QueryOptions{{}, QueryMode::all_contacts});
+    std::size_t count = 0;
+    ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+    std::vector<tetrapage_contact> listed(count);
+    std::size_t written = 0;
+    ASSERT_EQ(tetrapage_get_contacts(object, listed.data(), count, &written), TETRAPAGE_OK);
+    for (std::size_t c = 0; c < written; ++c) {
+      tetrapage_contact_geometry geometry;
+      ASSERT_EQ(tetrapage_get_contact_geometry(object, c, &geometry), TETRAPAGE_OK) << tetrapage_last_error();
+      const Contact same{listed[c].environment_part, listed[c].environment_triangle, listed[c].object_triangle,
+                         listed[c].environment_component};
+      const geometry::ContactGeometry expected = reference.contact_geometry(same);
+      EXPECT_EQ(geometry.shape, int(expected.shape));
+      EXPECT_NE(geometry.shape, 0);
+      ASSERT_EQ(geometry.point_count, expected.count);
+      for (std::uint32_t i = 0; i < geometry.point_count; ++i)
+        for (int a = 0; a < 3; ++a) EXPECT_EQ(geometry.points[i][a], expected.points[i][a]);
+      ++geometries;
+    }
+    tetrapage_contact_geometry none;
+    EXPECT_EQ(tetrapage_get_contact_geometry(object, written, &none), TETRAPAGE_ERROR_INPUT);
+    // The motion from the previous pose: the C++ API's answer.
+    tetrapage_impact impact;
+    ASSERT_EQ(tetrapage_time_of_impact(object, previous.data(), p.data(), 1e-3, &impact), TETRAPAGE_OK)
+        << tetrapage_last_error();
+    ImpactOptions options;
+    options.tolerance = 1e-3;
+    const ImpactResult expected = reference.time_of_impact(to_pose(previous), to_pose(p), options);
+    EXPECT_EQ(impact.impact, int(expected.impact));
+    EXPECT_EQ(impact.free_until, expected.free_until);
+    EXPECT_EQ(impact.contact_at, expected.contact_at);
+    EXPECT_EQ(impact.environment_triangle, expected.environment_triangle);
+    previous = p;
+  }
+  EXPECT_GT(touching, 3);
+  EXPECT_GT(apart, 5);
+  EXPECT_GT(geometries, 3);
+  tetrapage_distance distance;
+  tetrapage_impact impact;
+  const double pose[7] = {0, 0, 0, 1, 0, 0, 0};
+  EXPECT_EQ(tetrapage_distance_query(object, pose, -1.0, &distance), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_distance_query(object, pose, NAN, &distance), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_distance_query(object, nullptr, 1.0, &distance), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(tetrapage_distance_query(object, pose, 1.0, nullptr), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(tetrapage_time_of_impact(object, pose, pose, 0.0, &impact), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_time_of_impact(object, pose, pose, 2.0, &impact), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_time_of_impact(object, pose, nullptr, 0.1, &impact), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  tetrapage_object_destroy(object);
+}
+
 TEST_F(CApiTest, ContactsCopyAPrefixWhenTheBufferIsSmall) {
   tetrapage_object* object = create_object();
   ASSERT_NE(object, nullptr);

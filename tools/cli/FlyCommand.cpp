@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <future>
+#include <limits>
 #include <optional>
 
 #include "Commands.h"
@@ -21,6 +22,7 @@
 #include "tetrapage/tools/AnswerCheck.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/LatencySummary.h"
+#include "tetrapage/tools/QueryAnswerFile.h"
 
 namespace tetrapage::cli {
 namespace {
@@ -32,6 +34,9 @@ struct FlyArguments {
   TessellationArguments tessellation;
   std::string memory = "256M";
   std::string accuracy = "exact";
+  std::string query = "collide";
+  double max_distance = std::numeric_limits<double>::infinity();
+  double toi_tolerance = 1e-4;
   bool all_contacts = false;
   bool no_prefetch = false;
   bool prefetch_ahead = false;
@@ -68,6 +73,79 @@ TriangleSoup load_object(const FlyArguments& args) {
   return object;
 }
 
+// One step of the query --query names, its answer row, and what its summary counts.
+class QueryStep {
+ public:
+  QueryStep(const FlyArguments& args, const QueryOptions& options, const CollisionIndex& index)
+      : query_(parse_fly_query(args.query)), options_(options) {
+    if (query_ == FlyQuery::contacts) options_.mode = QueryMode::all_contacts;
+    distance_options_.max_distance = args.max_distance;
+    impact_options_.tolerance = args.toi_tolerance;
+    if (query_ != FlyQuery::collide && !args.answers.empty()) answers_.emplace(args.answers, query_, index);
+  }
+  FlyQuery query() const { return query_; }
+  /// Whether the object collides at step i (touches; for toi, during the motion to pose i).
+  bool run(FlyingObject& object, std::span<const Pose> poses, std::size_t i) {
+    switch (query_) {
+      case FlyQuery::distance:
+        object.distance(poses[i], distance_options_, distance_);
+        ++separations_[int(distance_.separation)];
+        if (answers_) answers_->write_distance(i, distance_);
+        return distance_.separation == Separation::touching;
+      case FlyQuery::time_of_impact:
+        impact_ = i == 0 ? object.time_of_impact(poses[0], poses[0], impact_options_)
+                         : object.time_of_impact(poses[i - 1], poses[i], impact_options_);
+        ++impacts_[int(impact_.impact)];
+        iterations_ += impact_.iterations;
+        if (answers_) answers_->write_impact(i, impact_);
+        return impact_.impact == Impact::hit;
+      case FlyQuery::contacts:
+      case FlyQuery::collide:
+        break;
+    }
+    object.query(poses[i], options_, result);
+    if (answers_) answers_->write_contacts(i, object, result);
+    return result.collides;
+  }
+  /// The collision query's last result (collide and contacts).
+  QueryResult result;
+  void commit() {
+    if (answers_) answers_->commit();
+  }
+  /// What the summary and the report add for this query.
+  std::string summary(std::size_t steps) const {
+    char text[200] = "";
+    if (query_ == FlyQuery::distance)
+      std::snprintf(text, sizeof text, "distance: %llu touching, %llu apart, %llu farther than --max-distance",
+                    (unsigned long long)separations_[0], (unsigned long long)separations_[1],
+                    (unsigned long long)separations_[2]);
+    else if (query_ == FlyQuery::time_of_impact)
+      std::snprintf(text, sizeof text, "time of impact: %llu hits, %llu free motions, %llu unresolved; %.1f distance queries per step",
+                    (unsigned long long)impacts_[1], (unsigned long long)impacts_[0],
+                    (unsigned long long)impacts_[2], double(iterations_) / double(std::max<std::size_t>(1, steps)));
+    return text;
+  }
+  nlohmann::json report() const {
+    if (query_ == FlyQuery::distance)
+      return {{"touching", separations_[0]}, {"apart", separations_[1]}, {"farther", separations_[2]}};
+    if (query_ == FlyQuery::time_of_impact)
+      return {{"hits", impacts_[1]}, {"none", impacts_[0]}, {"unresolved", impacts_[2]}, {"distance_queries", iterations_}};
+    return nlohmann::json::object();
+  }
+
+ private:
+  FlyQuery query_;
+  QueryOptions options_;
+  DistanceOptions distance_options_;
+  ImpactOptions impact_options_;
+  DistanceResult distance_;
+  ImpactResult impact_;
+  std::optional<QueryAnswerFile> answers_;
+  std::uint64_t separations_[3] = {0, 0, 0};
+  std::uint64_t impacts_[3] = {0, 0, 0};
+  std::uint64_t iterations_ = 0;
+};
+
 void run_fly(const FlyArguments& args) {
   check_outputs_writable({args.answers, args.report, args.contacts}, {args.index, args.object, args.path, args.check});
   QueryOptions query_options;
@@ -102,7 +180,8 @@ void run_fly(const FlyArguments& args) {
     preload_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - preload_start).count();
     index->cache().reset_counters();
   }
-  QueryResult result;
+  QueryStep step(args, query_options, *index);
+  const QueryResult& result = step.result;
   double first_answer_seconds = 0;
 
   std::vector<std::uint8_t> answers(poses.size());
@@ -112,11 +191,10 @@ void run_fly(const FlyArguments& args) {
   Progress progress("flying", poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
-    object.query(poses[i], query_options, result);
+    answers[i] = step.run(object, poses, i) ? 1 : 0;
     const auto end = std::chrono::steady_clock::now();
     seconds[i] = std::chrono::duration<double>(end - start).count();
     if (i == 0) first_answer_seconds = std::chrono::duration<double>(end - open_start).count() - preload_seconds;
-    answers[i] = result.collides ? 1 : 0;
     collisions += answers[i];
     containments += result.containment != Containment::none ? 1 : 0;
     contacts += result.contacts.size();
@@ -138,8 +216,8 @@ void run_fly(const FlyArguments& args) {
   const double lookups = double(cache.hits + cache.misses);
   const double hit_rate = lookups > 0 ? double(cache.hits) / lookups : 1.0;
   const double steps = std::max<double>(1, double(poses.size()));
-  std::printf("fly (%s, %s): %zu steps, %llu collisions (%llu by containment: one body inside the other)%s\n",
-              args.accuracy.c_str(), args.no_prefetch ? "no prefetch" : "prefetch", poses.size(),
+  std::printf("fly (%s, %s, %s): %zu steps, %llu collisions (%llu by containment: one body inside the other)%s\n",
+              fly_query_name(step.query()), args.accuracy.c_str(), args.no_prefetch ? "no prefetch" : "prefetch", poses.size(),
               (unsigned long long)collisions, (unsigned long long)containments,
               index->has_interiors() ? "" : "; the index has no interiors: objects inside obstacles go unseen");
   std::printf("%s\n", storage_statement(index->header()).c_str());
@@ -154,7 +232,9 @@ void run_fly(const FlyArguments& args) {
   std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; peak RSS %s\n",
               double(tets_visited) / steps, double(shards_touched) / steps, double(candidates) / steps,
               double(triangle_tests) / steps, format_byte_size(peak_resident_bytes()).c_str());
-  if (!args.answers.empty()) write_answers(args.answers, answers);
+  if (const std::string summary = step.summary(poses.size()); !summary.empty()) std::printf("%s\n", summary.c_str());
+  if (step.query() == FlyQuery::collide && !args.answers.empty()) write_answers(args.answers, answers);
+  step.commit();
   if (contact_file) {
     contact_file->commit();
     std::printf("contacts: %llu rows written to %s\n", (unsigned long long)contact_file->rows(), args.contacts.c_str());
@@ -163,6 +243,8 @@ void run_fly(const FlyArguments& args) {
     write_report(args.report, {{"command", "fly"},
                                {"index", args.index.string()},
                                {"accuracy", args.accuracy},
+                               {"query", fly_query_name(step.query())},
+                               {"query_answers", step.report()},
                                {"prefetch", !args.no_prefetch},
                                {"prefetch_ahead", !args.no_prefetch && args.prefetch_ahead},
                                {"shard_arena", !args.no_shard_arena},
@@ -250,7 +332,22 @@ void add_fly_command(CLI::App& app) {
   command->add_flag("--preload", args->preload,
                     "Load every shard before the first step (needs --memory of at least the index's shards): "
                     "the all-resident reference; open-to-first-answer then excludes the preload");
-  command->add_option("--answers", args->answers, "Write the answers (CSV step,collides)");
+  command->add_option("--query", args->query,
+                      "What each step asks: collide (does the object touch?), contacts (every contact pair with "
+                      "where the triangles meet and their normals), distance (the distance and closest points, "
+                      "0 when touching), toi (the first time of contact during the motion from the previous pose, "
+                      "translation linear and rotation by slerp)")
+      ->capture_default_str();
+  command->add_option("--max-distance", args->max_distance,
+                      "--query distance: distances beyond this (index units) are answered only as 'farther' "
+                      "(cheap in free space); default: measure any distance");
+  command->add_option("--toi-tolerance", args->toi_tolerance,
+                      "--query toi: the width of the certified bracket of the contact time, in the motion's time "
+                      "[0, 1] between two poses")
+      ->capture_default_str();
+  command->add_option("--answers", args->answers,
+                      "Write the answers as CSV: step,collides for --query collide; one row per contact, or per "
+                      "step with the distance or the time of impact, for the other queries (docs/USAGE.md)");
   command->add_option("--check", args->check, "Compare with these answers; exit non-zero on any disagreement")
       ->check(CLI::ExistingFile);
   command->add_option("--report", args->report, "Write figures as JSON");

@@ -6,7 +6,6 @@
 #include <cstdio>
 
 #include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage {
 namespace {
@@ -38,20 +37,6 @@ struct RepresentativePoint {
   }
 };
 
-// A CSV field, quoted when it holds a comma, a quote or a line break.
-std::string csv_field(const std::string& text) {
-  if (text.find_first_of(",\"\n\r") == std::string::npos) return text;
-  std::string quoted = "\"";
-  for (const char c : text) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return quoted + "\"";
-}
-
-std::string number_field(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", value);
-  return text;
-}
-
 }  // namespace
 
 std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a,
@@ -65,27 +50,16 @@ std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a,
 
 ContactFile::ContactFile(const std::filesystem::path& path, const CollisionIndex& index,
                          const TriangleSoup& object)
-    : path_(path), temporary_(path.string() + ".tmp"), index_(index), object_(object) {
-  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
-  guard_.emplace(temporary_);
-  out_.open(temporary_, std::ios::binary);
-  if (!out_) throw IoError("cannot create contacts file '" + temporary_.string() + "'");
-  out_ << "step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z\n";
-}
-
-ContactFile::~ContactFile() {
-  if (committed_) return;
-  out_.close();
-  std::error_code ignored;
-  std::filesystem::remove(temporary_, ignored);
-}
+    : file_(path, "step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z",
+            "contacts file"),
+      index_(index),
+      object_(object) {}
 
 void ContactFile::write_row(std::uint64_t step, const char* kind, std::uint32_t part,
                             const std::string& rest) {
   const IndexParts& parts = index_.parts();
-  out_ << step << ',' << kind << ',' << part << ',' << csv_field(parts.name(part)) << ','
-       << csv_field(parts.path(part)) << ',' << rest << '\n';
-  ++rows_;
+  file_.row(std::to_string(step) + ',' + kind + ',' + std::to_string(part) + ',' +
+            csv_field(parts.name(part)) + ',' + csv_field(parts.path(part)) + ',' + rest);
 }
 
 void ContactFile::write_step(std::uint64_t step, const Pose& pose, const QueryResult& result) {
@@ -117,17 +91,6 @@ void ContactFile::write_step(std::uint64_t step, const Pose& pose, const QueryRe
     write_row(step, "surface", contact.environment_part,
               environment + "," + std::to_string(contact.object_triangle) + "," + point);
   }
-}
-
-void ContactFile::commit() {
-  if (!out_.flush())
-    throw IoError("cannot write contacts file '" + temporary_.string() + "' (disk full?)");
-  out_.close();
-  std::error_code error;
-  std::filesystem::rename(temporary_, path_, error);
-  if (error)
-    throw IoError("cannot rename contacts file to '" + path_.string() + "': " + error.message());
-  committed_ = true;
 }
 
 }  // namespace tetrapage

@@ -290,6 +290,79 @@ typedef struct tetrapage_query_info {
 tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
                                            tetrapage_query_info* info);
 
+/* ------------------------------------------------------------------------------------------ */
+/* Contact geometry, distance and time of impact                                              */
+
+/* Where the two triangles of a contact meet, and their normals. */
+typedef struct tetrapage_contact_geometry {
+  /* 0 none (a contact of a solid: no object triangle), 1 a point, 2 a segment, 3 a polygon
+     (coplanar triangles overlapping; corners in order). */
+  int shape;
+  uint32_t point_count; /* 1, 2 or 3 to 6 */
+  double points[6][3];
+  double environment_normal[3]; /* unit, right-hand rule of the triangle's corners */
+  double object_normal[3];
+} tetrapage_contact_geometry;
+
+/* The geometry of contact `contact` (an index < tetrapage_contact_count) of the object's last
+   query, at that query's pose. Computed in double from exactly decided topology: each point
+   lies within about 2^-44 of the coordinates' magnitude of the exact intersection.
+   Errors: TETRAPAGE_ERROR_INPUT (no such contact), TETRAPAGE_ERROR_IO / _FORMAT (the
+           triangle's shard could not be read), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_get_contact_geometry(tetrapage_object* object, size_t contact,
+                                                tetrapage_contact_geometry* geometry);
+
+/* The distance from the object at a pose to the environment. */
+typedef struct tetrapage_distance {
+  /* 0 touching (distance 0: surfaces meet, or one body holds the other: see containment),
+     1 apart, 2 farther than max_distance (not measured; lower_bound >= max_distance). */
+  int separation;
+  double distance;
+  /* The true distance lies in [lower_bound, upper_bound] (the double computation's error
+     bound); upper_bound is +infinity when farther. */
+  double lower_bound;
+  double upper_bound;
+  double on_environment[3]; /* the closest points (apart), or a shared point (touching) */
+  double on_object[3];
+  uint64_t environment_triangle; /* UINT64_MAX when none (farther, or a containment) */
+  uint32_t environment_part;
+  uint32_t object_triangle;
+  int containment; /* as tetrapage_query_info.containment */
+  uint32_t containing_part;
+  uint64_t pair_tests; /* triangle pairs measured */
+} tetrapage_distance;
+
+/* Places the object at `pose` (as tetrapage_query) and measures its distance to the
+   environment: exact touching decision first, then closest points within max_distance (pass
+   INFINITY to measure any distance). Consecutive poses of one object start from the last
+   closest pair. This is a query: it replaces the object's last contacts.
+   Errors: as tetrapage_query; TETRAPAGE_ERROR_INPUT for a negative or NaN max_distance. */
+tetrapage_status tetrapage_distance_query(tetrapage_object* object, const double pose[7],
+                                          double max_distance, tetrapage_distance* result);
+
+/* The first contact of the object moving from pose `from` to pose `to`. */
+typedef struct tetrapage_impact {
+  /* 0 none (certified: no contact during the motion), 1 hit, 2 unresolved (the iterations ran
+     out: no contact before free_until, nothing known after). */
+  int impact;
+  double free_until; /* no contact at any time in [0, free_until) */
+  double contact_at; /* a hit: the pose at this time touches; contact_at - free_until <= tolerance */
+  int has_contact;   /* the contact below is set (a hit by containment has none) */
+  uint64_t environment_triangle;
+  uint32_t environment_part;
+  uint32_t object_triangle;
+  uint32_t iterations; /* distance queries run */
+} tetrapage_impact;
+
+/* The time of impact over the motion from `from` to `to` (translation linear, rotation by
+   slerp over time [0, 1]) by conservative advancement, with a bracket of width `tolerance`
+   (in (0, 1]) closed by an exact collision query.
+   Errors: as tetrapage_query; TETRAPAGE_ERROR_INPUT for a tolerance outside (0, 1]. */
+tetrapage_status tetrapage_time_of_impact(tetrapage_object* object, const double from[7],
+                                          const double to[7], double tolerance,
+                                          tetrapage_impact* result);
+
 #ifdef __cplusplus
 }
 #endif

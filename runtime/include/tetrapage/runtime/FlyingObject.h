@@ -31,6 +31,7 @@
 #include "tetrapage/runtime/TriangleIdSet.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
+#include "tetrapage/runtime/geometry/TriangleContact.h"
 
 namespace tetrapage {
 
@@ -180,6 +181,13 @@ class FlyingObject {
     distance(pose, options, result);
     return result;
   }
+
+  /// The geometry of a contact of the last query (or distance query that touched), at its
+  /// pose: where the two triangles meet (a point, a segment, or a polygon when coplanar) and
+  /// both normals (TriangleContact.h), the environment's "first". Pages in the triangle's
+  /// shard if needed. A contact of a solid (no object triangle) has shape none.
+  /// @throw InputError for an environment triangle the index does not hold.
+  geometry::ContactGeometry contact_geometry(const Contact& contact);
 
   /// The first time in [0, 1] at which the object moving from `from` to `to` (PoseMotion.h)
   /// touches the environment, by conservative advancement: distance queries along the motion,

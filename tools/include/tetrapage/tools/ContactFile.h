@@ -14,10 +14,10 @@
 #include <optional>
 
 #include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/TemporaryFiles.h"
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/tools/CsvFile.h"
 
 namespace tetrapage {
 
@@ -28,35 +28,27 @@ std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a,
 
 class ContactFile {
  public:
-  /// Opens `path` under a temporary name. @throw IoError.
+  /// Opens `path` under a temporary name (removed unless commit() runs). @throw IoError.
   ContactFile(const std::filesystem::path& path, const CollisionIndex& index,
               const TriangleSoup& object);
-  /// Removes the temporary unless commit() ran.
-  ~ContactFile();
-  ContactFile(const ContactFile&) = delete;
-  ContactFile& operator=(const ContactFile&) = delete;
 
   /// The rows of one step's answer. @throw IoError; what the index throws paging a shard in.
   void write_step(std::uint64_t step, const Pose& pose, const QueryResult& result);
-  std::uint64_t rows() const { return rows_; }
+  std::uint64_t rows() const { return file_.rows(); }
   /// Flushes and renames the file into place. @throw IoError.
-  void commit();
+  void commit() { file_.commit(); }
 
  private:
   void write_row(std::uint64_t step, const char* kind, std::uint32_t part,
                  const std::string& triangle_fields);
 
-  std::filesystem::path path_, temporary_;
-  std::optional<TemporaryFileGuard> guard_;
-  std::ofstream out_;
+  CsvFile file_;
   const CollisionIndex& index_;
   const TriangleSoup& object_;
   // The environment triangle of the last surface row: all_contacts lists one triangle's pairs
   // together, and looking it up pages shards in.
   std::uint64_t last_id_ = ~std::uint64_t{0};
   std::optional<CollisionIndex::StoredTriangle> last_triangle_;
-  std::uint64_t rows_ = 0;
-  bool committed_ = false;
 };
 
 }  // namespace tetrapage

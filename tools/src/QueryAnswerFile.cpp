@@ -1,0 +1,125 @@
+#include "tetrapage/tools/QueryAnswerFile.h"
+
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage {
+
+namespace {
+
+const char* header_of(FlyQuery query) {
+  switch (query) {
+    case FlyQuery::contacts:
+      return "step,part,part_name,environment_triangle,object_triangle,shape,x1,y1,z1,x2,y2,z2,polygon,"
+             "environment_nx,environment_ny,environment_nz,object_nx,object_ny,object_nz";
+    case FlyQuery::distance:
+      return "step,distance,x1,y1,z1,x2,y2,z2,part,environment_triangle,object_triangle,separation,"
+             "lower_bound,upper_bound";
+    case FlyQuery::time_of_impact:
+      return "step,impact,free_until,contact_at,part,environment_triangle,object_triangle,iterations";
+    case FlyQuery::collide:
+      break;
+  }
+  throw InputError("fly: --query collide writes its answers as step,collides");
+}
+
+std::string point_fields(const geometry::Point& p) {
+  return number_field(p[0]) + ',' + number_field(p[1]) + ',' + number_field(p[2]);
+}
+
+const char* shape_name(geometry::ContactShape shape) {
+  switch (shape) {
+    case geometry::ContactShape::point: return "point";
+    case geometry::ContactShape::segment: return "segment";
+    case geometry::ContactShape::polygon: return "polygon";
+    case geometry::ContactShape::none: break;
+  }
+  return "none";
+}
+
+// The geometry columns of a contact row: shape, two points, the polygon, both normals.
+std::string geometry_fields(const geometry::ContactGeometry& meet) {
+  std::string fields(shape_name(meet.shape));
+  fields += ',';
+  fields += meet.count > 0 ? point_fields(meet.points[0]) : std::string(",,");
+  fields += ',';
+  fields += meet.count > 1 ? point_fields(meet.points[1]) : meet.count == 1 ? point_fields(meet.points[0]) : ",,";
+  fields += ',';
+  if (meet.shape == geometry::ContactShape::polygon)
+    for (std::uint8_t i = 0; i < meet.count; ++i) {
+      const geometry::Point& p = meet.points[i];
+      if (i > 0) fields += ';';
+      fields.append(number_field(p[0])).append(" ").append(number_field(p[1])).append(" ").append(number_field(p[2]));
+    }
+  return fields + ',' + point_fields(meet.first_normal) + ',' + point_fields(meet.second_normal);
+}
+
+}  // namespace
+
+FlyQuery parse_fly_query(const std::string& text) {
+  if (text == "collide") return FlyQuery::collide;
+  if (text == "contacts") return FlyQuery::contacts;
+  if (text == "distance") return FlyQuery::distance;
+  if (text == "toi") return FlyQuery::time_of_impact;
+  throw InputError("--query must be collide, contacts, distance or toi, not '" + text + "'");
+}
+
+const char* fly_query_name(FlyQuery query) {
+  switch (query) {
+    case FlyQuery::collide: return "collide";
+    case FlyQuery::contacts: return "contacts";
+    case FlyQuery::distance: return "distance";
+    case FlyQuery::time_of_impact: return "toi";
+  }
+  return "collide";
+}
+
+QueryAnswerFile::QueryAnswerFile(const std::filesystem::path& path, FlyQuery query,
+                                 const CollisionIndex& index)
+    : file_(path, header_of(query), "answers file"), index_(index) {}
+
+void QueryAnswerFile::write_contacts(std::uint64_t step, FlyingObject& object, const QueryResult& result) {
+  const IndexParts& parts = index_.parts();
+  for (const Contact& contact : result.contacts) {
+    std::string row = std::to_string(step) + ',' + std::to_string(contact.environment_part) + ',' +
+                      csv_field(parts.name(contact.environment_part)) + ',' +
+                      std::to_string(contact.environment_triangle) + ',';
+    if (contact.object_triangle == Contact::kNoObjectTriangle)
+      row.append(",solid,,,,,,,,,,,,,");
+    else
+      row += std::to_string(contact.object_triangle) + ',' + geometry_fields(object.contact_geometry(contact));
+    file_.row(row);
+  }
+}
+
+void QueryAnswerFile::write_distance(std::uint64_t step, const DistanceResult& result) {
+  static constexpr const char* kSeparation[] = {"touching", "apart", "farther"};
+  const bool has_pair = result.environment_triangle != DistanceResult::kNoTriangle;
+  const bool has_points = result.separation == Separation::apart ||
+                          (result.separation == Separation::touching && has_pair &&
+                           result.object_triangle != Contact::kNoObjectTriangle);
+  std::string row = std::to_string(step) + ',' + number_field(result.distance) + ',';
+  row += has_points ? point_fields(result.on_environment) + ',' + point_fields(result.on_object) : ",,,,,";
+  row += ',';
+  row += has_pair ? std::to_string(result.environment_part) + ',' + std::to_string(result.environment_triangle) + ',' +
+                        (result.object_triangle == Contact::kNoObjectTriangle ? std::string()
+                                                                               : std::to_string(result.object_triangle))
+                  : std::string(",,");
+  row += std::string(",") + kSeparation[int(result.separation)] + ',' + number_field(result.lower_bound) + ',' +
+         number_field(result.upper_bound);
+  file_.row(row);
+}
+
+void QueryAnswerFile::write_impact(std::uint64_t step, const ImpactResult& result) {
+  static constexpr const char* kImpact[] = {"none", "hit", "unresolved"};
+  std::string row = std::to_string(step) + ',' + kImpact[int(result.impact)] + ',' +
+                    number_field(result.free_until) + ',' + number_field(result.contact_at) + ',';
+  row += result.has_contact ? std::to_string(result.environment_part) + ',' +
+                                  std::to_string(result.environment_triangle) + ',' +
+                                  (result.object_triangle == Contact::kNoObjectTriangle
+                                       ? std::string()
+                                       : std::to_string(result.object_triangle))
+                            : std::string(",,");
+  file_.row(row + ',' + std::to_string(result.iterations));
+}
+
+}  // namespace tetrapage
