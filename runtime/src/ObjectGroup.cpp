@@ -10,54 +10,11 @@
 #include "PlacedObject.h"
 #include "StepClock.h"
 #include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/geometry/TriangleBox.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 
 namespace tetrapage {
 
 namespace {
-
-geometry::Box intersection_of(const geometry::Box& a, const geometry::Box& b) {
-  geometry::Box out;
-  for (int k = 0; k < 3; ++k) {
-    out.lo[k] = std::max(a.lo[k], b.lo[k]);
-    out.hi[k] = std::min(a.hi[k], b.hi[k]);
-  }
-  return out;
-}
-
-// How far a world point may move when the object's frame change rounds it: far beyond the
-// rounding of to_object_frame and of apply_pose (the box it grows only prunes).
-double frame_rounding(const ObjectModel& model, const PlacedObject& placed,
-                      const geometry::Point& p) {
-  double magnitude = model.radius;
-  for (int a = 0; a < 3; ++a)
-    magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(placed.translation()[a]));
-  return magnitude * 0x1p-40;
-}
-
-// The world points taken into the object's frame: the box of their images, grown beyond the
-// rounding. Every object triangle whose placed copy meets the points' hull lies in it.
-template <std::size_t N>
-geometry::Box box_in_frame(const std::array<geometry::Point, N>& points, const ObjectModel& model,
-                           const PlacedObject& placed) {
-  geometry::Box framed;
-  double grow = 0;
-  for (const auto& p : points) {
-    framed.extend(placed.to_object_frame(p));
-    grow = std::max(grow, frame_rounding(model, placed, p));
-  }
-  for (int a = 0; a < 3; ++a) framed.lo[a] -= grow, framed.hi[a] += grow;
-  return framed;
-}
-
-std::array<geometry::Point, 8> corners_of(const geometry::Box& box) {
-  std::array<geometry::Point, 8> corners;
-  for (int c = 0; c < 8; ++c)
-    corners[c] = {(c & 1) ? box.hi[0] : box.lo[0], (c & 2) ? box.hi[1] : box.lo[1],
-                  (c & 4) ? box.hi[2] : box.lo[2]};
-  return corners;
-}
 
 // One object of a pair: its model and its placement at the step's pose.
 struct PairSide {
@@ -66,28 +23,66 @@ struct PairSide {
   const geometry::Box& world_box;
 };
 
-// The triangles of `probe` near `tree`, each searched in tree's BVH from tree's frame, each
-// candidate decided exactly on both placed triangles. `found(probe_triangle, tree_triangle)`
-// returns whether to go on.
+// The first object's frame seen from the second's: x -> M x + d, computed in double and
+// rounded, so node boxes are compared with a margin far beyond those roundings and the
+// placements' (the comparison only prunes: each triangle pair is decided on world vertices).
+class RelativeFrame {
+ public:
+  RelativeFrame(const PairSide& first, const PairSide& second) {
+    const auto& ra = first.placed.rotation();
+    const auto& rb = second.placed.rotation();
+    const Vec3& ta = first.placed.translation();
+    const Vec3& tb = second.placed.translation();
+    // world = R x + t for both, so x_second = Rb^T (Ra x_first + ta - tb).
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) {
+        m_[3 * i + j] = rb[i] * ra[j] + rb[3 + i] * ra[3 + j] + rb[6 + i] * ra[6 + j];
+        abs_m_[3 * i + j] = std::fabs(m_[3 * i + j]);
+      }
+      d_[i] = rb[i] * (ta[0] - tb[0]) + rb[3 + i] * (ta[1] - tb[1]) + rb[6 + i] * (ta[2] - tb[2]);
+    }
+    const double magnitude = first.model.radius + second.model.radius +
+                             3 * (first.placed.translation_magnitude() + second.placed.translation_magnitude());
+    margin_ = magnitude * 0x1p-40;
+  }
+
+  // Can a point of `mine` (first frame) lie in `theirs` (second frame)? Conservative.
+  bool boxes_meet(const geometry::Box& mine, const geometry::Box& theirs) const {
+    const Vec3 c{(mine.lo[0] + mine.hi[0]) / 2, (mine.lo[1] + mine.hi[1]) / 2, (mine.lo[2] + mine.hi[2]) / 2};
+    const Vec3 h{(mine.hi[0] - mine.lo[0]) / 2, (mine.hi[1] - mine.lo[1]) / 2, (mine.hi[2] - mine.lo[2]) / 2};
+    for (int i = 0; i < 3; ++i) {
+      const double centre = m_[3 * i] * c[0] + m_[3 * i + 1] * c[1] + m_[3 * i + 2] * c[2] + d_[i];
+      const double half =
+          abs_m_[3 * i] * h[0] + abs_m_[3 * i + 1] * h[1] + abs_m_[3 * i + 2] * h[2] + margin_;
+      if (centre - half > theirs.hi[i] || centre + half < theirs.lo[i]) return false;
+    }
+    return true;
+  }
+
+ private:
+  std::array<double, 9> m_{}, abs_m_{};
+  Vec3 d_{};
+  double margin_ = 0;
+};
+
+// Both BVHs descended together; each pair of triangles in leaves that meet, and whose placed
+// boxes meet, decided by the exact test on both placed triangles. `found(first_triangle,
+// second_triangle)` returns whether to go on.
 template <class Found>
-void find_triangle_pairs(const PairSide& probe, const PairSide& tree, GroupCounters& counters,
+void find_triangle_pairs(const PairSide& first, const PairSide& second, GroupCounters& counters,
                          Found&& found) {
-  // A contact point lies in both placed objects, so in both world boxes.
-  const geometry::Box shared = intersection_of(probe.world_box, tree.world_box);
-  const geometry::Box probe_query = box_in_frame(corners_of(shared), probe.model, probe.placed);
-  bool go_on = true;
-  probe.model.bvh.for_each_in_box(probe_query, [&](std::uint32_t p) {
-    const geometry::Triangle world = probe.placed.world_triangle(p);
-    if (!geometry::triangle_intersects_box(world, shared)) return true;
-    ++counters.candidates;
-    const geometry::Box tree_query = box_in_frame(world, tree.model, tree.placed);
-    tree.model.bvh.for_each_in_box(tree_query, [&](std::uint32_t t) {
-      ++counters.triangle_tests;
-      if (geometry::triangles_intersect(world, tree.placed.world_triangle(t))) go_on = found(p, t);
-      return go_on;
-    });
-    return go_on;
-  });
+  const RelativeFrame frame(first, second);
+  first.model.bvh.for_each_pair(
+      second.model.bvh,
+      [&](const geometry::Box& mine, const geometry::Box& theirs) { return frame.boxes_meet(mine, theirs); },
+      [&](std::uint32_t a, std::uint32_t b) {
+        ++counters.candidates;
+        const geometry::Triangle ta = first.placed.world_triangle(a);
+        const geometry::Triangle tb = second.placed.world_triangle(b);
+        if (!geometry::boxes_overlap(geometry::box_of(ta), geometry::box_of(tb))) return true;
+        ++counters.triangle_tests;
+        return !geometry::triangles_intersect(ta, tb) || found(a, b);
+      });
 }
 
 // With no surface contact between them, does a component of `inner` lie inside a closed
@@ -209,14 +204,10 @@ void ObjectGroup::test_pairs(const GroupQueryOptions& options, GroupResult& resu
       const PairSide first{*parts_->models[i], parts_->placed[i], boxes[i]};
       const PairSide second{*parts_->models[j], parts_->placed[j], boxes[j]};
       CollidingPair pair{i, j, PairContainment::none, std::uint32_t(result.triangle_pairs.size()), 0};
-      // The object with fewer triangles probes the other's BVH.
-      const bool first_probes = first.model.bvh.triangle_count() < second.model.bvh.triangle_count();
-      find_triangle_pairs(first_probes ? first : second, first_probes ? second : first, result.counters,
-                          [&](std::uint32_t p, std::uint32_t t) {
-                            result.triangle_pairs.push_back(first_probes ? TrianglePair{p, t}
-                                                                         : TrianglePair{t, p});
-                            return all;
-                          });
+      find_triangle_pairs(first, second, result.counters, [&](std::uint32_t a, std::uint32_t b) {
+        result.triangle_pairs.push_back({a, b});
+        return all;
+      });
       pair.triangle_pairs_end = std::uint32_t(result.triangle_pairs.size());
       if (pair.triangle_pairs_end == pair.triangle_pairs_begin && options.pair_containment) {
         if (holds_a_component(second, first))

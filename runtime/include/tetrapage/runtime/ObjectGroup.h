@@ -8,9 +8,9 @@
 /// of the other (touching counts), as a brute force over all placed triangle pairs with the
 /// exact triangle test answers; or, without touching surfaces, when a component of one lies
 /// inside a closed component of the other. A sweep on x over the objects' world boxes finds the
-/// pairs that can meet; for each, the triangles of one object near the other, taken into the
-/// other's frame, search the other's BVH (both only prune); every candidate pair is decided
-/// by the exact test on world coordinates.
+/// pairs that can meet; for each, both objects' BVHs are descended together, a node box of one
+/// taken into the other's frame with a margin beyond every rounding (it only prunes); every
+/// remaining triangle pair is decided by the exact test on world coordinates.
 ///
 /// A group is used from one thread at a time (step may use TBB's threads inside when asked);
 /// the index and the object models may be shared with anything else.
