@@ -107,6 +107,31 @@ bool holds_a_component(const PairSide& outer, const PairSide& inner) {
   return false;
 }
 
+// One pair whose world boxes overlap: its triangle pairs (the first, or all), else whether
+// one holds the other; appended to result.pairs when they collide.
+void test_pair(std::uint32_t i, std::uint32_t j, const PairSide& first, const PairSide& second,
+               const GroupQueryOptions& options, GroupResult& result) {
+  const bool all = options.pair_mode == QueryMode::all_contacts;
+  CollidingPair pair{i, j, PairContainment::none, std::uint32_t(result.triangle_pairs.size()), 0};
+  find_triangle_pairs(first, second, result.counters, [&](std::uint32_t a, std::uint32_t b) {
+    result.triangle_pairs.push_back({a, b});
+    return all;
+  });
+  pair.triangle_pairs_end = std::uint32_t(result.triangle_pairs.size());
+  if (pair.triangle_pairs_end > pair.triangle_pairs_begin) {
+    std::sort(result.triangle_pairs.begin() + pair.triangle_pairs_begin, result.triangle_pairs.end());
+  } else if (!options.pair_containment) {
+    return;
+  } else if (holds_a_component(second, first)) {
+    pair.containment = PairContainment::first_inside_second;
+  } else if (holds_a_component(first, second)) {
+    pair.containment = PairContainment::second_inside_first;
+  } else {
+    return;
+  }
+  result.pairs.push_back(pair);
+}
+
 }  // namespace
 
 struct ObjectGroup::Parts {
@@ -158,6 +183,7 @@ void ObjectGroup::step(std::span<const Pose> poses, const GroupQueryOptions& opt
     } catch (const InputError& e) {
       throw InputError("object " + std::to_string(i) + " of the group: " + e.what());
     }
+    result.world_boxes[i] = parts_->placed[i].world_box();
   }
   const auto start = Clock::now();
   query_environment(poses, options, result);
@@ -187,7 +213,6 @@ void ObjectGroup::query_environment(std::span<const Pose> poses, const GroupQuer
 
 void ObjectGroup::test_pairs(const GroupQueryOptions& options, GroupResult& result) {
   const std::size_t n = size();
-  for (std::size_t i = 0; i < n; ++i) result.world_boxes[i] = parts_->placed[i].world_box();
   // Sort and sweep on x: each object meets the later ones whose boxes start before it ends.
   auto& order = parts_->by_low_x;
   order.resize(n);
@@ -195,7 +220,6 @@ void ObjectGroup::test_pairs(const GroupQueryOptions& options, GroupResult& resu
   const auto& boxes = result.world_boxes;
   std::sort(order.begin(), order.end(),
             [&](std::uint32_t a, std::uint32_t b) { return boxes[a].lo[0] < boxes[b].lo[0]; });
-  const bool all = options.pair_mode == QueryMode::all_contacts;
   for (std::size_t k = 0; k < n; ++k) {
     for (std::size_t l = k + 1; l < n && boxes[order[l]].lo[0] <= boxes[order[k]].hi[0]; ++l) {
       const std::uint32_t i = std::min(order[k], order[l]), j = std::max(order[k], order[l]);
@@ -203,24 +227,7 @@ void ObjectGroup::test_pairs(const GroupQueryOptions& options, GroupResult& resu
       ++result.counters.box_pairs;
       const PairSide first{*parts_->models[i], parts_->placed[i], boxes[i]};
       const PairSide second{*parts_->models[j], parts_->placed[j], boxes[j]};
-      CollidingPair pair{i, j, PairContainment::none, std::uint32_t(result.triangle_pairs.size()), 0};
-      find_triangle_pairs(first, second, result.counters, [&](std::uint32_t a, std::uint32_t b) {
-        result.triangle_pairs.push_back({a, b});
-        return all;
-      });
-      pair.triangle_pairs_end = std::uint32_t(result.triangle_pairs.size());
-      if (pair.triangle_pairs_end == pair.triangle_pairs_begin && options.pair_containment) {
-        if (holds_a_component(second, first))
-          pair.containment = PairContainment::first_inside_second;
-        else if (holds_a_component(first, second))
-          pair.containment = PairContainment::second_inside_first;
-        else
-          continue;
-      } else if (pair.triangle_pairs_end == pair.triangle_pairs_begin) {
-        continue;
-      }
-      std::sort(result.triangle_pairs.begin() + pair.triangle_pairs_begin, result.triangle_pairs.end());
-      result.pairs.push_back(pair);
+      test_pair(i, j, first, second, options, result);
     }
   }
   std::sort(result.pairs.begin(), result.pairs.end(), [](const CollidingPair& a, const CollidingPair& b) {
