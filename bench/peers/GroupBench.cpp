@@ -9,12 +9,12 @@
 //   tetrapage_bench_group [--counts 2,8,64] [--steps 500] [--triangles 1000] [--repeats 3]
 //                         [--seed 1] [--report R.json]
 
-#include <CLI/CLI.hpp>
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/math/bv/OBBRSS.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_object.h>
+#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -44,8 +44,10 @@ using PairSet = std::vector<std::pair<std::uint32_t, std::uint32_t>>;  // sorted
 using Flight = std::vector<std::vector<Pose>>;                         // [step][object]
 
 std::array<double, 4> multiply(const std::array<double, 4>& a, const std::array<double, 4>& b) {
-  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3], a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
-          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1], a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
+  return {a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+          a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+          a[0] * b[2] - a[1] * b[3] + a[2] * b[0] + a[3] * b[1],
+          a[0] * b[3] + a[1] * b[2] - a[2] * b[1] + a[3] * b[0]};
 }
 
 // n objects of size `size` random-walking in a cube whose side grows with cbrt(n), so that the
@@ -59,7 +61,8 @@ Flight random_walk(std::size_t n, std::size_t steps, double size, std::uint64_t 
   std::vector<Pose> poses(n);
   std::vector<Vec3> velocity(n);
   for (std::size_t i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) poses[i].translation[a] = unit(random) * side, velocity[i][a] = normal(random);
+    for (int a = 0; a < 3; ++a)
+      poses[i].translation[a] = unit(random) * side, velocity[i][a] = normal(random);
     const double norm = std::hypot(velocity[i][0], velocity[i][1], velocity[i][2]);
     for (auto& v : velocity[i]) v *= 0.1 * size / norm;
   }
@@ -71,7 +74,8 @@ Flight random_walk(std::size_t n, std::size_t steps, double size, std::uint64_t 
         t += velocity[i][a];
         if (t < 0 || t > side) velocity[i][a] = -velocity[i][a], t = std::clamp(t, 0.0, side);
       }
-      std::array<double, 4> turn{1, 0.05 * normal(random), 0.05 * normal(random), 0.05 * normal(random)};
+      std::array<double, 4> turn{1, 0.05 * normal(random), 0.05 * normal(random),
+                                 0.05 * normal(random)};
       poses[i].rotation = unit_quaternion(multiply(poses[i].rotation, unit_quaternion(turn)));
     }
     flight.push_back(poses);
@@ -80,12 +84,13 @@ Flight random_walk(std::size_t n, std::size_t steps, double size, std::uint64_t 
 }
 
 struct Run {
-  std::vector<double> seconds;    // per step
-  std::vector<PairSet> answers;   // per step
+  std::vector<double> seconds;   // per step
+  std::vector<PairSet> answers;  // per step
 };
 
 Run run_tetrapage(const std::shared_ptr<const ObjectModel>& model, const Flight& flight) {
-  ObjectGroup group(nullptr, std::vector<std::shared_ptr<const ObjectModel>>(flight[0].size(), model));
+  ObjectGroup group(nullptr,
+                    std::vector<std::shared_ptr<const ObjectModel>>(flight[0].size(), model));
   GroupQueryOptions options;
   options.check_environment = false;
   options.pair_containment = false;  // the question FCL answers: do surfaces meet?
@@ -113,7 +118,8 @@ std::shared_ptr<FclModel> fcl_model(const TriangleSoup& soup) {
   int status = model->beginModel(int(triangles.size()), int(points.size()));
   if (status == fcl::BVH_OK) status = model->addSubModel(points, triangles);
   if (status == fcl::BVH_OK) status = model->endModel();
-  if (status != fcl::BVH_OK) throw Error("FCL: BVHModel<OBBRSS> failed with status " + std::to_string(status));
+  if (status != fcl::BVH_OK)
+    throw Error("FCL: BVHModel<OBBRSS> failed with status " + std::to_string(status));
   return model;
 }
 
@@ -186,8 +192,9 @@ Disagreement compare(const Run& exact, const Run& fcl) {
   Disagreement d;
   for (std::size_t s = 0; s < exact.answers.size(); ++s) {
     PairSet differ;
-    std::set_symmetric_difference(exact.answers[s].begin(), exact.answers[s].end(), fcl.answers[s].begin(),
-                                  fcl.answers[s].end(), std::back_inserter(differ));
+    std::set_symmetric_difference(exact.answers[s].begin(), exact.answers[s].end(),
+                                  fcl.answers[s].begin(), fcl.answers[s].end(),
+                                  std::back_inserter(differ));
     d.steps += !differ.empty();
     d.pairs += differ.size();
     d.colliding_pairs += exact.answers[s].size();
@@ -200,8 +207,9 @@ Disagreement compare(const Run& exact, const Run& fcl) {
 
 int main(int argc, char** argv) {
   using namespace tetrapage;
-  CLI::App app{"N copies of an object checked against each other: tetrapage's ObjectGroup vs FCL's "
-               "DynamicAABBTreeCollisionManager"};
+  CLI::App app{
+      "N copies of an object checked against each other: tetrapage's ObjectGroup vs FCL's "
+      "DynamicAABBTreeCollisionManager"};
   std::vector<std::size_t> counts{2, 8, 64};
   std::size_t steps = 500, repeats = 3;
   std::uint64_t triangles = 1000, seed = 1;
@@ -210,7 +218,8 @@ int main(int argc, char** argv) {
   app.add_option("--steps", steps, "steps of the random walk")->check(CLI::PositiveNumber);
   app.add_option("--triangles", triangles, "triangles of the object (tetrapage generate object)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--repeats", repeats, "times each run is repeated (noise)")->check(CLI::PositiveNumber);
+  app.add_option("--repeats", repeats, "times each run is repeated (noise)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--seed", seed, "seed of the random walk");
   app.add_option("--report", report, "write the figures as JSON");
   CLI11_PARSE(app, argc, argv);
@@ -221,10 +230,14 @@ int main(int argc, char** argv) {
     object_options.triangles = triangles;
     const GeneratedObject object = generate_object(object_options, library ? &*library : nullptr);
     const auto model = std::make_shared<const ObjectModel>(object.soup);
-    std::printf("object: %s, %zu triangles, size %g; %zu steps, %zu repeats\n\n", object.source.c_str(),
-                object.soup.triangle_count(), object_options.size, steps, repeats);
-    std::printf("| N | colliding pairs/step | tetrapage steps/s | p50 us | p99 us | FCL steps/s | p50 us | p99 us | "
-                "FCL/tetrapage time | disagreeing steps (pairs) |\n|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("object: %s, %zu triangles, size %g; %zu steps, %zu repeats\n\n",
+                object.source.c_str(), object.soup.triangle_count(), object_options.size, steps,
+                repeats);
+    std::printf(
+        "| N | colliding pairs/step | tetrapage steps/s | p50 us | p99 us | FCL steps/s | p50 us | "
+        "p99 us | "
+        "FCL/tetrapage time | disagreeing steps (pairs) "
+        "|\n|---|---|---|---|---|---|---|---|---|---|\n");
     nlohmann::json runs = nlohmann::json::array();
     for (const std::size_t n : counts) {
       const Flight flight = random_walk(n, steps, object_options.size, seed + n);
@@ -238,23 +251,27 @@ int main(int argc, char** argv) {
         const auto a = LatencySummary::of(ours.seconds), b = LatencySummary::of(theirs.seconds);
         const double ta = total(ours.seconds), tb = total(theirs.seconds);
         const Disagreement d = compare(ours, theirs);
-        std::printf("| %zu | %.2f | %.0f | %.1f | %.1f | %.0f | %.1f | %.1f | %.2f | %zu (%zu) |\n", n,
-                    double(d.colliding_pairs) / double(steps), double(steps) / ta, a.p50_us, a.p99_us,
-                    double(steps) / tb, b.p50_us, b.p99_us, tb / ta, d.steps, d.pairs);
-        runs.push_back({{"objects", n},
-                        {"repeat", r},
-                        {"steps", steps},
-                        {"colliding_pairs", d.colliding_pairs},
-                        {"tetrapage", {{"steps_per_second", double(steps) / ta}, {"latency_us", a.to_json()}}},
-                        {"fcl", {{"steps_per_second", double(steps) / tb}, {"latency_us", b.to_json()}}},
-                        {"fcl_over_tetrapage_time", tb / ta},
-                        {"disagreeing_steps", d.steps},
-                        {"disagreeing_pairs", d.pairs}});
+        std::printf("| %zu | %.2f | %.0f | %.1f | %.1f | %.0f | %.1f | %.1f | %.2f | %zu (%zu) |\n",
+                    n, double(d.colliding_pairs) / double(steps), double(steps) / ta, a.p50_us,
+                    a.p99_us, double(steps) / tb, b.p50_us, b.p99_us, tb / ta, d.steps, d.pairs);
+        runs.push_back(
+            {{"objects", n},
+             {"repeat", r},
+             {"steps", steps},
+             {"colliding_pairs", d.colliding_pairs},
+             {"tetrapage", {{"steps_per_second", double(steps) / ta}, {"latency_us", a.to_json()}}},
+             {"fcl", {{"steps_per_second", double(steps) / tb}, {"latency_us", b.to_json()}}},
+             {"fcl_over_tetrapage_time", tb / ta},
+             {"disagreeing_steps", d.steps},
+             {"disagreeing_pairs", d.pairs}});
       }
     }
     if (!report.empty()) {
       std::ofstream out(report);
-      out << nlohmann::json{{"object", object.source}, {"triangles", object.soup.triangle_count()}, {"runs", runs}}.dump(2)
+      out << nlohmann::json{{"object", object.source},
+                            {"triangles", object.soup.triangle_count()},
+                            {"runs", runs}}
+                 .dump(2)
           << "\n";
       if (!out) throw IoError("cannot write " + report);
     }

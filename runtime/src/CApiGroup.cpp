@@ -84,7 +84,8 @@ tetrapage_status tetrapage_group_step(tetrapage_group* group, const double* pose
       placed[k].rotation = {pose[3], pose[4], pose[5], pose[6]};
     }
     tetrapage::GroupQueryOptions options;
-    const auto mode = all_contacts ? tetrapage::QueryMode::all_contacts : tetrapage::QueryMode::first_hit;
+    const auto mode =
+        all_contacts ? tetrapage::QueryMode::all_contacts : tetrapage::QueryMode::first_hit;
     options.environment.mode = mode;
     options.pair_mode = mode;
     state->group.step(placed, options, state->result);
@@ -93,8 +94,8 @@ tetrapage_status tetrapage_group_step(tetrapage_group* group, const double* pose
   });
 }
 
-tetrapage_status tetrapage_group_pairs(const tetrapage_group* group, uint32_t* pairs, size_t capacity,
-                                       size_t* written) {
+tetrapage_status tetrapage_group_pairs(const tetrapage_group* group, uint32_t* pairs,
+                                       size_t capacity, size_t* written) {
   if (written) *written = 0;
   return guarded(__func__, [&] {
     const auto state = group_state(group);
@@ -112,8 +113,8 @@ tetrapage_status tetrapage_group_pairs(const tetrapage_group* group, uint32_t* p
 }
 
 tetrapage_status tetrapage_group_pair_triangles(const tetrapage_group* group, size_t pair,
-                                                uint32_t* triangles, size_t capacity, size_t* written,
-                                                int* containment) {
+                                                uint32_t* triangles, size_t capacity,
+                                                size_t* written, int* containment) {
   if (written) *written = 0;
   if (containment) *containment = 0;
   return guarded(__func__, [&] {
@@ -122,8 +123,8 @@ tetrapage_status tetrapage_group_pair_triangles(const tetrapage_group* group, si
     if (capacity > 0) require(triangles, "triangles");
     const std::size_t pairs = state->has_result ? state->result.pairs.size() : 0;
     if (pair >= pairs)
-      throw tetrapage::InputError("no colliding pair " + std::to_string(pair) + " (the last step has " +
-                                  std::to_string(pairs) + ")");
+      throw tetrapage::InputError("no colliding pair " + std::to_string(pair) +
+                                  " (the last step has " + std::to_string(pairs) + ")");
     const auto& found = state->result.pairs[pair];
     const auto contacts = state->result.triangles_of(found);
     const std::size_t n = std::min(capacity, contacts.size());
@@ -136,8 +137,8 @@ tetrapage_status tetrapage_group_pair_triangles(const tetrapage_group* group, si
   });
 }
 
-tetrapage_status tetrapage_group_environment(const tetrapage_group* group, int* collides, size_t capacity,
-                                             size_t* written) {
+tetrapage_status tetrapage_group_environment(const tetrapage_group* group, int* collides,
+                                             size_t capacity, size_t* written) {
   if (written) *written = 0;
   return guarded(__func__, [&] {
     const auto state = group_state(group);

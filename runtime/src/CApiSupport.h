@@ -110,7 +110,8 @@ class HandleTable {
   StaleHandle stale(std::uintptr_t id) const {
     char text[160];
     std::snprintf(text, sizeof text,
-                  "%s handle 0x%" PRIxPTR " is stale: released already, or never returned by tetrapage",
+                  "%s handle 0x%" PRIxPTR
+                  " is stale: released already, or never returned by tetrapage",
                   kind_, id);
     return StaleHandle(text);
   }
@@ -132,7 +133,9 @@ inline HandleTable<ObjectState>& objects() {
   return *table;
 }
 
-inline std::uintptr_t id_of(const void* handle) { return reinterpret_cast<std::uintptr_t>(handle); }
+inline std::uintptr_t id_of(const void* handle) {
+  return reinterpret_cast<std::uintptr_t>(handle);
+}
 
 inline std::shared_ptr<IndexState> index_state(const tetrapage_index* index) {
   require(index, "index");
@@ -144,7 +147,8 @@ inline std::shared_ptr<ObjectState> object_state(const tetrapage_object* object)
   return objects().get(id_of(object));
 }
 
-inline tetrapage_status fail(tetrapage_status status, const char* function, const char* what) noexcept {
+inline tetrapage_status fail(tetrapage_status status, const char* function,
+                             const char* what) noexcept {
   try {
     last_error_message = std::string(function) + ": " + what;
   } catch (...) {

@@ -41,15 +41,18 @@ class RelativeFrame {
       }
       d_[i] = rb[i] * (ta[0] - tb[0]) + rb[3 + i] * (ta[1] - tb[1]) + rb[6 + i] * (ta[2] - tb[2]);
     }
-    const double magnitude = first.model.radius + second.model.radius +
-                             3 * (first.placed.translation_magnitude() + second.placed.translation_magnitude());
+    const double magnitude =
+        first.model.radius + second.model.radius +
+        3 * (first.placed.translation_magnitude() + second.placed.translation_magnitude());
     margin_ = magnitude * 0x1p-40;
   }
 
   // Can a point of `mine` (first frame) lie in `theirs` (second frame)? Conservative.
   bool boxes_meet(const geometry::Box& mine, const geometry::Box& theirs) const {
-    const Vec3 c{(mine.lo[0] + mine.hi[0]) / 2, (mine.lo[1] + mine.hi[1]) / 2, (mine.lo[2] + mine.hi[2]) / 2};
-    const Vec3 h{(mine.hi[0] - mine.lo[0]) / 2, (mine.hi[1] - mine.lo[1]) / 2, (mine.hi[2] - mine.lo[2]) / 2};
+    const Vec3 c{(mine.lo[0] + mine.hi[0]) / 2, (mine.lo[1] + mine.hi[1]) / 2,
+                 (mine.lo[2] + mine.hi[2]) / 2};
+    const Vec3 h{(mine.hi[0] - mine.lo[0]) / 2, (mine.hi[1] - mine.lo[1]) / 2,
+                 (mine.hi[2] - mine.lo[2]) / 2};
     for (int i = 0; i < 3; ++i) {
       const double centre = m_[3 * i] * c[0] + m_[3 * i + 1] * c[1] + m_[3 * i + 2] * c[2] + d_[i];
       const double half =
@@ -74,7 +77,9 @@ void find_triangle_pairs(const PairSide& first, const PairSide& second, GroupCou
   const RelativeFrame frame(first, second);
   first.model.bvh.for_each_pair(
       second.model.bvh,
-      [&](const geometry::Box& mine, const geometry::Box& theirs) { return frame.boxes_meet(mine, theirs); },
+      [&](const geometry::Box& mine, const geometry::Box& theirs) {
+        return frame.boxes_meet(mine, theirs);
+      },
       [&](std::uint32_t a, std::uint32_t b) {
         ++counters.candidates;
         const geometry::Triangle ta = first.placed.world_triangle(a);
@@ -119,7 +124,8 @@ void test_pair(std::uint32_t i, std::uint32_t j, const PairSide& first, const Pa
   });
   pair.triangle_pairs_end = std::uint32_t(result.triangle_pairs.size());
   if (pair.triangle_pairs_end > pair.triangle_pairs_begin) {
-    std::sort(result.triangle_pairs.begin() + pair.triangle_pairs_begin, result.triangle_pairs.end());
+    std::sort(result.triangle_pairs.begin() + pair.triangle_pairs_begin,
+              result.triangle_pairs.end());
   } else if (!options.pair_containment) {
     return;
   } else if (holds_a_component(second, first)) {
@@ -136,8 +142,8 @@ void test_pair(std::uint32_t i, std::uint32_t j, const PairSide& first, const Pa
 
 struct ObjectGroup::Parts {
   std::vector<std::shared_ptr<const ObjectModel>> models;
-  std::vector<FlyingObject> flying;  ///< one per object, with an index
-  std::vector<PlacedObject> placed;  ///< one per object, for the pairs
+  std::vector<FlyingObject> flying;     ///< one per object, with an index
+  std::vector<PlacedObject> placed;     ///< one per object, for the pairs
   std::vector<std::uint32_t> by_low_x;  ///< the sweep's order
 };
 
@@ -162,7 +168,9 @@ ObjectGroup::~ObjectGroup() = default;
 ObjectGroup::ObjectGroup(ObjectGroup&&) noexcept = default;
 ObjectGroup& ObjectGroup::operator=(ObjectGroup&&) noexcept = default;
 
-std::size_t ObjectGroup::size() const { return parts_->models.size(); }
+std::size_t ObjectGroup::size() const {
+  return parts_->models.size();
+}
 
 const std::shared_ptr<const ObjectModel>& ObjectGroup::model(std::size_t object) const {
   return parts_->models.at(object);
@@ -230,9 +238,10 @@ void ObjectGroup::test_pairs(const GroupQueryOptions& options, GroupResult& resu
       test_pair(i, j, first, second, options, result);
     }
   }
-  std::sort(result.pairs.begin(), result.pairs.end(), [](const CollidingPair& a, const CollidingPair& b) {
-    return std::pair(a.first, a.second) < std::pair(b.first, b.second);
-  });
+  std::sort(result.pairs.begin(), result.pairs.end(),
+            [](const CollidingPair& a, const CollidingPair& b) {
+              return std::pair(a.first, a.second) < std::pair(b.first, b.second);
+            });
 }
 
 }  // namespace tetrapage

@@ -47,7 +47,8 @@ using ModelPtr = std::shared_ptr<const ObjectModel>;
 // The closed cube [-h, h]^3, faces outwards.
 TriangleSoup cube(double h) {
   TriangleSoup soup;
-  for (int c = 0; c < 8; ++c) soup.vertices.push_back({c & 1 ? h : -h, c & 2 ? h : -h, c & 4 ? h : -h});
+  for (int c = 0; c < 8; ++c)
+    soup.vertices.push_back({c & 1 ? h : -h, c & 2 ? h : -h, c & 4 ? h : -h});
   soup.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                     {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   soup.part_of.assign(soup.triangles.size(), 0);
@@ -78,7 +79,9 @@ const TriangleSoup& real_mesh() {
   return mesh;
 }
 
-ModelPtr model_of(TriangleSoup soup) { return std::make_shared<const ObjectModel>(std::move(soup)); }
+ModelPtr model_of(TriangleSoup soup) {
+  return std::make_shared<const ObjectModel>(std::move(soup));
+}
 
 Pose at(double x, double y, double z, std::array<double, 4> q = {1, 0, 0, 0}) {
   Pose pose;
@@ -196,7 +199,8 @@ std::vector<OraclePair> oracle_step(std::vector<Placed>& placed) {
   return pairs;
 }
 
-std::vector<OraclePair> oracle_for(const std::vector<const TriangleSoup*>& soups, std::span<const Pose> poses) {
+std::vector<OraclePair> oracle_for(const std::vector<const TriangleSoup*>& soups,
+                                   std::span<const Pose> poses) {
   std::vector<Placed> placed;
   for (std::size_t i = 0; i < soups.size(); ++i) placed.push_back(place(*soups[i], poses[i]));
   return oracle_step(placed);
@@ -215,17 +219,20 @@ void expect_oracle(const GroupResult& result, const std::vector<OraclePair>& ora
     const OraclePair& want = oracle[k];
     ASSERT_EQ(got.first, want.first) << where << " pair " << k;
     ASSERT_EQ(got.second, want.second) << where << " pair " << k;
-    EXPECT_EQ(got.containment, want.containment) << where << " pair " << want.first << "," << want.second;
+    EXPECT_EQ(got.containment, want.containment)
+        << where << " pair " << want.first << "," << want.second;
     const auto triangles = result.triangles_of(got);
     if (mode == QueryMode::all_contacts) {
-      EXPECT_TRUE(std::equal(triangles.begin(), triangles.end(), want.triangles.begin(), want.triangles.end()))
-          << where << " pair " << want.first << "," << want.second << ": " << triangles.size() << " triangle pairs, "
-          << want.triangles.size() << " by brute force";
+      EXPECT_TRUE(std::equal(triangles.begin(), triangles.end(), want.triangles.begin(),
+                             want.triangles.end()))
+          << where << " pair " << want.first << "," << want.second << ": " << triangles.size()
+          << " triangle pairs, " << want.triangles.size() << " by brute force";
     } else if (want.triangles.empty()) {
       EXPECT_TRUE(triangles.empty()) << where;
     } else {
       ASSERT_EQ(triangles.size(), 1u) << where;
-      EXPECT_TRUE(std::binary_search(want.triangles.begin(), want.triangles.end(), triangles[0])) << where;
+      EXPECT_TRUE(std::binary_search(want.triangles.begin(), want.triangles.end(), triangles[0]))
+          << where;
     }
     if (seen) ++(want.triangles.empty() ? seen->containment : seen->touching);
   }
@@ -257,7 +264,8 @@ TEST(ObjectGroup, CubesTouchAtVertexEdgeFaceAndMissByOneUlp) {
       ObjectGroup group(nullptr, {model_of(soup), model_of(soup)});
       for (const Case& k : cases) {
         for (const QueryMode mode : {QueryMode::first_hit, QueryMode::all_contacts}) {
-          std::array<Pose, 2> poses{at(c, c, c), at(c + k.offset[0] * s, c + k.offset[1] * s, c + k.offset[2] * s)};
+          std::array<Pose, 2> poses{
+              at(c, c, c), at(c + k.offset[0] * s, c + k.offset[1] * s, c + k.offset[2] * s)};
           if (k.nudged_axis >= 0) {
             double& t = poses[1].translation[k.nudged_axis];
             t = std::nextafter(t, std::numeric_limits<double>::infinity());
@@ -265,7 +273,8 @@ TEST(ObjectGroup, CubesTouchAtVertexEdgeFaceAndMissByOneUlp) {
           GroupQueryOptions options;
           options.pair_mode = mode;
           const GroupResult result = group.step(poses, options);
-          const std::string where = std::string(k.name) + " at scale " + std::to_string(s) + " offset " + std::to_string(c);
+          const std::string where = std::string(k.name) + " at scale " + std::to_string(s) +
+                                    " offset " + std::to_string(c);
           expect_oracle(result, oracle_for({&soup, &soup}, poses), mode, where);
           // At 1e6 a 2^-30 cube rounds into another shape: the brute force alone decides there.
           if (c != 1e6 || s >= 1) {
@@ -287,7 +296,8 @@ TEST(ObjectGroup, RotatedCubesGrazingAtACorner) {
     const Pose first = at(3, -2, 1, random_rotation(random));
     const Vec3 corner = apply_pose(first, soup.vertices[trial % 8]);
     const double d = trial % 3 == 0 ? 0 : (trial % 3 == 1 ? 1e-15 : -1e-15);
-    const std::array<Pose, 2> poses{first, at(corner[0] + 0.5 + d, corner[1] + 0.5 + d, corner[2] + 0.5 + d)};
+    const std::array<Pose, 2> poses{
+        first, at(corner[0] + 0.5 + d, corner[1] + 0.5 + d, corner[2] + 0.5 + d)};
     GroupQueryOptions options;
     options.pair_mode = QueryMode::all_contacts;
     expect_oracle(group.step(poses, options), oracle_for({&soup, &soup}, poses), options.pair_mode,
@@ -301,12 +311,13 @@ TEST(ObjectGroup, RotatedCubesGrazingAtACorner) {
 TEST(ObjectGroup, ContainmentWithoutTouchingSurfaces) {
   const TriangleSoup ball = scaled(sphere(), 20);  // fits a cube of side 1
   const TriangleSoup small = cube(0.05), big = cube(2);
-  ObjectGroup group(nullptr, {model_of(small), model_of(ball), model_of(small), model_of(small), model_of(big)});
+  ObjectGroup group(
+      nullptr, {model_of(small), model_of(ball), model_of(small), model_of(small), model_of(big)});
   const std::vector<const TriangleSoup*> soups{&small, &ball, &small, &small, &big};
   // 0: inside the ball (and the big cube); 2: in the ball's box corner, outside it; 3: across
   // the ball's surface; 4: the big cube around everything, touching nothing.
-  const std::array<Pose, 5> poses{at(0.01, 0.02, -0.03), at(0, 0, 0), at(0.44, 0.44, 0.44), at(0.5, 0, 0),
-                                  at(0, 0, 0.1)};
+  const std::array<Pose, 5> poses{at(0.01, 0.02, -0.03), at(0, 0, 0), at(0.44, 0.44, 0.44),
+                                  at(0.5, 0, 0), at(0, 0, 0.1)};
   for (const bool containment : {true, false}) {
     GroupQueryOptions options;
     options.pair_containment = containment;
@@ -314,8 +325,10 @@ TEST(ObjectGroup, ContainmentWithoutTouchingSurfaces) {
     const GroupResult result = group.step(poses, options);
     auto oracle = oracle_for(soups, poses);
     if (!containment)
-      std::erase_if(oracle, [](const OraclePair& p) { return p.containment != PairContainment::none; });
-    expect_oracle(result, oracle, options.pair_mode, containment ? "with containment" : "surfaces only");
+      std::erase_if(oracle,
+                    [](const OraclePair& p) { return p.containment != PairContainment::none; });
+    expect_oracle(result, oracle, options.pair_mode,
+                  containment ? "with containment" : "surfaces only");
     const auto find = [&](std::uint32_t i, std::uint32_t j) -> const CollidingPair* {
       for (const auto& p : result.pairs)
         if (p.first == i && p.second == j) return &p;
@@ -339,7 +352,8 @@ TEST(ObjectGroup, ContainmentWithoutTouchingSurfaces) {
 
 // n objects (cubes, spheres and a real mesh, in turn) at random poses in a box about as wide
 // as cbrt(n) objects, so that some pairs touch and most do not.
-void check_random(std::size_t n, std::size_t steps, double scale, double offset, std::uint64_t seed, Seen& seen) {
+void check_random(std::size_t n, std::size_t steps, double scale, double offset, std::uint64_t seed,
+                  Seen& seen) {
   static const TriangleSoup sphere_soup = sphere();
   const std::array<TriangleSoup, 3> kinds{scaled(cube(0.02), scale), scaled(sphere_soup, scale),
                                           scaled(real_mesh(), scale)};
@@ -347,7 +361,8 @@ void check_random(std::size_t n, std::size_t steps, double scale, double offset,
   for (int k = 0; k < 3; ++k) models[k] = model_of(kinds[k]);
   std::vector<ModelPtr> group_models;
   std::vector<const TriangleSoup*> soups;
-  for (std::size_t i = 0; i < n; ++i) group_models.push_back(models[i % 3]), soups.push_back(&kinds[i % 3]);
+  for (std::size_t i = 0; i < n; ++i)
+    group_models.push_back(models[i % 3]), soups.push_back(&kinds[i % 3]);
   ObjectGroup group(nullptr, group_models);
   std::mt19937_64 random(seed);
   const double side = 0.04 * std::cbrt(double(n)) * scale;
@@ -355,7 +370,8 @@ void check_random(std::size_t n, std::size_t steps, double scale, double offset,
   std::vector<Pose> poses(n);
   GroupResult result;
   for (std::size_t step = 0; step < steps; ++step) {
-    for (auto& pose : poses) pose = at(within(random), within(random), within(random), random_rotation(random));
+    for (auto& pose : poses)
+      pose = at(within(random), within(random), within(random), random_rotation(random));
     const auto oracle = oracle_for(soups, poses);
     for (const QueryMode mode : {QueryMode::first_hit, QueryMode::all_contacts}) {
       GroupQueryOptions options;
@@ -430,17 +446,20 @@ const Environment& environment() {
 }
 
 // Poses of n objects random-walking through the environment's box.
-std::vector<std::vector<Pose>> walk(std::size_t n, std::size_t steps, const BoundingBox& box, std::uint64_t seed) {
+std::vector<std::vector<Pose>> walk(std::size_t n, std::size_t steps, const BoundingBox& box,
+                                    std::uint64_t seed) {
   std::mt19937_64 random(seed);
   std::uniform_real_distribution<double> unit(0, 1), jitter(-0.02, 0.02);
   std::vector<Pose> poses(n);
   for (auto& pose : poses)
-    for (int a = 0; a < 3; ++a) pose.translation[a] = box.lo[a] + unit(random) * (box.hi[a] - box.lo[a]);
+    for (int a = 0; a < 3; ++a)
+      pose.translation[a] = box.lo[a] + unit(random) * (box.hi[a] - box.lo[a]);
   std::vector<std::vector<Pose>> flight;
   for (std::size_t step = 0; step < steps; ++step) {
     for (auto& pose : poses) {
       for (int a = 0; a < 3; ++a)
-        pose.translation[a] = std::clamp(pose.translation[a] + jitter(random), box.lo[a], box.hi[a]);
+        pose.translation[a] =
+            std::clamp(pose.translation[a] + jitter(random), box.lo[a], box.hi[a]);
       pose.rotation = random_rotation(random);
     }
     flight.push_back(poses);
@@ -450,16 +469,19 @@ std::vector<std::vector<Pose>> walk(std::size_t n, std::size_t steps, const Boun
 
 void sort_contacts(std::vector<Contact>& contacts) {
   std::sort(contacts.begin(), contacts.end(), [](const Contact& a, const Contact& b) {
-    return std::tie(a.environment_triangle, a.object_triangle) < std::tie(b.environment_triangle, b.object_triangle);
+    return std::tie(a.environment_triangle, a.object_triangle) <
+           std::tie(b.environment_triangle, b.object_triangle);
   });
 }
 
 TEST(ObjectGroup, EnvironmentAnswersAreLoneFlyingObjects) {
   const Environment& env = environment();
   const TriangleSoup ball = scaled(sphere(), 2), box = cube(0.04);
-  const std::vector<ModelPtr> models{model_of(ball), model_of(box), model_of(real_mesh()), model_of(ball),
-                                     model_of(box), model_of(real_mesh()), model_of(ball), model_of(box)};
-  const std::vector<const TriangleSoup*> soups{&ball, &box, &real_mesh(), &ball, &box, &real_mesh(), &ball, &box};
+  const std::vector<ModelPtr> models{model_of(ball), model_of(box), model_of(real_mesh()),
+                                     model_of(ball), model_of(box), model_of(real_mesh()),
+                                     model_of(ball), model_of(box)};
+  const std::vector<const TriangleSoup*> soups{&ball, &box,         &real_mesh(), &ball,
+                                               &box,  &real_mesh(), &ball,        &box};
   // In a box a few objects wide, so that they also meet each other.
   BoundingBox middle = env.bounds;
   for (int a = 0; a < 3; ++a) {
@@ -491,7 +513,8 @@ TEST(ObjectGroup, EnvironmentAnswersAreLoneFlyingObjects) {
         EXPECT_EQ(got.contacts, alone.contacts) << where;
         collisions += got.collides;
       }
-      expect_oracle(result, oracle_for(soups, flight[step]), options.pair_mode, "step " + std::to_string(step));
+      expect_oracle(result, oracle_for(soups, flight[step]), options.pair_mode,
+                    "step " + std::to_string(step));
       pairs += result.pairs.size();
     }
   }
@@ -502,9 +525,11 @@ TEST(ObjectGroup, EnvironmentAnswersAreLoneFlyingObjects) {
 TEST(ObjectGroup, CApiAgreesWithCpp) {
   const Environment& env = environment();
   tetrapage_index* index = nullptr;
-  ASSERT_EQ(tetrapage_open(env.index_path.c_str(), TETRAPAGE_DEFAULT_BUDGET_BYTES, &index), TETRAPAGE_OK)
+  ASSERT_EQ(tetrapage_open(env.index_path.c_str(), TETRAPAGE_DEFAULT_BUDGET_BYTES, &index),
+            TETRAPAGE_OK)
       << tetrapage_last_error();
-  const std::vector<TriangleSoup> soups{scaled(sphere(), 2), cube(0.04), real_mesh(), scaled(sphere(), 3)};
+  const std::vector<TriangleSoup> soups{scaled(sphere(), 2), cube(0.04), real_mesh(),
+                                        scaled(sphere(), 3)};
   std::vector<tetrapage_object*> objects;
   std::vector<ModelPtr> models;
   for (const auto& soup : soups) {
@@ -513,8 +538,8 @@ TEST(ObjectGroup, CApiAgreesWithCpp) {
     std::vector<std::uint32_t> triangles;
     for (const auto& t : soup.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
     tetrapage_object* object = nullptr;
-    ASSERT_EQ(tetrapage_object_create(index, vertices.data(), soup.vertices.size(), triangles.data(),
-                                      soup.triangles.size(), &object),
+    ASSERT_EQ(tetrapage_object_create(index, vertices.data(), soup.vertices.size(),
+                                      triangles.data(), soup.triangles.size(), &object),
               TETRAPAGE_OK);
     objects.push_back(object);
     models.push_back(model_of(soup));
@@ -540,9 +565,11 @@ TEST(ObjectGroup, CApiAgreesWithCpp) {
         flat.insert(flat.end(), p.rotation.begin(), p.rotation.end());
       }
       size_t count = 0;
-      ASSERT_EQ(tetrapage_group_step(group, flat.data(), all, &count), TETRAPAGE_OK) << tetrapage_last_error();
+      ASSERT_EQ(tetrapage_group_step(group, flat.data(), all, &count), TETRAPAGE_OK)
+          << tetrapage_last_error();
       GroupQueryOptions options;
-      options.environment.mode = options.pair_mode = all ? QueryMode::all_contacts : QueryMode::first_hit;
+      options.environment.mode = options.pair_mode =
+          all ? QueryMode::all_contacts : QueryMode::first_hit;
       const GroupResult want = cpp.step(poses, options);
       ASSERT_EQ(count, want.pairs.size());
       pairs_seen += count;
@@ -556,7 +583,8 @@ TEST(ObjectGroup, CApiAgreesWithCpp) {
         const auto triangles = want.triangles_of(want.pairs[k]);
         std::vector<std::uint32_t> got(2 * triangles.size());
         int containment = -1;
-        ASSERT_EQ(tetrapage_group_pair_triangles(group, k, got.data(), triangles.size(), &written, &containment),
+        ASSERT_EQ(tetrapage_group_pair_triangles(group, k, got.data(), triangles.size(), &written,
+                                                 &containment),
                   TETRAPAGE_OK);
         ASSERT_EQ(written, triangles.size());
         EXPECT_EQ(containment, int(want.pairs[k].containment));
@@ -566,9 +594,11 @@ TEST(ObjectGroup, CApiAgreesWithCpp) {
         }
       }
       std::vector<int> collides(soups.size(), -1);
-      ASSERT_EQ(tetrapage_group_environment(group, collides.data(), collides.size(), &written), TETRAPAGE_OK);
+      ASSERT_EQ(tetrapage_group_environment(group, collides.data(), collides.size(), &written),
+                TETRAPAGE_OK);
       ASSERT_EQ(written, soups.size());
-      for (std::size_t i = 0; i < soups.size(); ++i) EXPECT_EQ(collides[i], want.environment[i].collides ? 1 : 0);
+      for (std::size_t i = 0; i < soups.size(); ++i)
+        EXPECT_EQ(collides[i], want.environment[i].collides ? 1 : 0);
     }
   }
   EXPECT_GT(pairs_seen, 0u);
@@ -577,19 +607,24 @@ TEST(ObjectGroup, CApiAgreesWithCpp) {
   size_t count = 7, written = 7;
   const std::vector<double> bad(7 * soups.size(), 0.0);  // zero quaternions
   EXPECT_EQ(tetrapage_group_step(group, bad.data(), 0, &count), TETRAPAGE_ERROR_INPUT);
-  EXPECT_NE(std::string(tetrapage_last_error()).find("object 0"), std::string::npos) << tetrapage_last_error();
+  EXPECT_NE(std::string(tetrapage_last_error()).find("object 0"), std::string::npos)
+      << tetrapage_last_error();
   EXPECT_EQ(count, 0u);
   EXPECT_EQ(tetrapage_group_pairs(group, nullptr, 0, &written), TETRAPAGE_OK);
   EXPECT_EQ(written, 0u);  // a failed step leaves no answer
-  EXPECT_EQ(tetrapage_group_pair_triangles(group, 0, nullptr, 0, &written, nullptr), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_group_pair_triangles(group, 0, nullptr, 0, &written, nullptr),
+            TETRAPAGE_ERROR_INPUT);
   EXPECT_EQ(tetrapage_group_step(group, nullptr, 0, &count), TETRAPAGE_ERROR_INVALID_ARGUMENT);
   EXPECT_EQ(tetrapage_group_pairs(group, nullptr, 1, &written), TETRAPAGE_ERROR_INVALID_ARGUMENT);
   tetrapage_group* none = nullptr;
   EXPECT_EQ(tetrapage_group_create(index, objects.data(), 0, &none), TETRAPAGE_ERROR_INPUT);
-  EXPECT_EQ(tetrapage_group_create(index, objects.data(), objects.size(), &none), TETRAPAGE_ERROR_STALE_HANDLE);
+  EXPECT_EQ(tetrapage_group_create(index, objects.data(), objects.size(), &none),
+            TETRAPAGE_ERROR_STALE_HANDLE);
   tetrapage_object* null_object = nullptr;
-  EXPECT_EQ(tetrapage_group_create(index, &null_object, 1, &none), TETRAPAGE_ERROR_INVALID_ARGUMENT);
-  EXPECT_NE(std::string(tetrapage_last_error()).find("objects[0]"), std::string::npos) << tetrapage_last_error();
+  EXPECT_EQ(tetrapage_group_create(index, &null_object, 1, &none),
+            TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("objects[0]"), std::string::npos)
+      << tetrapage_last_error();
   EXPECT_EQ(none, nullptr);
   EXPECT_EQ(tetrapage_group_destroy(group), TETRAPAGE_OK);
   EXPECT_EQ(tetrapage_group_destroy(group), TETRAPAGE_ERROR_STALE_HANDLE);
