@@ -310,14 +310,15 @@ TEST(ObjectGroup, RotatedCubesGrazingAtACorner) {
 
 TEST(ObjectGroup, ContainmentWithoutTouchingSurfaces) {
   const TriangleSoup ball = scaled(sphere(), 20);  // fits a cube of side 1
-  const TriangleSoup small = cube(0.05), big = cube(2);
-  ObjectGroup group(
-      nullptr, {model_of(small), model_of(ball), model_of(small), model_of(small), model_of(big)});
-  const std::vector<const TriangleSoup*> soups{&small, &ball, &small, &small, &big};
+  const TriangleSoup small = cube(0.05), big = cube(2), tiny = cube(0.005);
+  ObjectGroup group(nullptr, {model_of(small), model_of(ball), model_of(small), model_of(small),
+                              model_of(big), model_of(tiny)});
+  const std::vector<const TriangleSoup*> soups{&small, &ball, &small, &small, &big, &tiny};
   // 0: inside the ball (and the big cube); 2: in the ball's box corner, outside it; 3: across
-  // the ball's surface; 4: the big cube around everything, touching nothing.
-  const std::array<Pose, 5> poses{at(0.01, 0.02, -0.03), at(0, 0, 0), at(0.44, 0.44, 0.44),
-                                  at(0.5, 0, 0), at(0, 0, 0.1)};
+  // the ball's surface; 4: the big cube around everything, touching nothing; 5: inside the
+  // ball, just under its surface (where the interior grid cannot tell: a crossing parity).
+  const std::array<Pose, 6> poses{at(0.01, 0.02, -0.03), at(0, 0, 0),   at(0.44, 0.44, 0.44),
+                                  at(0.5, 0, 0),         at(0, 0, 0.1), at(0.47, 0.003, 0.002)};
   for (const bool containment : {true, false}) {
     GroupQueryOptions options;
     options.pair_containment = containment;
@@ -339,6 +340,8 @@ TEST(ObjectGroup, ContainmentWithoutTouchingSurfaces) {
       EXPECT_EQ(find(0, 1)->containment, PairContainment::first_inside_second);
       ASSERT_TRUE(find(1, 4));
       EXPECT_EQ(find(1, 4)->containment, PairContainment::first_inside_second);
+      ASSERT_TRUE(find(1, 5));
+      EXPECT_EQ(find(1, 5)->containment, PairContainment::second_inside_first);
     } else {
       EXPECT_FALSE(find(0, 1));
     }
