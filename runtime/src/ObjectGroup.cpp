@@ -23,9 +23,11 @@ struct PairSide {
   const geometry::Box& world_box;
 };
 
-// The first object's frame seen from the second's: x -> M x + d, computed in double and
-// rounded, so node boxes are compared with a margin far beyond those roundings and the
-// placements' (the comparison only prunes: each triangle pair is decided on world vertices).
+// The two objects' frames seen from each other: x_second = M x_first + d and back, x_first =
+// M^T x_second + e, computed in double and rounded, so node boxes are compared with a margin
+// far beyond those roundings and the placements' (the comparison only prunes: each triangle
+// pair is decided on world vertices). A box of one, taken into the other's frame, must meet
+// the other's box, and the other way round: the six face axes of a separating-axis test.
 class RelativeFrame {
  public:
   RelativeFrame(const PairSide& first, const PairSide& second) {
@@ -35,12 +37,19 @@ class RelativeFrame {
     const Vec3& tb = second.placed.translation();
     // world = R x + t for both, so x_second = Rb^T (Ra x_first + ta - tb).
     for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) {
-        m_[3 * i + j] = rb[i] * ra[j] + rb[3 + i] * ra[3 + j] + rb[6 + i] * ra[6 + j];
-        abs_m_[3 * i + j] = std::fabs(m_[3 * i + j]);
-      }
-      d_[i] = rb[i] * (ta[0] - tb[0]) + rb[3 + i] * (ta[1] - tb[1]) + rb[6 + i] * (ta[2] - tb[2]);
+      for (int j = 0; j < 3; ++j)
+        to_second_.m[3 * i + j] = rb[i] * ra[j] + rb[3 + i] * ra[3 + j] + rb[6 + i] * ra[6 + j];
+      to_second_.d[i] =
+          rb[i] * (ta[0] - tb[0]) + rb[3 + i] * (ta[1] - tb[1]) + rb[6 + i] * (ta[2] - tb[2]);
     }
+    // And x_first = Ra^T (Rb x_second + tb - ta).
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) to_first_.m[3 * i + j] = to_second_.m[3 * j + i];
+      to_first_.d[i] =
+          ra[i] * (tb[0] - ta[0]) + ra[3 + i] * (tb[1] - ta[1]) + ra[6 + i] * (tb[2] - ta[2]);
+    }
+    for (Map* map : {&to_second_, &to_first_})
+      for (int k = 0; k < 9; ++k) map->abs_m[k] = std::fabs(map->m[k]);
     const double magnitude =
         first.model.radius + second.model.radius +
         3 * (first.placed.translation_magnitude() + second.placed.translation_magnitude());
@@ -49,22 +58,32 @@ class RelativeFrame {
 
   // Can a point of `mine` (first frame) lie in `theirs` (second frame)? Conservative.
   bool boxes_meet(const geometry::Box& mine, const geometry::Box& theirs) const {
-    const Vec3 c{(mine.lo[0] + mine.hi[0]) / 2, (mine.lo[1] + mine.hi[1]) / 2,
-                 (mine.lo[2] + mine.hi[2]) / 2};
-    const Vec3 h{(mine.hi[0] - mine.lo[0]) / 2, (mine.hi[1] - mine.lo[1]) / 2,
-                 (mine.hi[2] - mine.lo[2]) / 2};
+    return lands_in(to_second_, mine, theirs) && lands_in(to_first_, theirs, mine);
+  }
+
+ private:
+  struct Map {
+    std::array<double, 9> m{}, abs_m{};
+    Vec3 d{};
+  };
+
+  // Does the box `from`, mapped by `map` (grown by the margin), meet the box `to`?
+  bool lands_in(const Map& map, const geometry::Box& from, const geometry::Box& to) const {
+    const Vec3 c{(from.lo[0] + from.hi[0]) / 2, (from.lo[1] + from.hi[1]) / 2,
+                 (from.lo[2] + from.hi[2]) / 2};
+    const Vec3 h{(from.hi[0] - from.lo[0]) / 2, (from.hi[1] - from.lo[1]) / 2,
+                 (from.hi[2] - from.lo[2]) / 2};
     for (int i = 0; i < 3; ++i) {
-      const double centre = m_[3 * i] * c[0] + m_[3 * i + 1] * c[1] + m_[3 * i + 2] * c[2] + d_[i];
-      const double half =
-          abs_m_[3 * i] * h[0] + abs_m_[3 * i + 1] * h[1] + abs_m_[3 * i + 2] * h[2] + margin_;
-      if (centre - half > theirs.hi[i] || centre + half < theirs.lo[i]) return false;
+      const double centre =
+          map.m[3 * i] * c[0] + map.m[3 * i + 1] * c[1] + map.m[3 * i + 2] * c[2] + map.d[i];
+      const double half = map.abs_m[3 * i] * h[0] + map.abs_m[3 * i + 1] * h[1] +
+                          map.abs_m[3 * i + 2] * h[2] + margin_;
+      if (centre - half > to.hi[i] || centre + half < to.lo[i]) return false;
     }
     return true;
   }
 
- private:
-  std::array<double, 9> m_{}, abs_m_{};
-  Vec3 d_{};
+  Map to_second_, to_first_;
   double margin_ = 0;
 };
 
