@@ -5,199 +5,27 @@
 // Handles are ids, never addresses: each is looked up in a process-wide table under a lock,
 // so a handle released already (or never issued) is found missing and reported, never
 // dereferenced. Ids come from one 64-bit counter and are never reused, so a stale handle
-// cannot alias a newer index or object.
+// cannot alias a newer index or object. Both, shared with CApiGroup.cpp, are in CApiSupport.h.
 
 #include "tetrapage/tetrapage.h"
 
 #include <algorithm>
 #include <cmath>
-#include <atomic>
-#include <cinttypes>
-#include <cstdio>
 #include <cstring>
-#include <exception>
 #include <memory>
-#include <mutex>
-#include <new>
-#include <shared_mutex>
 #include <string>
-#include <unordered_map>
 #include <utility>
 
+#include "CApiSupport.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 
+using namespace tetrapage::capi;
+
 namespace {
-
-thread_local std::string last_error_message;
-
-/// A null handle or pointer: reported as TETRAPAGE_ERROR_INVALID_ARGUMENT.
-class NullArgument : public std::exception {
- public:
-  explicit NullArgument(const char* name) : name_(name) {}
-  const char* what() const noexcept override { return name_; }
-
- private:
-  const char* name_;
-};
-
-template <class T>
-void require(const T* pointer, const char* name) {
-  if (pointer == nullptr) throw NullArgument(name);
-}
-
-/// A handle that names no live index or object: reported as TETRAPAGE_ERROR_STALE_HANDLE.
-class StaleHandle : public std::exception {
- public:
-  explicit StaleHandle(std::string message) : message_(std::move(message)) {}
-  const char* what() const noexcept override { return message_.c_str(); }
-
- private:
-  std::string message_;
-};
-
-// What a handle stands for. The object holds the index through its FlyingObject (shared
-// ownership), so closing the index handle first leaves the object answering.
-struct IndexState {
-  std::shared_ptr<const tetrapage::CollisionIndex> index;
-};
-
-struct ObjectState {
-  tetrapage::FlyingObject flying;
-  tetrapage::QueryResult result;
-  bool has_result = false;
-};
-
-// Shared by both tables: an index's id is never an object's.
-std::atomic<std::uint64_t> next_handle_id{1};
-
-/// The live handles of one kind. Lookups share the lock and return a reference-counted state,
-/// so a release on another thread cannot free what a call is using.
-template <class State>
-class HandleTable {
- public:
-  explicit HandleTable(const char* kind) : kind_(kind) {}
-
-  std::uintptr_t add(std::shared_ptr<State> state) {
-    const std::uint64_t id = next_handle_id.fetch_add(1, std::memory_order_relaxed);
-    if (id > std::uint64_t(UINTPTR_MAX)) throw std::bad_alloc();  // 32-bit ids exhausted
-    std::unique_lock lock(mutex_);
-    live_.emplace(std::uintptr_t(id), std::move(state));
-    return std::uintptr_t(id);
-  }
-
-  /// @throw StaleHandle naming the function's argument and the id.
-  std::shared_ptr<State> get(std::uintptr_t id) const {
-    {
-      std::shared_lock lock(mutex_);
-      if (auto found = live_.find(id); found != live_.end()) return found->second;
-    }
-    throw stale(id);
-  }
-
-  /// The state removed from the table (to be destroyed by the caller, outside the lock).
-  /// @throw StaleHandle when the id is not live.
-  std::shared_ptr<State> remove(std::uintptr_t id) {
-    std::shared_ptr<State> removed;
-    {
-      std::unique_lock lock(mutex_);
-      if (auto found = live_.find(id); found != live_.end()) {
-        removed = std::move(found->second);
-        live_.erase(found);
-      }
-    }
-    if (!removed) throw stale(id);
-    return removed;
-  }
-
- private:
-  StaleHandle stale(std::uintptr_t id) const {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "%s handle 0x%" PRIxPTR " is stale: released already, or never returned by tetrapage",
-                  kind_, id);
-    return StaleHandle(text);
-  }
-
-  const char* kind_;
-  mutable std::shared_mutex mutex_;
-  std::unordered_map<std::uintptr_t, std::shared_ptr<State>> live_;
-};
-
-// Never destroyed: a caller may release handles from its own static destructors, and the
-// states of handles never released must not be torn down (with their threads) at exit.
-HandleTable<IndexState>& indexes() {
-  static auto* table = new HandleTable<IndexState>("index");
-  return *table;
-}
-
-HandleTable<ObjectState>& objects() {
-  static auto* table = new HandleTable<ObjectState>("object");
-  return *table;
-}
-
-std::uintptr_t id_of(const void* handle) { return reinterpret_cast<std::uintptr_t>(handle); }
-
-std::shared_ptr<IndexState> index_state(const tetrapage_index* index) {
-  require(index, "index");
-  return indexes().get(id_of(index));
-}
-
-std::shared_ptr<ObjectState> object_state(const tetrapage_object* object) {
-  require(object, "object");
-  return objects().get(id_of(object));
-}
-
-tetrapage_status fail(tetrapage_status status, const char* function, const char* what) noexcept {
-  try {
-    last_error_message = std::string(function) + ": " + what;
-  } catch (...) {
-    // No memory for the message: the status still says what happened.
-    last_error_message.clear();
-  }
-  return status;
-}
-
-/// Runs `body`, mapping each exception to its status (most derived first).
-template <class Body>
-tetrapage_status guarded(const char* function, Body&& body) noexcept {
-  try {
-    body();
-    last_error_message.clear();
-    return TETRAPAGE_OK;
-  } catch (const NullArgument& e) {
-    return fail(TETRAPAGE_ERROR_INVALID_ARGUMENT, function,
-                (std::string(e.what()) + " is null").c_str());
-  } catch (const StaleHandle& e) {
-    return fail(TETRAPAGE_ERROR_STALE_HANDLE, function, e.what());
-  } catch (const tetrapage::IoError& e) {
-    return fail(TETRAPAGE_ERROR_IO, function, e.what());
-  } catch (const tetrapage::FormatError& e) {
-    return fail(TETRAPAGE_ERROR_FORMAT, function, e.what());
-  } catch (const tetrapage::InputError& e) {
-    return fail(TETRAPAGE_ERROR_INPUT, function, e.what());
-  } catch (const std::bad_alloc&) {
-    return fail(TETRAPAGE_ERROR_OUT_OF_MEMORY, function, "out of memory");
-  } catch (const std::exception& e) {
-    return fail(TETRAPAGE_ERROR_INTERNAL, function, e.what());
-  } catch (...) {
-    return fail(TETRAPAGE_ERROR_INTERNAL, function, "unknown exception");
-  }
-}
-
-/// The int a C caller passed as an enum, read without loading it as the C++ enum: any int may
-/// arrive, and loading one outside the enumerators' range is undefined behaviour in C++.
-/// (Even copying it is such a load, so the enum is taken by reference.)
-template <class Enum>
-int caller_value(const Enum& value) {
-  static_assert(sizeof(Enum) == sizeof(int));
-  int raw = 0;
-  std::memcpy(&raw, &value, sizeof raw);
-  return raw;
-}
 
 /// `accuracy`: a tetrapage_accuracy read by caller_value.
 tetrapage::geometry::Accuracy to_accuracy(int accuracy, double parameter) {

@@ -71,11 +71,11 @@ void ContainmentCheck::check_obstacle_inside_object(const geometry::Box& box, Pl
   }
   enclosed_.resize(undecided);
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i)
-    if (crossing_parity_holds(enclosed_[i].second, box, object)) inside(enclosed_[i].first);
+    if (crossing_parity_holds(*model_, object, enclosed_[i].second, box)) inside(enclosed_[i].first);
 }
 
-bool ContainmentCheck::crossing_parity_holds(const geometry::Point& p, const geometry::Box& box,
-                                             PlacedObject& object) const {
+bool crossing_parity_holds(const ObjectModel& model, PlacedObject& object, const geometry::Point& p,
+                           const geometry::Box& box) {
   // Parity of crossings with the placed object along a segment from p to beyond the object's
   // box; a direction whose segment meets an edge, a vertex or a plane is replaced by the next.
   // Directions are nearly along the object's own axes, so that the segment's box in the
@@ -101,7 +101,7 @@ bool ContainmentCheck::crossing_parity_holds(const geometry::Point& p, const geo
     const geometry::Segment segment{p, far};
     // The segment's box in the object's frame (rounded: it only prunes), as in phase II.
     geometry::Box query;
-    double magnitude = model_->radius;
+    double magnitude = model.radius;
     for (const auto& q : segment) {
       query.extend(object.to_object_frame(q));
       for (int a = 0; a < 3; ++a)
@@ -109,7 +109,7 @@ bool ContainmentCheck::crossing_parity_holds(const geometry::Point& p, const geo
     }
     const double grow = magnitude * 0x1p-40;
     for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-    if (const auto odd = crossing_parity(model_->bvh, model_->closed_components, segment, query,
+    if (const auto odd = crossing_parity(model.bvh, model.closed_components, segment, query,
                                          [&](std::uint32_t t) { return object.world_triangle(t); }))
       return *odd;
   }

@@ -19,6 +19,13 @@
 
 namespace tetrapage {
 
+/// Does the closed `model`, placed as `object`, hold the world point p? By the parity of
+/// crossings along segments reaching beyond `box` (a world box holding the placed object), for
+/// when the interior grid cannot tell: p must not lie on the object's surface. Also used for
+/// one flying object inside another (ObjectGroup).
+bool crossing_parity_holds(const ObjectModel& model, PlacedObject& object, const geometry::Point& p,
+                           const geometry::Box& box);
+
 class ContainmentCheck {
  public:
   ContainmentCheck(const CollisionIndex& index, const ObjectModel& model)
@@ -40,11 +47,6 @@ class ContainmentCheck {
                                     QueryResult& result);
   void check_obstacle_inside_object(const geometry::Box& box, PlacedObject& object,
                                     QueryResult& result);
-  // Does the placed object hold p? By the parity of crossings (the interior grid could not
-  // tell): p must not lie on the object's surface.
-  bool crossing_parity_holds(const geometry::Point& p, const geometry::Box& box,
-                             PlacedObject& object) const;
-
   const CollisionIndex* index_;
   const ObjectModel* model_;
   // Per step: the environment components whose boxes lie in the object's box (only those can

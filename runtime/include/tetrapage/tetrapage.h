@@ -363,6 +363,65 @@ tetrapage_status tetrapage_time_of_impact(tetrapage_object* object, const double
                                           const double to[7], double tolerance,
                                           tetrapage_impact* result);
 
+/* ------------------------------------------------------------------------------------------ */
+/* Groups of objects                                                                           */
+
+/* Several objects moving through one index, checked at each step against the environment and
+   against each other (the C++ ObjectGroup). Object/object answers are exact on the placed
+   vertices: a pair collides when a triangle of one meets a triangle of the other (touching
+   counts), or when one holds a component of the other inside a closed component. A group is
+   used from one thread at a time. */
+typedef struct tetrapage_group tetrapage_group;
+
+/* Creates a group of `count` (>= 1) objects on `index`: the group's object k is a new flying
+   instance of objects[k]'s mesh (the object handles stay the caller's; destroying them later
+   does not affect the group). On failure *group is set to NULL.
+   Errors: TETRAPAGE_ERROR_INPUT (count is 0), TETRAPAGE_ERROR_INVALID_ARGUMENT (a null
+           argument or a null objects[k]), TETRAPAGE_ERROR_STALE_HANDLE (a closed index, or an
+           objects[k] destroyed already). */
+tetrapage_status tetrapage_group_create(tetrapage_index* index, tetrapage_object* const* objects,
+                                        size_t count, tetrapage_group** group);
+
+/* Releases the group, whose handle becomes stale. A null group is ignored (TETRAPAGE_OK).
+   Errors: TETRAPAGE_ERROR_STALE_HANDLE (destroyed already, or not a group handle). */
+tetrapage_status tetrapage_group_destroy(tetrapage_group* group);
+
+/* One step: object k at poses[7k .. 7k+6] (tx, ty, tz, qw, qx, qy, qz, as tetrapage_query),
+   checked against the environment (exact accuracy, the object's mesh, discrete) and against
+   every other object. all_contacts: 0 keeps the first contact found per object and per pair;
+   non-zero every one. On success *colliding_pairs is the number of pairs of objects that
+   collide; the answers are kept in the group until its next step.
+   Errors: as tetrapage_query (the message names the object of a bad pose),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. After a failure the
+           group holds no answer. */
+tetrapage_status tetrapage_group_step(tetrapage_group* group, const double* poses, int all_contacts,
+                                      size_t* colliding_pairs);
+
+/* Copies the first min(capacity, count) colliding pairs of the last step to `pairs` as
+   (first, second) object indices, first < second, sorted (2 * capacity uint32_t), and their
+   number to *written. `pairs` may be null when capacity is 0.
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_group_pairs(const tetrapage_group* group, uint32_t* pairs, size_t capacity,
+                                       size_t* written);
+
+/* The triangle pairs of colliding pair `pair` (its rank in tetrapage_group_pairs): (triangle of
+   first, triangle of second), sorted (2 * capacity uint32_t); *written is how many were copied
+   and *containment why the pair collides without them: 0 surfaces touch, 1 first lies inside
+   second, 2 second inside first (then no triangle pair). `triangles` may be null when capacity
+   is 0; containment may be null.
+   Errors: TETRAPAGE_ERROR_INPUT (no such pair), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_group_pair_triangles(const tetrapage_group* group, size_t pair,
+                                                uint32_t* triangles, size_t capacity, size_t* written,
+                                                int* containment);
+
+/* Per object k, collides[k] = 1 when it collided with the environment in the last step (its
+   surfaces touch, or one body holds the other), else 0; for the first min(capacity, count)
+   objects, their number to *written.
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_group_environment(const tetrapage_group* group, int* collides, size_t capacity,
+                                             size_t* written);
+
 #ifdef __cplusplus
 }
 #endif

@@ -16,6 +16,7 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "tetrapage/runtime/geometry/Accuracy.h"
@@ -165,6 +166,47 @@ class ObjectBVH {
     if (counters) {
       counters->nodes_visited += visited;
       counters->triangle_tests += tests;
+    }
+  }
+
+  /// Both hierarchies descended together (two objects, each in its own frame): calls
+  /// visit(mine, theirs) (indices in the inputs) for every pair of a triangle of this BVH and
+  /// one of `other` whose leaves' boxes, and every ancestor's, `meet(my_box, their_box)`
+  /// accepts, until visit returns false. `meet` receives node boxes in their own frames (rounded
+  /// outwards) and must be conservative: it compares boxes across frames, so it is the caller's.
+  template <class Meet, class Visit>
+  void for_each_pair(const ObjectBVH& other, Meet&& meet, Visit&& visit) const {
+    const auto box_of_node = [](const Node& n) {
+      Box b;
+      b.lo = {n.lo[0], n.lo[1], n.lo[2]};
+      b.hi = {n.hi[0], n.hi[1], n.hi[2]};
+      return b;
+    };
+    // Each split pops one pair and pushes two: the stack holds at most one pair per level of
+    // either hierarchy, plus one.
+    std::pair<std::uint32_t, std::uint32_t> stack[2 * kMaxStack + 2];
+    int top = 0;
+    if (meet(box_of_node(nodes_[0]), box_of_node(other.nodes_[0]))) stack[top++] = {0, 0};
+    while (top > 0) {
+      const auto [a, b] = stack[--top];
+      const Node& na = nodes_[a];
+      const Node& nb = other.nodes_[b];
+      if (na.count > 0 && nb.count > 0) {
+        for (std::uint32_t i = na.first; i < na.first + na.count; ++i)
+          for (std::uint32_t j = nb.first; j < nb.first + nb.count; ++j)
+            if (!visit(original_[i], other.original_[j])) return;
+        continue;
+      }
+      // Split the inner node, or the larger of two (by the sum of its sides).
+      const auto sides = [](const Node& n) { return (n.hi[0] - n.lo[0]) + (n.hi[1] - n.lo[1]) + (n.hi[2] - n.lo[2]); };
+      const bool split_mine = nb.count > 0 || (na.count == 0 && sides(na) >= sides(nb));
+      if (split_mine) {
+        for (const std::uint32_t child : {na.first, a + 1})
+          if (meet(box_of_node(nodes_[child]), box_of_node(nb))) stack[top++] = {child, b};
+      } else {
+        for (const std::uint32_t child : {nb.first, b + 1})
+          if (meet(box_of_node(na), box_of_node(other.nodes_[child]))) stack[top++] = {a, child};
+      }
     }
   }
 
