@@ -47,7 +47,7 @@ struct Arguments {
   fs::path scene, object, flight, index, report;
   std::optional<double> max_distance;
   std::size_t impact_steps = 0;      // 0: every consecutive pair
-  std::size_t fcl_impact_steps = 100;  // FCL's continuous collision is slow: its rows' motions
+  std::size_t fcl_ca_steps = 10;       // FCL's conservative advancement is slow: its rows' motions
   std::size_t naive_samples = 10;      // FCL's default request
 };
 
@@ -70,6 +70,8 @@ struct Row {
               {"steps", seconds.size()},
               {"steps_per_second", steps_per_second()},
               {"latency_us", LatencySummary::of(seconds).to_json()}};
+    if (!seconds.empty())  // the step to replay when the tail needs explaining
+      j["slowest_step_offset"] = std::size_t(std::max_element(seconds.begin(), seconds.end()) - seconds.begin());
     j.update(extra);
     return j;
   }
@@ -423,10 +425,11 @@ json run_impact(const Workload& w, FclPeers& fcl, const Arguments& args) {
   Row tetrapage = tetrapage_impacts(w, end, mine);
   tetrapage.name = "tetrapage time_of_impact";
   tetrapage.description = "FlyingObject::time_of_impact, tolerance 1e-4 (default ImpactOptions)";
-  const std::size_t fcl_end = std::min(end, args.fcl_impact_steps + 1);
+  const std::size_t ca_end = std::min(end, args.fcl_ca_steps + 1);
   std::vector<Row> rows;
   auto add_fcl_row = [&](FclDistance& model, FclImpactSolver solver, std::string name, std::string description) {
     std::vector<FclImpactAnswer> answers;
+    const std::size_t fcl_end = solver == FclImpactSolver::naive ? end : ca_end;
     Row row = fcl_impacts(model, w.poses, fcl_end, solver, args.naive_samples, answers);
     row.name = std::move(name);
     row.description = std::move(description);
@@ -445,8 +448,8 @@ json run_impact(const Workload& w, FclPeers& fcl, const Arguments& args) {
   hull.name = "tetrapage swept hull (yes/no)";
   hull.description = "FlyingObject::query, Motion::swept: the convex hull of the object at both poses";
   hull.extra["agreement"] = swept_agreement(mine, swept);
-  std::printf("\n### Time of impact, %zu motions (pose i-1 -> i; FCL rows: the first %zu; no untimed pass, the index "
-              "is preloaded)\n\n", end - 1, fcl_end - 1);
+  std::printf("\n### Time of impact, %zu motions (pose i-1 -> i; FCL's conservative advancement: the first %zu; no "
+              "untimed pass, the index is preloaded)\n\n", end - 1, ca_end - 1);
   std::printf("| row | steps/s | p50 us | p99 us | max us | tetrapage steps/s / row's | hits both / neither / only "
               "tetrapage / only FCL; FCL time < free_until / > contact_at; median / max |FCL time - contact_at| |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---|\n");
@@ -528,8 +531,8 @@ int main(int argc, char** argv) {
   app.add_option("index", args.index, "The scene's index (.tpi)")->required()->check(CLI::ExistingFile);
   app.add_option("--max-distance", args.max_distance, "Also time tetrapage's distance bounded by this (FCL has no bound)");
   app.add_option("--impact-steps", args.impact_steps, "Time of impact on the first N motions only (0: all)");
-  app.add_option("--fcl-impact-steps", args.fcl_impact_steps,
-                 "FCL's continuous collision on the first N motions only (default 100: it is slow)");
+  app.add_option("--fcl-ca-steps", args.fcl_ca_steps,
+                 "FCL's conservative advancement on the first N motions only (default 10: it is slow)");
   app.add_option("--naive-samples", args.naive_samples, "Times sampled by FCL's naive continuous collision (default 10)")
       ->check(CLI::Range(std::size_t(2), std::size_t(10000)));
   app.add_option("--report", args.report, "Write the figures as JSON");

@@ -17,7 +17,7 @@ run_checked(${CLI} generate flight --env ${WORK}/scene.ply --object ${WORK}/obje
 run_checked(${CLI} preprocess ${WORK}/scene.ply -o ${WORK}/scene.tpi --precision double --threads 1)
 # FCL's conservative advancement takes a tenth of a second per motion here: 20 motions.
 run_checked(${BENCH} ${WORK}/scene.ply ${WORK}/object.ply ${WORK}/flight.csv ${WORK}/scene.tpi --max-distance 0.05
-            --fcl-impact-steps 20 --report ${WORK}/report.json)
+            --fcl-ca-steps 20 --report ${WORK}/report.json)
 message(STATUS "${last_output}")
 
 foreach(row "tetrapage distance" "FCL OBBRSS exact" "FCL OBBRSS default request" "FCL RSS exact"
