@@ -1,14 +1,10 @@
 #include "tetrapage/bench/FclCollider.h"
 
-#include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/math/bv/OBBRSS.h>
 #include <fcl/narrowphase/collision.h>
 #include <fcl/narrowphase/collision_object.h>
 
-#include <string>
-#include <vector>
-
-#include "tetrapage/formats/Error.h"
+#include "FclModel.h"
 
 namespace tetrapage {
 namespace {
@@ -16,29 +12,7 @@ namespace {
 using Model = fcl::BVHModel<fcl::OBBRSSd>;
 
 std::shared_ptr<Model> build_model(const TriangleSoup& soup, const char* what) {
-  if (soup.triangles.empty()) throw InputError(std::string("FCL collider: the ") + what + " has no triangle");
-  std::vector<fcl::Vector3d> points;
-  points.reserve(soup.vertices.size());
-  for (const auto& v : soup.vertices) points.emplace_back(v[0], v[1], v[2]);
-  std::vector<fcl::Triangle> triangles;
-  triangles.reserve(soup.triangles.size());
-  for (const auto& t : soup.triangles) triangles.emplace_back(t[0], t[1], t[2]);
-  auto model = std::make_shared<Model>();
-  int status = model->beginModel(int(triangles.size()), int(points.size()));
-  if (status == fcl::BVH_OK) status = model->addSubModel(points, triangles);
-  if (status == fcl::BVH_OK) status = model->endModel();
-  if (status != fcl::BVH_OK)
-    throw Error(std::string("FCL collider: BVHModel<OBBRSS> of the ") + what + " failed with status " +
-                std::to_string(status));
-  return model;
-}
-
-// The arrays a built BVHModel holds: BV nodes, triangles with their primitive indices, vertices.
-// (BVHModel::memUsage returns a status code in FCL 0.7 and sums in int, so it cannot say.)
-std::uint64_t model_bytes(const Model& model) {
-  return std::uint64_t(model.getNumBVs()) * sizeof(fcl::BVNode<fcl::OBBRSSd>) +
-         std::uint64_t(model.num_tris) * (sizeof(fcl::Triangle) + sizeof(unsigned int)) +
-         std::uint64_t(model.num_vertices) * sizeof(fcl::Vector3d);
+  return fcl_model::build<fcl::OBBRSSd>(soup, "FCL collider", what, "OBBRSS");
 }
 
 }  // namespace
@@ -53,19 +27,13 @@ class FclCollider::Impl {
         request_(/*num_max_contacts=*/1, /*enable_contact=*/false) {}
 
   bool collides(const Pose& pose) {
-    // The matrix apply_pose uses; with the environment first (identity transform), FCL's
-    // relative transform is exactly this one.
-    const auto r = rotation_matrix(pose.rotation);
-    fcl::Transform3d transform = fcl::Transform3d::Identity();
-    transform.linear() << r[0], r[1], r[2], r[3], r[4], r[5], r[6], r[7], r[8];
-    transform.translation() << pose.translation[0], pose.translation[1], pose.translation[2];
-    object_.setTransform(transform);
+    object_.setTransform(fcl_model::transform_of(pose));
     result_.clear();
     fcl::collide(&environment_, &object_, request_, result_);
     return result_.isCollision();
   }
 
-  std::uint64_t structure_bytes() const { return model_bytes(*environment_model_) + model_bytes(*object_model_); }
+  std::uint64_t structure_bytes() const { return fcl_model::bytes(*environment_model_) + fcl_model::bytes(*object_model_); }
 
  private:
   std::shared_ptr<Model> environment_model_, object_model_;
