@@ -12,11 +12,10 @@
 /// [v, w] with a plane (or, coplanar, with an edge line of the other triangle), computed as
 /// v + t (w - v) with t = |f(v)| / (|f(v)| + |f(w)|), f that plane's or line's determinant.
 /// f(v) and f(w) are computed within 2^-42 (|f(v)| + |f(w)|) of the exact values together (a
-/// floating-point filter with a proven bound, else CGAL's exact Mpzf, t then
-/// rounded from the exact rational), so
-/// |t - t*| <= 2^-42 + 2u, and each coordinate of the point is within
-/// 2 M (2^-42 + 2u) + 5 u M < 2^-40 M (about 9.1e-13 M) of the exact point's (the rounding of
-/// w - v, of the product and of the sum adding 2u, 2u and u times M):
+/// floating-point filter with a proven bound; else exactly, with CGAL's Mpzf, and t rounded
+/// from the exact rational), so |t - t*| <= 2^-42 + 2u, and each coordinate of the point is
+/// within 2 M (2^-42 + 2u) + 5 u M < 2^-40 M (about 9.1e-13 M) of the exact point's (the
+/// roundings of w - v, of the product and of the sum add 2u, 2u and u times M):
 /// kContactPointRelativeError * M. In practice the error is a few u M. The unit normals are
 /// within 2^-40 of the exact ones, for any triangle, however thin. Coordinates are assumed
 /// finite and below about 1e150 in magnitude (nothing may overflow).
