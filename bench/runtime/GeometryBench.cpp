@@ -28,6 +28,7 @@
 #include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/runtime/geometry/SegmentTriangle.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
+#include "tetrapage/runtime/geometry/TriangleContact.h"
 #include "tetrapage/runtime/geometry/TriangleDistance.h"
 #include "tetrapage/runtime/geometry/TriangleTetrahedron.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
@@ -385,6 +386,44 @@ void register_distance() {
   }
 }
 
+// Contact geometry on pairs that meet: crossing pairs (random pairs kept when they intersect),
+// exact touching contacts, and coplanar overlapping pairs (polygons); Epeck's constructed
+// intersection next to it on the crossing pairs.
+void register_contact() {
+  static std::vector<Pair> crossing, coplanar;
+  Generator g(6);
+  while (crossing.size() < kInputs) {
+    Pair p;
+    const Point ca = g.point(0, 1), cb = add(ca, g.point(-0.2, 0.2));
+    for (auto& v : p.a) v = add(ca, g.point(-0.3, 0.3));
+    for (auto& v : p.b) v = add(cb, g.point(-0.3, 0.3));
+    if (triangles_intersect(p.a, p.b)) crossing.push_back(p);
+  }
+  while (coplanar.size() < kInputs) {  // lattice triangles in the plane z = 3
+    Pair p;
+    for (auto* t : {&p.a, &p.b})
+      for (auto& v : *t) v = {std::floor(g.uniform(-64, 64)), std::floor(g.uniform(-64, 64)), 3};
+    if (triangles_intersect(p.a, p.b)) coplanar.push_back(p);
+  }
+  const std::vector<std::pair<std::string, const std::vector<Pair>*>> sets{
+      {"crossing", &crossing}, {"touching", &pairs("touching")}, {"coplanar", &coplanar}};
+  for (const auto& [name, data] : sets)
+    benchmark::RegisterBenchmark(("triangle_contact/" + name + "/double").c_str(), [data](benchmark::State& s) {
+      run(s, *data, [](const Pair& p) { return contact_geometry(p.a, p.b).count; });
+    });
+  benchmark::RegisterBenchmark("triangle_contact/crossing/cgal_epeck_intersection", [](benchmark::State& s) {
+    std::vector<std::pair<Epeck::Triangle_3, Epeck::Triangle_3>> converted;
+    for (const auto& p : crossing) converted.emplace_back(to_cgal<Epeck>(p.a), to_cgal<Epeck>(p.b));
+    run(s, converted, [](const auto& c) {
+      const auto result = CGAL::intersection(c.first, c.second);
+      double x = 0;  // read the endpoints (their interval approximations)
+      if (const auto* segment = result ? boost::get<Epeck::Segment_3>(&*result) : nullptr)
+        x = CGAL::to_double(segment->source().x()) + CGAL::to_double(segment->target().x());
+      return x;
+    });
+  });
+}
+
 // Phase II: an object of ~20k triangles, queried by small environment triangles around it.
 void register_bvh() {
   static TriangleSoup object;
@@ -443,6 +482,7 @@ int main(int argc, char** argv) {
   register_triangle_box();
   register_tetrahedra();
   register_distance();
+  register_contact();
   register_bvh();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

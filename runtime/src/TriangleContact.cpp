@@ -1,9 +1,11 @@
 #include "tetrapage/runtime/geometry/TriangleContact.h"
 
+#include <CGAL/Gmpq.h>
 #include <CGAL/Mpzf.h>
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 
 #include "CoplanarTests.h"
 #include "PlaneCut.h"
@@ -15,12 +17,32 @@ namespace {
 
 using internal::Point2;
 
-// The filter accepts a determinant when its rounding error is below 2^-46 of its magnitude;
-// filter_accepts(x, ...) checks x > 2 * bound, hence the scale 2^-45.
-constexpr double kAcceptScale = 0x1p-45;
+// A determinant computed in double by expansion of minors, with what bounds its error:
+// |value - exact| <= bound + 2^-1072 underflow_units (DeterminantFilter.h).
+struct Estimate {
+  double value;
+  double bound;
+  double underflow_units;
+};
 
-// det[b - a, c - a, d - a] (the value whose sign orient3d gives), relative error <= 2^-46.
-double orient3d_value(const Point& a, const Point& b, const Point& c, const Point& d) {
+// The accuracy asked of the determinants that place a point: their errors together below
+// 2^-42 of their magnitudes. Tighter asks for the exact fallback too often (the filter's bound
+// is 8u times the permanent, which is often 10 to 100 times the determinant).
+constexpr double kDeterminantAccuracy = 0x1p-42;
+
+// The errors together are below kDeterminantAccuracy * magnitude: filter_accepts(x, ...)
+// checks that each of the two error terms is below x / 2.
+bool accurate_enough(std::initializer_list<Estimate> values, double magnitude) {
+  double bound = 0, units = 0;
+  for (const Estimate& e : values) {
+    bound += e.bound;
+    units += e.underflow_units;
+  }
+  return detail::filter_accepts(magnitude * kDeterminantAccuracy, 1.0, bound, units);
+}
+
+// det[b - a, c - a, d - a], the value whose sign orient3d gives.
+Estimate orient3d_estimate(const Point& a, const Point& b, const Point& c, const Point& d) {
   const double ux = b[0] - a[0], uy = b[1] - a[1], uz = b[2] - a[2];
   const double vx = c[0] - a[0], vy = c[1] - a[1], vz = c[2] - a[2];
   const double wx = d[0] - a[0], wy = d[1] - a[1], wz = d[2] - a[2];
@@ -30,52 +52,99 @@ double orient3d_value(const Point& a, const Point& b, const Point& c, const Poin
   const double permanent = awx * (std::fabs(p1) + std::fabs(p2)) +
                            awy * (std::fabs(p3) + std::fabs(p4)) +
                            awz * (std::fabs(p5) + std::fabs(p6));
-  if (detail::filter_accepts(std::fabs(det) * kAcceptScale, detail::kOrient3dRelativeBound,
-                             permanent, awx + awy + awz + 2))
-    return det;
-  // Exact: Mpzf represents every double and every sum and product of them.
-  using CGAL::Mpzf;
+  return {det, detail::kOrient3dRelativeBound * permanent, awx + awy + awz + 2};
+}
+
+// The exact fallback: Mpzf holds every sum and product of doubles exactly, without the gcd
+// of a rational (slow for tiny coordinates, whose denominators reach 2^1074); only the ratio
+// t goes through a rational, so that it is exact before its rounding even when the
+// determinants lie below the range of double.
+using CGAL::Mpzf;
+
+Mpzf orient3d_exact(const Point& a, const Point& b, const Point& c, const Point& d) {
   auto diff = [](double x, double y) { return Mpzf(x) - Mpzf(y); };
-  const Mpzf eux = diff(b[0], a[0]), euy = diff(b[1], a[1]), euz = diff(b[2], a[2]);
-  const Mpzf evx = diff(c[0], a[0]), evy = diff(c[1], a[1]), evz = diff(c[2], a[2]);
-  const Mpzf ewx = diff(d[0], a[0]), ewy = diff(d[1], a[1]), ewz = diff(d[2], a[2]);
-  const Mpzf exact =
-      ewx * (euy * evz - euz * evy) + ewy * (euz * evx - eux * evz) + ewz * (eux * evy - euy * evx);
-  return exact.to_double();  // within 2u relative
+  const Mpzf ux = diff(b[0], a[0]), uy = diff(b[1], a[1]), uz = diff(b[2], a[2]);
+  const Mpzf vx = diff(c[0], a[0]), vy = diff(c[1], a[1]), vz = diff(c[2], a[2]);
+  const Mpzf wx = diff(d[0], a[0]), wy = diff(d[1], a[1]), wz = diff(d[2], a[2]);
+  return wx * (uy * vz - uz * vy) + wy * (uz * vx - ux * vz) + wz * (ux * vy - uy * vx);
 }
 
-// (b - a) x (c - a) for 2D points (the value whose sign orient2d gives), relative error
-// <= 2^-46.
-double orient2d_value(const Point2& a, const Point2& b, const Point2& c) {
-  const double ux = b.x - a.x, uy = b.y - a.y, vx = c.x - a.x, vy = c.y - a.y;
-  const double left = ux * vy, right = uy * vx;
-  const double det = left - right;
-  if (detail::filter_accepts(std::fabs(det) * kAcceptScale, detail::kOrient2dRelativeBound,
-                             std::fabs(left) + std::fabs(right), 2))
-    return det;
-  using CGAL::Mpzf;
-  const Mpzf exact = (Mpzf(b.x) - Mpzf(a.x)) * (Mpzf(c.y) - Mpzf(a.y)) -
-                     (Mpzf(b.y) - Mpzf(a.y)) * (Mpzf(c.x) - Mpzf(a.x));
-  return exact.to_double();
+// x / y rounded to double (within 2u relative), y nonzero.
+double exact_ratio(const Mpzf& x, const Mpzf& y) {
+  return CGAL::to_double(CGAL::Gmpq(x) / CGAL::Gmpq(y));
 }
 
-// The point of [v, w] where an affine function with values fv, fw (nonzero, opposite signs)
-// vanishes: v + t (w - v), t = fv / (fv - fw), in [0, 1] whatever the rounding.
-Point zero_on_edge(const Point& v, const Point& w, double fv, double fw) {
-  const double t = std::fabs(fv) / (std::fabs(fv) + std::fabs(fw));
+// (b - a) x (c - a) for 2D points, the value whose sign orient2d gives.
+Estimate orient2d_estimate(const Point2& a, const Point2& b, const Point2& c) {
+  const double left = (b.x - a.x) * (c.y - a.y), right = (b.y - a.y) * (c.x - a.x);
+  return {left - right, detail::kOrient2dRelativeBound * (std::fabs(left) + std::fabs(right)), 2};
+}
+
+Mpzf orient2d_exact(const Point2& a, const Point2& b, const Point2& c) {
+  return (Mpzf(b.x) - Mpzf(a.x)) * (Mpzf(c.y) - Mpzf(a.y)) -
+         (Mpzf(b.y) - Mpzf(a.y)) * (Mpzf(c.x) - Mpzf(a.x));
+}
+
+// The point of [v, w] where an affine function f vanishes, f(v) and f(w) nonzero of opposite
+// signs: v + t (w - v) with t = |f(v)| / (|f(v)| + |f(w)|), in [0, 1] whatever the rounding.
+// With both values within 2^-42 (|f(v)| + |f(w)|) of the exact ones, |t - t*| <= 2^-42 + 2u
+// (t(a, b) - t(a*, b*) = (a b* - a* b) / ((a + b)(a* + b*)), exactly).
+Point at_parameter(const Point& v, const Point& w, double t) {
   return {v[0] + t * (w[0] - v[0]), v[1] + t * (w[1] - v[1]), v[2] + t * (w[2] - v[2])};
+}
+Point zero_on_edge(const Point& v, const Point& w, double fv, double fw) {
+  return at_parameter(v, w, std::fabs(fv) / (std::fabs(fv) + std::fabs(fw)));
+}
+// The same with exact values: t exact, then rounded (within 2u relative).
+Point zero_on_edge(const Point& v, const Point& w, const Mpzf& fv, const Mpzf& fw) {
+  const Mpzf a = CGAL::abs(fv), b = CGAL::abs(fw);
+  return at_parameter(v, w, exact_ratio(a, a + b));
+}
+
+// Edge [v, w] of one triangle crossing the plane of `plane`.
+Point crossing_of_plane(const Point& v, const Point& w, const Triangle& plane) {
+  const Estimate fv = orient3d_estimate(plane[0], plane[1], plane[2], v);
+  const Estimate fw = orient3d_estimate(plane[0], plane[1], plane[2], w);
+  if (accurate_enough({fv, fw}, std::fabs(fv.value) + std::fabs(fw.value)))
+    return zero_on_edge(v, w, fv.value, fw.value);
+  return zero_on_edge(v, w, orient3d_exact(plane[0], plane[1], plane[2], v),
+                      orient3d_exact(plane[0], plane[1], plane[2], w));
+}
+
+// Segment [v, w] crossing the line (r, s), in the projection `flat` of their common plane
+// (the ratio of the two determinants is the same in the plane and in the projection).
+Point crossing_of_line(const Point& v, const Point& w, const Point2& fv2, const Point2& fw2,
+                       const Point2& r, const Point2& s) {
+  const Estimate fv = orient2d_estimate(r, s, fv2), fw = orient2d_estimate(r, s, fw2);
+  if (accurate_enough({fv, fw}, std::fabs(fv.value) + std::fabs(fw.value)))
+    return zero_on_edge(v, w, fv.value, fw.value);
+  return zero_on_edge(v, w, orient2d_exact(r, s, fv2), orient2d_exact(r, s, fw2));
 }
 
 Vec3 unit_normal(const Triangle& t) {
-  // Component k is the orientation of the projection along k (see normal_sign), computed to
-  // 2^-46 relative, so the direction is accurate even for slivers.
-  Vec3 n;
-  for (int axis = 0; axis < 3; ++axis)
-    n[axis] = orient2d_value(internal::project(t[0], axis), internal::project(t[1], axis),
-                             internal::project(t[2], axis));
+  // Component k is the orientation of the projection along k (see normal_sign), computed
+  // within 2^-42 of the largest in all, so the direction is accurate even for slivers.
+  std::array<Point2, 3> p[3];
+  std::array<Estimate, 3> e;
+  for (int axis = 0; axis < 3; ++axis) {
+    p[axis] = internal::project(t, axis);
+    e[axis] = orient2d_estimate(p[axis][0], p[axis][1], p[axis][2]);
+  }
+  Vec3 n{e[0].value, e[1].value, e[2].value};
+  if (!accurate_enough({e[0], e[1], e[2]},
+                       std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])}))) {
+    // Exactly, divided by the largest magnitude before rounding (the components may lie
+    // below the range of double).
+    std::array<Mpzf, 3> exact;
+    for (int axis = 0; axis < 3; ++axis)
+      exact[axis] = orient2d_exact(p[axis][0], p[axis][1], p[axis][2]);
+    const Mpzf largest = std::max({CGAL::abs(exact[0]), CGAL::abs(exact[1]), CGAL::abs(exact[2])});
+    if (CGAL::is_zero(largest)) return {0, 0, 0};
+    for (int axis = 0; axis < 3; ++axis) n[axis] = exact_ratio(exact[axis], largest);
+  }
   const double largest = std::max({std::fabs(n[0]), std::fabs(n[1]), std::fabs(n[2])});
   if (largest == 0) return {0, 0, 0};
-  for (double& x : n) x /= largest;  // exact (a power of two would be too), avoids overflow
+  for (double& x : n) x /= largest;  // no overflow nor underflow in the squares
   const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
   for (double& x : n) x /= length;
   return n;
@@ -98,9 +167,7 @@ void set_shape_from_count(ContactGeometry& out) {
 Point cut_point(const Triangle& t, const Sign s[3], internal::IntervalEnd end,
                 const Triangle& plane) {
   if (s[end.other] == Sign::zero) return t[end.other];
-  const double f_off = orient3d_value(plane[0], plane[1], plane[2], t[end.off]);
-  const double f_other = orient3d_value(plane[0], plane[1], plane[2], t[end.other]);
-  return zero_on_edge(t[end.off], t[end.other], f_off, f_other);
+  return crossing_of_plane(t[end.off], t[end.other], plane);
 }
 
 // a and b proper and not coplanar, sa and sb their vertices' sides of the other plane (each
@@ -152,11 +219,12 @@ class PlanarContact {
       for (int j = 0; j < edges(q_); ++j) add_crossing(p_, i, q_, j);
   }
 
-  // Writes the corners, a polygon in counterclockwise order about `normal`.
-  void write(const Vec3& normal, ContactGeometry& out) const {
+  // Writes the corners; a polygon in the order whose projected orientation is
+  // `counterclockwise`.
+  void write(Sign counterclockwise, ContactGeometry& out) const {
     std::array<int, kMax> order{};
     for (int i = 0; i < count_; ++i) order[i] = i;
-    if (count_ >= 3) sort_around(normal, order);
+    if (count_ >= 3) sort_around(counterclockwise, order);
     for (int i = 0; i < std::min(count_, 6); ++i) add_point(out, found_[order[i]]);
     set_shape_from_count(out);
   }
@@ -194,9 +262,7 @@ class PlanarContact {
     const Sign orr = orient(p, q, r), os = orient(p, q, s);
     if (orr == Sign::zero || os != -orr) return;
     // orient(r, s, x) is affine in x: its zero on [p, q] is the crossing.
-    const double fp = orient2d_value(flat(r), flat(s), flat(p));
-    const double fq = orient2d_value(flat(r), flat(s), flat(q));
-    found_[count_++] = zero_on_edge(p, q, fp, fq);
+    found_[count_++] = crossing_of_line(p, q, flat(p), flat(q), flat(r), flat(s));
   }
 
   void add(const Point& x) {
@@ -205,22 +271,27 @@ class PlanarContact {
     found_[count_++] = x;
   }
 
-  // The corners are in convex position: their angles about their mean give the cycle.
-  void sort_around(const Vec3& normal, std::array<int, kMax>& order) const {
-    Point2 centre{0, 0};
-    for (int i = 0; i < count_; ++i) {
-      centre.x += flat(found_[i]).x / count_;
-      centre.y += flat(found_[i]).y / count_;
-    }
-    std::array<double, kMax> angle{};
-    for (int i = 0; i < count_; ++i) {
-      const Point2 f = flat(found_[i]);
-      angle[i] = std::atan2(f.y - centre.y, f.x - centre.x);
-    }
-    // The projection keeps orientation when the normal points along +axis.
-    const bool reversed = normal[axis_] < 0;
-    std::sort(order.begin(), order.begin() + count_,
-              [&](int i, int j) { return reversed ? angle[i] > angle[j] : angle[i] < angle[j]; });
+  // The corners are in convex position; `counterclockwise` is the projected orientation of a
+  // counterclockwise turn about the first triangle's normal. Monotone chains: from the lowest
+  // corner (x, then y) to the highest, the ones below that diagonal by increasing x, then
+  // those above by decreasing x. Corners closer than the rounding error may swap, nothing
+  // more (an angle about a centre, or from a corner, can misorder corners far apart).
+  void sort_around(Sign counterclockwise, std::array<int, kMax>& order) const {
+    std::sort(order.begin(), order.begin() + count_, [&](int i, int j) {
+      const Point2 a = flat(found_[i]), b = flat(found_[j]);
+      return a.x < b.x || (a.x == b.x && a.y < b.y);
+    });
+    const Point2 lo = flat(found_[order[0]]), hi = flat(found_[order[count_ - 1]]);
+    std::array<int, kMax> cycle{};
+    int n = 0;
+    cycle[n++] = order[0];
+    for (int i = 1; i + 1 < count_; ++i)
+      if (internal::orient(lo, hi, flat(found_[order[i]])) != Sign::positive) cycle[n++] = order[i];
+    cycle[n++] = order[count_ - 1];
+    for (int i = count_ - 2; i > 0; --i)
+      if (internal::orient(lo, hi, flat(found_[order[i]])) == Sign::positive) cycle[n++] = order[i];
+    if (counterclockwise == Sign::negative) std::reverse(cycle.begin() + 1, cycle.begin() + n);
+    order = cycle;
   }
 
   const Piece& p_;
@@ -230,11 +301,13 @@ class PlanarContact {
   int count_ = 0;
 };
 
-void planar_contact(const Piece& p, const Piece& q, int axis, const Vec3& normal,
+// counterclockwise: the projected orientation of the first triangle (a polygon is ordered
+// counterclockwise about its normal); any sign when a piece is not a triangle (no polygon).
+void planar_contact(const Piece& p, const Piece& q, int axis, Sign counterclockwise,
                     ContactGeometry& out) {
   PlanarContact contact(p, q, axis);
   contact.collect();
-  contact.write(normal, out);
+  contact.write(counterclockwise, out);
 }
 
 // ---- Degenerate triangles --------------------------------------------------------------------
@@ -254,7 +327,7 @@ void piece_against_triangle(const Piece& s, const Triangle& t, ContactGeometry& 
   if (sp != Sign::zero && sp == sq) return;
   if (sp == Sign::zero && sq == Sign::zero) {
     const int axis = internal::injective_axis(t[0], t[1], t[2]);
-    planar_contact(s, {t, 3}, axis, {0, 0, 0}, out);
+    planar_contact(s, {t, 3}, axis, Sign::positive, out);
     return;
   }
   // The segment crosses the plane at one point.
@@ -264,8 +337,7 @@ void piece_against_triangle(const Piece& s, const Triangle& t, ContactGeometry& 
   } else if (sq == Sign::zero) {
     add_point(out, s.v[1]);
   } else {
-    add_point(out, zero_on_edge(s.v[0], s.v[1], orient3d_value(t[0], t[1], t[2], s.v[0]),
-                                orient3d_value(t[0], t[1], t[2], s.v[1])));
+    add_point(out, crossing_of_plane(s.v[0], s.v[1], t));
   }
   set_shape_from_count(out);
 }
@@ -277,7 +349,7 @@ void piece_against_piece(const Piece& p, const Piece& q, ContactGeometry& out) {
   // A projection injective on their plane, or, all on one line, on that line.
   for (int k = 0; k < 4; ++k) {
     const int axis = internal::injective_axis(*all[k % 4], *all[(k + 1) % 4], *all[(k + 2) % 4]);
-    if (axis >= 0) return planar_contact(p, q, axis, {0, 0, 0}, out);
+    if (axis >= 0) return planar_contact(p, q, axis, Sign::positive, out);
   }
   Point lo = *all[0], hi = *all[0];
   for (const Point* x : all) {
@@ -287,7 +359,7 @@ void piece_against_piece(const Piece& p, const Piece& q, ContactGeometry& out) {
   int axis = 0;  // the coordinate along which the line varies least keeps the others
   for (int k = 1; k < 3; ++k)
     if (std::fabs(hi[k] - lo[k]) < std::fabs(hi[axis] - lo[axis])) axis = k;
-  planar_contact(p, q, axis, {0, 0, 0}, out);
+  planar_contact(p, q, axis, Sign::positive, out);
 }
 
 void degenerate_contact(const Triangle& a, bool a_proper, const Triangle& b, bool b_proper,
@@ -323,7 +395,8 @@ ContactGeometry contact_geometry(const Triangle& first, const Triangle& second) 
     return out;
   }
   out.coplanar = true;
-  planar_contact({first, 3}, {second, 3}, axis_a, out.first_normal, out);
+  planar_contact({first, 3}, {second, 3}, axis_a, normal_sign(first[0], first[1], first[2], axis_a),
+                 out);
   return out;
 }
 

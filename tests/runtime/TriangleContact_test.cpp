@@ -124,7 +124,8 @@ struct Statistics {
   std::array<std::uint64_t, 4> shapes{};    // by ContactShape
   std::array<std::uint64_t, 7> polygons{};  // by corner count
   std::uint64_t coplanar = 0, degenerate = 0;
-  double worst_relative_error = 0;  // over M
+  std::uint64_t loosely_ordered = 0;  // polygons ordered only up to corners within the bound
+  double worst_relative_error = 0;    // over M
 };
 
 // The computed points equal the exact corners in order, up to a cyclic shift when
@@ -139,6 +140,35 @@ bool match_in_order(const ContactGeometry& got, const std::vector<EPoint>& exact
       all = within(got.points[i], exact[(shift + i) % n], bound);
     if (all) return true;
   }
+  return false;
+}
+
+// Polygon corners closer together than the error bound may come in either order (their
+// computed positions may be in either order too). So when the strict order fails: some
+// matching within the bound, and every turn counterclockwise that involves no two such
+// corners.
+bool match_polygon_loosely(const ContactGeometry& got, const std::vector<EPoint>& exact,
+                           const EVector& normal, double bound) {
+  auto close = [&](const EPoint& x, const EPoint& y) {
+    return error_of({CGAL::to_double(CGAL::exact(x.x())), CGAL::to_double(CGAL::exact(x.y())),
+                     CGAL::to_double(CGAL::exact(x.z()))},
+                    y) <= 2 * bound;
+  };
+  std::vector<std::size_t> index(exact.size());
+  for (std::size_t i = 0; i < index.size(); ++i) index[i] = i;
+  do {
+    bool ok = true;
+    for (std::size_t i = 0; i < index.size() && ok; ++i)
+      ok = within(got.points[i], exact[index[i]], bound);
+    for (std::size_t i = 0; i < index.size() && ok; ++i) {
+      const EPoint& p = exact[index[i]];
+      const EPoint& q = exact[index[(i + 1) % index.size()]];
+      const EPoint& r = exact[index[(i + 2) % index.size()]];
+      if (close(p, q) || close(q, r) || close(p, r)) continue;
+      ok = CGAL::scalar_product(CGAL::cross_product(q - p, r - p), normal) > 0;
+    }
+    if (ok) return true;
+  } while (std::next_permutation(index.begin(), index.end()));
   return false;
 }
 
@@ -188,6 +218,8 @@ std::string check_pair(const Pair& pair, Statistics& stats) {
                                        to_epeck(pair.a[2]), to_epeck(pair.b[0]));
   stats.coplanar += coplanar;
   if (got.coplanar != coplanar) return "coplanar flag wrong";
+  for (std::size_t i = 0; i < got.count; ++i)
+    if (!is_finite(got.points[i])) return "a point is not finite";
   const double bound = kContactPointRelativeError * largest_coordinate(pair);
   std::vector<EPoint> ordered = exact;
   bool any_shift = true;
@@ -199,7 +231,11 @@ std::string check_pair(const Pair& pair, Statistics& stats) {
   } else if (got.shape == ContactShape::polygon) {
     ordered = counterclockwise(ordered, na);
   }
-  if (!match_in_order(got, ordered, any_shift, bound))
+  const bool strict = match_in_order(got, ordered, any_shift, bound);
+  const bool loose =
+      !strict && got.shape == ContactShape::polygon && match_polygon_loosely(got, exact, na, bound);
+  stats.loosely_ordered += loose;
+  if (!strict && !loose)
     return got.shape == ContactShape::polygon || !any_shift
                ? "points out of order or farther than the bound from the exact ones"
                : "a point is farther than the bound from the exact one";
@@ -228,7 +264,7 @@ constexpr Scale kScales[] = {
     {"unit at 1e6", -3, 1e6, 1},  // lattice range 8 times 2^-3: unit triangles
 };
 
-constexpr int kFamilies = 10;
+constexpr int kFamilies = 11;
 const char* const kFamilyNames[kFamilies] = {"generic",
                                              "shared vertex",
                                              "shared edge",
@@ -238,7 +274,8 @@ const char* const kFamilyNames[kFamilies] = {"generic",
                                              "coplanar overlap",
                                              "coplanar edge touch",
                                              "degenerate",
-                                             "near touching"};
+                                             "near touching",
+                                             "near coplanar"};
 
 Pair generic_pair(Generator& g, const Scale& scale) {
   const Rotation rotation = random_rotation(g);
@@ -283,6 +320,8 @@ Triangle family_second(Generator& g, const Triangle& a, int family, std::int64_t
               dyadic_point_on(g, a, 3)};
     case 7:
       return across_edge(g, a, r);
+    case 10:
+      return family_second(g, a, 6, range);  // nudged in contact_pair
     default: {  // degenerate: collinear (a segment) or a repeated vertex (a point)
       const int source = int(g.integer(0, 2));  // anywhere, through a point of a, in a's plane
       Triangle b = source == 0   ? lattice_triangle(g, range)
@@ -306,6 +345,12 @@ Pair contact_pair(Generator& g, int family, const Scale& scale) {
   Triangle b = family_second(g, a, family, range);
   Pair pair{transform(a), transform(b)};
   if (family == 9) pair.b[0] = nudge(g, pair.b[0]);
+  // Near coplanar: each cut of the other's plane is ill-conditioned, and the points are placed
+  // by the exact fallback.
+  if (family == 10) {
+    const int v = int(g.integer(0, 2));
+    pair.b[v] = nudge(g, pair.b[v]);
+  }
   if (g.coin()) std::swap(pair.a, pair.b);
   return pair;
 }
@@ -356,14 +401,20 @@ void check_family(int family, std::uint64_t cases) {
         EXPECT_GT(s[2], cases / 50) << scale.name;
         EXPECT_GT(stats.degenerate, cases / 2) << scale.name;
         break;
+      case 10:
+        EXPECT_GT(s[2], cases / 10) << scale.name;
+        EXPECT_GT(s[0], cases / 50) << scale.name;
+        break;
       default:
         EXPECT_GT(met, cases / 50) << scale.name;
         EXPECT_GT(s[0], cases / 50) << scale.name;
     }
-    std::printf("  %-20s %-12s none %6llu point %6llu segment %6llu polygon %6llu  worst %.2e M\n",
-                kFamilyNames[family], scale.name, (unsigned long long)s[0],
-                (unsigned long long)s[1], (unsigned long long)s[2], (unsigned long long)s[3],
-                stats.worst_relative_error);
+    std::printf(
+        "  %-20s %-12s none %6llu point %6llu segment %6llu polygon %6llu (loosely "
+        "ordered %llu)  worst %.2e M\n",
+        kFamilyNames[family], scale.name, (unsigned long long)s[0], (unsigned long long)s[1],
+        (unsigned long long)s[2], (unsigned long long)s[3],
+        (unsigned long long)stats.loosely_ordered, stats.worst_relative_error);
   }
 }
 
@@ -398,6 +449,9 @@ TEST(TriangleContactGeometry, DegenerateTrianglesMatchEpeck) {
 }
 TEST(TriangleContactGeometry, NearTouchingMatchesEpeck) {
   check_family(9, kCases);
+}
+TEST(TriangleContactGeometry, NearCoplanarMatchesEpeck) {
+  check_family(10, kCases);
 }
 
 // ---- Small cases with answers by hand -----------------------------------------------------
