@@ -306,7 +306,7 @@ typedef struct tetrapage_contact_geometry {
 
 /* The geometry of contact `contact` (an index < tetrapage_contact_count) of the object's last
    query, at that query's pose. Computed in double from exactly decided topology: each point
-   lies within about 2^-44 of the coordinates' magnitude of the exact intersection.
+   lies within 2^-40 of the coordinates' magnitude of the exact intersection.
    Errors: TETRAPAGE_ERROR_INPUT (no such contact), TETRAPAGE_ERROR_IO / _FORMAT (the
            triangle's shard could not be read), TETRAPAGE_ERROR_INVALID_ARGUMENT,
            TETRAPAGE_ERROR_STALE_HANDLE. */
