@@ -28,6 +28,7 @@ void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
   lowest_bound_ = kInfinity;
   lowest_upper_ = kInfinity;
   found_ = false;
+  axis_ = {0, 0, 0};
   // The bounding ball prunes far better than the world box when the object is far away.
   ball_centre_ = apply_pose(object.rotation(), object.translation(), model.ball_centre);
   ball_radius_ = model.ball_radius * (1 + 0x1p-30) +
@@ -155,11 +156,28 @@ void DistanceSearch::measure_triangle(const geometry::Triangle& environment, std
     margin = std::max(margin, object_->frame_margin(corner));
   }
   framed = geometry::inflated(framed, margin);
+  // The best pair's direction, in the object's frame: object nodes that lie beyond the
+  // triangle along it by more than the reach are pruned.
+  const Vec3 axis = object_->direction_to_object_frame(axis_);
+  const double axis_length = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+  double triangle_reach = -kInfinity;  // the triangle's farthest extent along the axis
+  for (const geometry::Point& corner : environment) {
+    const Vec3 x = object_->to_object_frame(corner);
+    triangle_reach = std::max(triangle_reach, axis[0] * x[0] + axis[1] * x[1] + axis[2] * x[2]);
+  }
+  auto node_beyond = [&](const geometry::Box& node, double reach) {
+    if (!(axis_length > 0)) return false;
+    double nearest = 0;  // the node's least extent along the axis
+    for (int a = 0; a < 3; ++a) nearest += axis[a] * (axis[a] > 0 ? node.lo[a] : node.hi[a]);
+    // Margins far beyond the roundings of the frame change and of these sums.
+    const double slack = (margin + 0x1p-40 * (std::fabs(nearest) + std::fabs(triangle_reach))) * axis_length;
+    return nearest - triangle_reach - slack > reach * axis_length * (1 + 0x1p-40);
+  };
   model_->bvh.for_each_near(
-      framed, [this] { return reach_; },
+      framed, node_beyond, [this] { return reach_; },
       [&](std::uint32_t object_triangle) {
         const geometry::Triangle placed = object_->world_triangle(object_triangle);
-        if (geometry::farther_than_cheaply(environment, placed, reach_)) return true;
+        if (geometry::farther_than_cheaply(environment, placed, reach_, axis_)) return true;
         ++result_->pair_tests;
         offer(geometry::triangle_distance(environment, placed), environment, id, part, object_triangle);
         return true;
@@ -176,6 +194,7 @@ void DistanceSearch::offer(const geometry::TriangleDistance& distance,
   if (found_ && distance.distance >= best_.distance.distance) return;
   found_ = true;
   best_ = {distance, environment, id, part, object_triangle};
+  for (int a = 0; a < 3; ++a) axis_[a] = distance.on_second[a] - distance.on_first[a];
 }
 
 }  // namespace tetrapage

@@ -76,6 +76,7 @@ class DistanceSearch {
   double lowest_upper_ = 0;   ///< the least upper bound of the pairs measured
   bool found_ = false;
   Pair best_;
+  Vec3 axis_{};  ///< from the best pair's environment point to its object point
   DistanceResult* result_ = nullptr;
   // The last step's closest pair: the environment triangle (its stored corners) and the
   // object's triangle.

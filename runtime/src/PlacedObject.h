@@ -58,6 +58,13 @@ class PlacedObject {
             rotation_[2] * e[0] + rotation_[5] * e[1] + rotation_[8] * e[2]};
   }
 
+  // A world direction turned into the object's frame (rounded: for pruning with margins).
+  Vec3 direction_to_object_frame(const Vec3& d) const {
+    return {rotation_[0] * d[0] + rotation_[3] * d[1] + rotation_[6] * d[2],
+            rotation_[1] * d[0] + rotation_[4] * d[1] + rotation_[7] * d[2],
+            rotation_[2] * d[0] + rotation_[5] * d[1] + rotation_[8] * d[2]};
+  }
+
   // How far from the object's box or surface a world point must be for the frame change's
   // rounding not to matter.
   double frame_margin(const geometry::Point& p) const {

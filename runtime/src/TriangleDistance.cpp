@@ -163,7 +163,7 @@ TriangleDistance triangle_distance(const Triangle& a, const Triangle& b) {
   return result;
 }
 
-bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d) {
+bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d, const Vector& axis) {
   // Separated boxes: fl(lo - hi) (1 - 2u) is below the true axis gap.
   const Box box_a = box_of(a), box_b = box_of(b);
   for (int k = 0; k < 3; ++k) {
@@ -171,6 +171,8 @@ bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d) {
     if ((box_a.lo[k] - box_b.hi[k]) * (1 - 2 * kUnit) > d) return true;
   }
   const Translated t = translate(a, b);
+  // The caller's axis (a search's last closest direction) separates most of its pairs.
+  if (separation_lower_bound(t, axis) > d) return true;
   // The triangles' own planes often separate by more than d: cheap and rigorous.
   const Vector normal_a = cross(sub(t.a[1], t.a[0]), sub(t.a[2], t.a[0]));
   const Vector normal_b = cross(sub(t.b[1], t.b[0]), sub(t.b[2], t.b[0]));
@@ -182,7 +184,7 @@ bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d) {
 }
 
 bool within_distance(const Triangle& a, const Triangle& b, double d) {
-  return !farther_than_cheaply(a, b, d) && triangle_distance(a, b).lower_bound <= d;
+  return !farther_than_cheaply(a, b, d, {0, 0, 0}) && triangle_distance(a, b).lower_bound <= d;
 }
 
 bool triangle_outside_ball(const Triangle& triangle, const Point& centre, double radius) {

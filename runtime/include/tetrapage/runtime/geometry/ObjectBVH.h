@@ -118,6 +118,14 @@ class ObjectBVH {
   template <class Reach, class Visit>
   void for_each_near(const Box& box, Reach&& reach, Visit&& visit,
                      QueryCounters* counters = nullptr) const {
+    for_each_near(box, [](const Box&, double) { return false; }, reach, visit, counters);
+  }
+  /// The same, also pruning the nodes (with their boxes, rounded outwards, and the reach)
+  /// that `beyond_node(box, reach)` says lie beyond the reach: a caller's own conservative
+  /// bound, e.g. a separating direction.
+  template <class BeyondNode, class Reach, class Visit>
+  void for_each_near(const Box& box, BeyondNode&& beyond_node, Reach&& reach, Visit&& visit,
+                     QueryCounters* counters = nullptr) const {
     auto squared_gap = [&box](const auto& lo, const auto& hi) {
       double sum = 0;
       for (int k = 0; k < 3; ++k) {
@@ -142,6 +150,8 @@ class ObjectBVH {
       const Entry entry = stack[--top];
       if (beyond(entry.squared_gap)) continue;
       const Node& node = nodes_[entry.node];
+      if (beyond_node(Box{{node.lo[0], node.lo[1], node.lo[2]}, {node.hi[0], node.hi[1], node.hi[2]}}, reach()))
+        continue;
       ++visited;
       if (node.count > 0) {
         for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {

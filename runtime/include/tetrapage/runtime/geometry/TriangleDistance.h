@@ -32,10 +32,11 @@ TriangleDistance triangle_distance(const Triangle& a, const Triangle& b);
 /// Precondition: d >= 0 and finite.
 bool within_distance(const Triangle& a, const Triangle& b, double d);
 
-/// True only when the triangles are certainly farther apart than d, by cheap rigorous tests
-/// (their boxes, and each triangle's plane separating the other by more than d); false says
-/// nothing. within_distance's first step, for searches that measure what it lets through.
-bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d);
+/// True only when the triangles are certainly farther apart than d, by cheap rigorous tests:
+/// their boxes, `axis` (any direction, pointing from a towards b; zero: none) and each
+/// triangle's plane separating them by more than d; false says nothing. within_distance's
+/// first step, for searches that measure what it lets through.
+bool farther_than_cheaply(const Triangle& a, const Triangle& b, double d, const Vec3& axis);
 
 /// True only when every point of the closed triangle lies farther than `radius` from
 /// `centre`: a pruning test, conservative whatever the rounding. The closest point is found in
