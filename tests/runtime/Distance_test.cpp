@@ -25,31 +25,14 @@
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
+#include "TestSolids.h"
 
 namespace tetrapage {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace test_solids;
 using Exact = CGAL::Exact_predicates_exact_constructions_kernel;
-
-void add_box(TriangleSoup& soup, const Vec3& lo, const Vec3& hi, bool open_top = false) {
-  const auto base = std::uint32_t(soup.vertices.size());
-  for (int i = 0; i < 8; ++i)
-    soup.vertices.push_back({(i & 1) ? hi[0] : lo[0], (i & 2) ? hi[1] : lo[1], (i & 4) ? hi[2] : lo[2]});
-  const std::array<std::array<std::uint32_t, 4>, 6> faces{
-      {{0, 2, 3, 1}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}, {4, 5, 7, 6}}};
-  for (std::size_t f = 0; f < (open_top ? 5u : 6u); ++f) {
-    soup.triangles.push_back({base + faces[f][0], base + faces[f][1], base + faces[f][2]});
-    soup.triangles.push_back({base + faces[f][0], base + faces[f][2], base + faces[f][3]});
-  }
-}
-
-void add_sheet(TriangleSoup& soup, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
-  const auto base = std::uint32_t(soup.vertices.size());
-  soup.vertices.insert(soup.vertices.end(), {a, b, c, d});
-  soup.triangles.push_back({base, base + 1, base + 2});
-  soup.triangles.push_back({base, base + 2, base + 3});
-}
 
 // Closed boxes (one nested in another), a topless box and a slanted open sheet, in one part.
 TriangleSoup mixed_scene() {
@@ -57,7 +40,7 @@ TriangleSoup mixed_scene() {
   add_box(soup, {0.125, 0.125, 0.125}, {0.5, 0.5, 0.5});
   add_box(soup, {0.25, 0.25, 0.25}, {0.3125, 0.3125, 0.3125});
   add_box(soup, {0.625, 0.625, 0.125}, {0.8125, 0.8125, 0.3125}, true);
-  add_sheet(soup, {0.625, 0.125, 0.75}, {0.9375, 0.125, 0.625}, {0.9375, 0.4375, 0.8125}, {0.625, 0.4375, 0.875});
+  add_quad(soup, {0.625, 0.125, 0.75}, {0.9375, 0.125, 0.625}, {0.9375, 0.4375, 0.8125}, {0.625, 0.4375, 0.875});
   soup.part_of.assign(soup.triangles.size(), 0);
   soup.part_names = {"mixed"};
   return soup;
@@ -67,15 +50,9 @@ TriangleSoup mixed_scene() {
 TriangleSoup cube_and_sheet() {
   TriangleSoup soup;
   add_box(soup, {-0.02, -0.02, -0.02}, {0.02, 0.02, 0.02});
-  add_sheet(soup, {0.03, -0.02, -0.02}, {0.03, 0.02, -0.02}, {0.04, 0.02, 0.02}, {0.03, -0.02, 0.02});
+  add_quad(soup, {0.03, -0.02, -0.02}, {0.03, 0.02, -0.02}, {0.04, 0.02, 0.02}, {0.03, -0.02, 0.02});
   soup.part_of.assign(soup.triangles.size(), 0);
   soup.part_names = {"cube and sheet"};
-  return soup;
-}
-
-TriangleSoup placed(TriangleSoup soup, double s, const Vec3& o) {
-  for (Vec3& v : soup.vertices)
-    for (int a = 0; a < 3; ++a) v[a] = o[a] + s * v[a];
   return soup;
 }
 
