@@ -75,7 +75,8 @@ ImpactResult FlyingObject::time_of_impact(const Pose& from, const Pose& to,
     if (result.free_until >= 1) return certified_free();
     if (advance < options.tolerance) {
       // Near contact: the end of a bracket of the tolerance's width, decided exactly.
-      const double probe = std::min(1.0, result.free_until + options.tolerance);
+      double probe = std::min(1.0, result.free_until + options.tolerance);
+      while (probe - result.free_until > options.tolerance) probe = std::nextafter(probe, 0.0);
       query(motion.at(probe), QueryOptions{}, touch);
       if (touch.collides) {
         report_hit(touch, result.free_until, probe, result);

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "Commands.h"
+#include "FlyArguments.h"
 #include "TessellationArguments.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/Manifest.h"
@@ -25,37 +26,16 @@
 #include "tetrapage/tools/QueryAnswerFile.h"
 
 namespace tetrapage::cli {
-namespace {
 
-struct FlyArguments {
-  std::filesystem::path index, object, path, answers, check, report, contacts;
-  std::string object_unit;
-  double object_scale = 1.0;
-  TessellationArguments tessellation;
-  std::string memory = "256M";
-  std::string accuracy = "exact";
-  std::string query = "collide";
-  double max_distance = std::numeric_limits<double>::infinity();
-  double toi_tolerance = 1e-4;
-  bool all_contacts = false;
-  bool no_prefetch = false;
-  bool prefetch_ahead = false;
-  bool no_shard_arena = false;
-  unsigned spin_before_sleep_us = 200;
-  bool preload = false;
-};
-
-// The flying object: a mesh, a STEP or IGES file, or a manifest, in the index's unit (times
-// --object-scale) when both say their unit.
-TriangleSoup load_object(const FlyArguments& args) {
+TriangleSoup load_object(const FlyArguments& args, const std::filesystem::path& path) {
   std::vector<ReadReport> reports;
-  TriangleSoup object = load_inputs({args.object}, &reports, Progress::silent(), args.tessellation.options(false));
-  std::string unit = is_manifest_path(args.object) ? read_manifest(args.object).units
+  TriangleSoup object = load_inputs({path}, &reports, Progress::silent(), args.tessellation.options(false));
+  std::string unit = is_manifest_path(path) ? read_manifest(path).units
                                                    : (reports.empty() ? std::string() : reports.front().length_unit);
   if (!args.object_unit.empty()) {
     metres_per_unit(args.object_unit);  // an unknown unit is an InputError naming it
     if (!unit.empty() && unit != args.object_unit)
-      throw InputError("--object-unit " + args.object_unit + ", but " + args.object.string() + " is in " + unit);
+      throw InputError("--object-unit " + args.object_unit + ", but " + path.string() + " is in " + unit);
     unit = args.object_unit;
   }
   const std::string index_unit = IndexReader(args.index).header().length_unit;
@@ -72,6 +52,18 @@ TriangleSoup load_object(const FlyArguments& args) {
       for (double& c : v) c *= scale;
   return object;
 }
+
+CollisionIndexOptions fly_index_options(const FlyArguments& args) {
+  CollisionIndexOptions index_options;
+  index_options.memory_budget_bytes = parse_byte_size(args.memory);
+  index_options.prefetch = !args.no_prefetch;
+  index_options.prefetch_ahead = args.prefetch_ahead;
+  index_options.shard_arena = !args.no_shard_arena;
+  index_options.spin_before_sleep = std::chrono::microseconds(args.spin_before_sleep_us);
+  return index_options;
+}
+
+namespace {
 
 // One step of the query --query names, its answer row, and what its summary counts.
 class QueryStep {
@@ -147,19 +139,19 @@ class QueryStep {
 };
 
 void run_fly(const FlyArguments& args) {
-  check_outputs_writable({args.answers, args.report, args.contacts}, {args.index, args.object, args.path, args.check});
+  if (args.objects.size() != args.paths.size())
+    throw InputError("fly: " + std::to_string(args.objects.size()) + " --object but " +
+                     std::to_string(args.paths.size()) + " --path: give one pose file per object");
+  if (args.objects.size() > 1) return run_fly_group(args);
+  check_outputs_writable({args.answers, args.report, args.contacts},
+                         {args.index, args.objects[0], args.paths[0], args.check});
   QueryOptions query_options;
   query_options.accuracy = geometry::parse_accuracy(args.accuracy);
   query_options.mode = args.all_contacts ? QueryMode::all_contacts : QueryMode::first_hit;
-  CollisionIndexOptions index_options;
-  index_options.memory_budget_bytes = parse_byte_size(args.memory);
-  index_options.prefetch = !args.no_prefetch;
-  index_options.prefetch_ahead = args.prefetch_ahead;
-  index_options.shard_arena = !args.no_shard_arena;
-  index_options.spin_before_sleep = std::chrono::microseconds(args.spin_before_sleep_us);
+  const CollisionIndexOptions index_options = fly_index_options(args);
 
-  const TriangleSoup object_mesh = load_object(args);
-  const std::vector<Pose> poses = read_poses(args.path);
+  const TriangleSoup object_mesh = load_object(args, args.objects[0]);
+  const std::vector<Pose> poses = read_poses(args.paths[0]);
   AnswerCheck check(args.check, poses.size(), "fly");
   const auto open_start = std::chrono::steady_clock::now();
   // The object's structures do not need the index: build them while it opens.
@@ -296,9 +288,11 @@ void add_fly_command(CLI::App& app) {
   command->add_option("index", args->index, "Index file (.tpi) from `tetrapage preprocess`")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--object", args->object,
+  command->add_option("--object", args->objects,
                       "Flying object: a mesh, a STEP or IGES file (read in mm), or a manifest (.json); converted "
-                      "to the index's unit when both state theirs")
+                      "to the index's unit when both state theirs. Repeat it, with one --path each, to fly "
+                      "several objects at once (each against the environment and against each other; --query "
+                      "collide only)")
       ->required()
       ->check(CLI::ExistingFile);
   command->add_option("--object-unit", args->object_unit,
@@ -310,7 +304,9 @@ void add_fly_command(CLI::App& app) {
                       "Write the contacts as CSV: step, kind, environment part (id, name, instance path), "
                       "environment and object triangle, one point where they meet (the first contact of a "
                       "step; every pair with --all-contacts)");
-  command->add_option("--path", args->path, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz)")->required()->check(CLI::ExistingFile);
+  command->add_option("--path", args->paths, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz); one per --object, in order")
+      ->required()
+      ->check(CLI::ExistingFile);
   command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")
       ->capture_default_str()
       ->check(byte_size_check());

@@ -38,10 +38,9 @@ void check_writable(const std::filesystem::path& path) {
   std::filesystem::remove(temporary, ec);
 }
 
-void check_outputs_writable(std::initializer_list<std::filesystem::path> outputs,
-                            std::initializer_list<std::filesystem::path> inputs) {
-  check_outputs(std::span<const std::filesystem::path>(outputs.begin(), outputs.size()),
-                std::span<const std::filesystem::path>(inputs.begin(), inputs.size()));
+void check_outputs_writable(std::span<const std::filesystem::path> outputs,
+                            std::span<const std::filesystem::path> inputs) {
+  check_outputs(outputs, inputs);
   for (const auto& output : outputs) check_writable(output);
 }
 

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <initializer_list>
+#include <span>
 
 #include <nlohmann/json.hpp>
 
@@ -22,7 +23,12 @@ void check_writable(const std::filesystem::path& path);
 /// Every output checked before any work: none is an input, a non-regular file (a device node,
 /// FIFO or folder) or another output (FileChecks.h), and each can be written (check_writable).
 /// @throw InputError or IoError naming the output.
-void check_outputs_writable(std::initializer_list<std::filesystem::path> outputs,
-                            std::initializer_list<std::filesystem::path> inputs);
+void check_outputs_writable(std::span<const std::filesystem::path> outputs,
+                            std::span<const std::filesystem::path> inputs);
+inline void check_outputs_writable(std::initializer_list<std::filesystem::path> outputs,
+                                   std::initializer_list<std::filesystem::path> inputs) {
+  check_outputs_writable(std::span<const std::filesystem::path>(outputs.begin(), outputs.size()),
+                         std::span<const std::filesystem::path>(inputs.begin(), inputs.size()));
+}
 
 }  // namespace tetrapage
