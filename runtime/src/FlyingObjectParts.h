@@ -27,6 +27,8 @@ struct FlyingObject::Parts {
   TriangleIdSet met_triangles;   ///< the triangles phase I has met this step
   DistanceSearch distance;       ///< the closest pair, and the last one (coherence)
   QueryResult touch;             ///< scratch: the collision step of a distance query
+  std::shared_ptr<const DynamicObstacles> obstacles;  ///< merged into every query, or null
+  std::uint64_t obstacles_version = 0;  ///< the overlay's version the free box was found with
 };
 
 }  // namespace tetrapage
