@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <string>
 
 #include "FlyingObjectParts.h"
 #include "PhaseTwo.h"
@@ -220,6 +221,22 @@ void FlyingObject::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacl
   parts_->obstacles = std::move(obstacles);
   parts_->coherence.obstacles_changed();  // the free box did not know them
   parts_->obstacles_version = parts_->obstacles ? parts_->obstacles->version() : 0;
+}
+
+geometry::ContactGeometry FlyingObject::dynamic_contact_geometry(const Contact& contact) {
+  const DynamicObstacles::Part* part =
+      parts_->obstacles ? parts_->obstacles->find(contact.dynamic_part) : nullptr;
+  if (part == nullptr)
+    throw InputError("contact geometry: no dynamic part " + std::to_string(contact.dynamic_part));
+  if (contact.environment_triangle >= part->model->mesh.triangles.size() ||
+      contact.object_triangle >= model_->mesh.triangles.size())
+    throw InputError("contact geometry: dynamic part " + std::to_string(contact.dynamic_part) +
+                     " has no triangle " + std::to_string(contact.environment_triangle) +
+                     " or the object no triangle " + std::to_string(contact.object_triangle));
+  PlacedObject placed(*part->model);
+  placed.place(part->pose);
+  return geometry::contact_geometry(placed.world_triangle(std::uint32_t(contact.environment_triangle)),
+                                    parts_->object.world_triangle(contact.object_triangle));
 }
 
 const std::shared_ptr<const DynamicObstacles>& FlyingObject::obstacles() const {

@@ -236,6 +236,8 @@ class FlyingObject {
   // Phases I and II over the region's shards that the step needs, then containment.
   void test_region(const geometry::Box& box, const QueryOptions& options, bool solid_query,
                    std::chrono::steady_clock::time_point loop_start, QueryResult& result);
+  // contact_geometry of a contact with a dynamic obstacle (at the overlay's current pose).
+  geometry::ContactGeometry dynamic_contact_geometry(const Contact& contact);
   // A step whose box met no tet of the mesh: the dynamic obstacles alone.
   void test_obstacles_alone(const geometry::Box& box, const QueryOptions& options, bool solid_query,
                             QueryResult& result);
