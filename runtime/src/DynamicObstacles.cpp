@@ -37,16 +37,15 @@ std::uint64_t DynamicObstacles::CellRange::count() const {
 }
 
 DynamicObstacles::CellKey DynamicObstacles::key(std::int64_t x, std::int64_t y, std::int64_t z) {
-  // Cells lie within the mesh box (parts do; a query's range is clamped): 21 bits an axis.
+  // Cells are clamped to the mesh box, at most 2^20 an axis: 21 bits an axis.
   constexpr std::int64_t kMask = (std::int64_t(1) << 21) - 1;
   return (CellKey(x & kMask) << 42) | (CellKey(y & kMask) << 21) | CellKey(z & kMask);
 }
 
 DynamicObstacles::CellRange DynamicObstacles::cells_of(const geometry::Box& box) const {
-  // Cells counted from the mesh box's low corner, clamped to it: parts lie inside it, so a
-  // query's cells outside it hold nothing. Rounding only moves a box edge to a neighbouring
-  // cell, and both sides of the comparison round the same way: a part's cells and a query's
-  // cells are computed by this one function, so a part meeting the box shares a cell with it.
+  // Cells counted from the mesh box's low corner, clamped to it (a part outside it shares the
+  // border cells). The map from a coordinate to its cell is monotone, rounding included, and
+  // parts and queries use this one function: two boxes that meet share a cell.
   const BoundingBox& bounds = index_->mesh_bounds();
   CellRange range;
   for (int a = 0; a < 3; ++a) {
@@ -68,16 +67,7 @@ geometry::Box DynamicObstacles::placed_box(const ObjectModel& model, const Pose&
   } catch (const InputError& e) {
     throw InputError("dynamic part " + std::to_string(id) + ": " + e.what());
   }
-  const geometry::Box box = placed.world_box();
-  const BoundingBox& bounds = index_->mesh_bounds();
-  for (int a = 0; a < 3; ++a)
-    if (!(box.lo[a] >= bounds.lo[a] && box.hi[a] <= bounds.hi[a]))
-      throw InputError("dynamic part " + std::to_string(id) +
-                       " does not lie inside the index's mesh box (axis " + std::to_string(a) +
-                       ": [" + std::to_string(box.lo[a]) + ", " + std::to_string(box.hi[a]) +
-                       "] against [" + std::to_string(bounds.lo[a]) + ", " +
-                       std::to_string(bounds.hi[a]) + "])");
-  return box;
+  return placed.world_box();
 }
 
 void DynamicObstacles::add_to_grid(std::uint32_t slot) {

@@ -118,16 +118,16 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     counters.locate_seconds = std::chrono::duration<double>(phase_start - start).count();
 
   // 2.-4. When the box leaves the searched region: the walk, the box search, the shards.
-  // (Dynamic obstacles lie inside the mesh's box: a box outside it meets none.)
-  if (!geometry::boxes_overlap(box, index.mesh_bounds())) return outside_model(result);
+  // Outside the model, dynamic obstacles may still stand.
+  if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
+    outside_model(result);
+    return test_obstacles_alone(box, options, question.own_frame, question.solid, reach, result);
+  }
   if (!parts.region.contains(box)) {
-    // A centre outside the convex mesh: the box meets only the model's empty margin, where
-    // dynamic obstacles may stand.
+    // A centre outside the convex mesh: the box meets only the model's empty margin.
     if (!parts.region.search(box, parts.coherence.motion(), counters)) {
       outside_model(result);
-      parts.shapes.prepare(*model_, parts.object, box, reach, question.own_frame, question.solid,
-                           index.mesh_bounds());
-      return test_obstacles_alone(box, options, question.solid, result);
+      return test_obstacles_alone(box, options, question.own_frame, question.solid, reach, result);
     }
     phase_start = Clock::now();
   }
@@ -138,7 +138,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
 
   // 5. Phase I and II over the region's shards whose bounds meet the box, then containment.
   parts.shapes.prepare(*model_, parts.object, box, reach, question.own_frame, question.solid,
-                       index.mesh_bounds());
+                       shapes_box(box));
   test_region(box, options, question.solid, phase_start, result);
 }
 
@@ -203,10 +203,20 @@ void FlyingObject::test_region(const geometry::Box& box, const QueryOptions& opt
   parts.containment.check_dynamic(box, parts.object, solid_query, result);
 }
 
+geometry::Box FlyingObject::shapes_box(const geometry::Box& box) const {
+  // The pruning shapes' margins scale with the coordinates they meet: the mesh's, and with
+  // dynamic obstacles (which may stand outside it) the step's box's too.
+  geometry::Box covered = index_->mesh_bounds();
+  if (parts_->obstacles) covered.extend(box);
+  return covered;
+}
+
 void FlyingObject::test_obstacles_alone(const geometry::Box& box, const QueryOptions& options,
-                                        bool solid_query, QueryResult& result) {
+                                        bool own_frame, bool solid_query, double reach,
+                                        QueryResult& result) {
   Parts& parts = *parts_;
   if (!parts.obstacles || parts.obstacles->size() == 0) return;
+  parts.shapes.prepare(*model_, parts.object, box, reach, own_frame, solid_query, shapes_box(box));
   PhaseTwo phase_two(*index_, *model_, parts.object, parts.shapes, parts.solid, parts.coherence,
                      parts.containment, parts.met_triangles, options, solid_query, box, result);
   phase_two.test_dynamic_parts(*parts.obstacles);

@@ -442,8 +442,8 @@ tetrapage_status tetrapage_obstacles_destroy(tetrapage_obstacles* obstacles);
 
 /* A new dynamic part: its mesh as in tetrapage_object_create, at `pose`, named `name` (may be
    null). Its id (never 0, never reused) goes to *id.
-   Errors: TETRAPAGE_ERROR_INPUT (a mesh the object constructor rejects, a bad pose, a part
-           outside the index's mesh box), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+   Errors: TETRAPAGE_ERROR_INPUT (a mesh the object constructor rejects, a bad pose),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT,
            TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_obstacles_insert(tetrapage_obstacles* obstacles, const double* vertices,
                                             size_t vertex_count, const uint32_t* triangles,

@@ -11,7 +11,8 @@
 /// Dynamic parts live in a uniform hash grid over their world boxes (cells of cell_size()):
 /// insert, move and remove cost the cells a part's box covers, a box query the cells it covers
 /// plus the parts found; a part wider than kMaxCellsPerPart cells sits in a short list that
-/// every query scans. Each part lies inside the index's mesh box ("placed in the coarse mesh").
+/// every query scans. The grid covers the index's mesh box: parts outside it are answered
+/// too, but share its border cells (slower when many stand there).
 ///
 /// Threading: changes (insert, move, remove, hide, show, load) from one thread, between the
 /// steps of the FlyingObjects that hold the overlay; steps of any number of FlyingObjects on
@@ -62,8 +63,9 @@ class DynamicObstacles {
 
   /// A new part: `mesh` (built into an ObjectModel, tens of microseconds for 100 triangles) or
   /// a shared model, at `pose`. Returns its id.
-  /// @throw InputError for a mesh ObjectModel rejects, a null model, a bad pose (as
-  ///        FlyingObject::query), or a placed part not inside the index's mesh box.
+  /// @throw InputError for a mesh ObjectModel rejects, a null model, or a bad pose (as
+  ///        FlyingObject::query: non-finite, non-unit, a translation beyond
+  ///        kMaxCoordinateMagnitude).
   DynamicPartId insert(TriangleSoup mesh, const Pose& pose, std::string name = {});
   DynamicPartId insert(std::shared_ptr<const ObjectModel> model, const Pose& pose,
                        std::string name = {});
@@ -104,8 +106,7 @@ class DynamicObstacles {
   /// An overlay on `index` read from `path`: the same ids, names, poses, meshes and hidden
   /// parts (ids inserted later continue after the saved ones).
   /// @throw FormatError naming the file (and the line) for a missing, truncated or malformed
-  ///        file, or a part that does not fit `index` (outside its mesh box, a hidden part it
-  ///        does not list).
+  ///        file, or one that does not fit `index` (a hidden part it does not list).
   static DynamicObstacles load(std::shared_ptr<const CollisionIndex> index,
                                const std::filesystem::path& path, double cell_size = 0);
 

@@ -239,8 +239,10 @@ class FlyingObject {
   // contact_geometry of a contact with a dynamic obstacle (at the overlay's current pose).
   geometry::ContactGeometry dynamic_contact_geometry(const Contact& contact);
   // A step whose box met no tet of the mesh: the dynamic obstacles alone.
-  void test_obstacles_alone(const geometry::Box& box, const QueryOptions& options, bool solid_query,
-                            QueryResult& result);
+  void test_obstacles_alone(const geometry::Box& box, const QueryOptions& options, bool own_frame,
+                            bool solid_query, double reach, QueryResult& result);
+  // The box whose coordinates bound what the pruning shapes meet (their margins).
+  geometry::Box shapes_box(const geometry::Box& box) const;
 
   std::shared_ptr<const CollisionIndex> index_;
   std::shared_ptr<const ObjectModel> model_;
