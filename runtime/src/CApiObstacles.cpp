@@ -48,6 +48,11 @@ tetrapage_obstacles* add_overlay(tetrapage::DynamicObstacles overlay) {
 
 }  // namespace
 
+std::shared_ptr<const tetrapage::DynamicObstacles> tetrapage::capi::obstacles_of(
+    const tetrapage_obstacles* obstacles) {
+  return obstacles ? obstacles_state(obstacles)->obstacles : nullptr;
+}
+
 extern "C" {
 
 tetrapage_status tetrapage_obstacles_create(tetrapage_index* index, tetrapage_obstacles** obstacles) {
@@ -107,7 +112,7 @@ tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
   return guarded(__func__, [&] {
     const auto state = object_state(object);
     state->has_result = false;  // the last answer was without (or with other) obstacles
-    state->flying.set_obstacles(obstacles ? obstacles_state(obstacles)->obstacles : nullptr);
+    state->flying.set_obstacles(obstacles_of(obstacles));
   });
 }
 

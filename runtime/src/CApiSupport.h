@@ -20,6 +20,7 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/tetrapage.h"
 
@@ -209,6 +210,11 @@ inline tetrapage::TriangleSoup object_soup(const double* vertices, std::size_t v
   soup.part_names = {"object"};
   return soup;
 }
+
+/// The overlay of an obstacles handle, for the objects and groups that attach it (null for a
+/// null handle). Defined in CApiObstacles.cpp, with its table.
+/// @throw StaleHandle for a destroyed or foreign handle.
+std::shared_ptr<const tetrapage::DynamicObstacles> obstacles_of(const tetrapage_obstacles* obstacles);
 
 /// The int a C caller passed as an enum, read without loading it as the C++ enum: any int may
 /// arrive, and loading one outside the enumerators' range is undefined behaviour in C++.

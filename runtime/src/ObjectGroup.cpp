@@ -81,6 +81,11 @@ const std::shared_ptr<const ObjectModel>& ObjectGroup::model(std::size_t object)
   return parts_->models.at(object);
 }
 
+void ObjectGroup::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacles) {
+  if (!index_ && obstacles) throw InputError("a group without an index has no environment to add obstacles to");
+  for (FlyingObject& flying : parts_->flying) flying.set_obstacles(obstacles);
+}
+
 void ObjectGroup::step(std::span<const Pose> poses, const GroupQueryOptions& options,
                        GroupResult& result) {
   if (poses.size() != size())

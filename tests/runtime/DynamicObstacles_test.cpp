@@ -29,6 +29,7 @@
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/ObjectGroup.h"
 #include "tetrapage/tetrapage.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
@@ -344,6 +345,26 @@ TEST(DynamicObstacles, SolidShapesSweptMotionAndOtherAccuracies) {
   EXPECT_GT(dynamic_hits, 2);
 }
 
+TEST(DynamicObstacles, AGroupsObjectsAnswerAsLoneObjects) {
+  auto overlay = std::make_shared<DynamicObstacles>(scene().index);
+  Random random(31);
+  for (int k = 0; k < 8; ++k) overlay->insert(part_model(116, 0.15, 80 + k), random_pose(random, 0.15, 0.85));
+  overlay->hide_part(0);
+  const std::vector<std::shared_ptr<const ObjectModel>> models = {part_model(116, 0.12, 7), part_model(300, 0.12, 8)};
+  ObjectGroup group(scene().index, models);
+  group.set_obstacles(overlay);
+  FlyingObject a(scene().index, models[0]), b(scene().index, models[1]);
+  a.set_obstacles(overlay);
+  b.set_obstacles(overlay);
+  for (int i = 0; i < 100; ++i) {
+    const std::vector<Pose> poses = {random_pose(random, 0.1, 0.9), random_pose(random, 0.1, 0.9)};
+    const GroupResult got = group.step(poses);
+    EXPECT_EQ(got.environment[0].contacts, a.query(poses[0]).contacts);
+    EXPECT_EQ(got.environment[1].contacts, b.query(poses[1]).contacts);
+  }
+  EXPECT_THROW(ObjectGroup(nullptr, models).set_obstacles(overlay), InputError);
+}
+
 TEST(DynamicObstacles, SaveAndLoadGiveTheSameAnswers) {
   auto overlay = std::make_shared<DynamicObstacles>(scene().index);
   Random random(21);
@@ -472,6 +493,21 @@ TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
     dynamic += written == 1 && part != 0;
   }
   EXPECT_GT(dynamic, 0);
+  // A group of the one object answers the same with the overlay.
+  tetrapage_group* group = nullptr;
+  ASSERT_EQ(tetrapage_group_create(index, &flying, 1, &group), TETRAPAGE_OK);
+  ASSERT_EQ(tetrapage_group_set_obstacles(group, obstacles), TETRAPAGE_OK);
+  for (int i = 0; i < 50; ++i) {
+    const Pose pose = random_pose(random, 0.1, 0.9);
+    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2], pose.rotation[0],
+                         pose.rotation[1],    pose.rotation[2],    pose.rotation[3]};
+    std::size_t pairs = 0, written = 0;
+    int collides = 0;
+    ASSERT_EQ(tetrapage_group_step(group, p, 0, &pairs), TETRAPAGE_OK);
+    ASSERT_EQ(tetrapage_group_environment(group, &collides, 1, &written), TETRAPAGE_OK);
+    EXPECT_EQ(collides != 0, cxx.query(pose).collides);
+  }
+  EXPECT_EQ(tetrapage_group_destroy(group), TETRAPAGE_OK);
   const std::string path = (scene().folder / "capi.tpo").string();
   ASSERT_EQ(tetrapage_obstacles_save(obstacles, path.c_str()), TETRAPAGE_OK);
   tetrapage_obstacles* loaded = nullptr;

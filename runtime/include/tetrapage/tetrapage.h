@@ -468,6 +468,10 @@ tetrapage_status tetrapage_obstacles_hide_part(tetrapage_obstacles* obstacles, u
 tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
                                                 tetrapage_obstacles* obstacles);
 
+/* The same for every object of a group (their environment queries; null: none).
+   Errors: TETRAPAGE_ERROR_INPUT (an overlay on another index), TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group, tetrapage_obstacles* obstacles);
+
 /* Per contact of the last query (as tetrapage_get_contacts), its dynamic part's id or 0 for a
    part of the index: the first min(capacity, count), their number to *written.
    Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
