@@ -75,10 +75,18 @@ class Coherence {
   NewFreeBox look_for_free_box(const geometry::Box& box, SearchedRegion& region,
                                const CollisionIndex& index, const DynamicObstacles* overlay,
                                StepCounters& counters);
-  /// The dynamic obstacles changed (their version): the free box may hold one now.
-  void obstacles_changed() {
-    free_box_valid_ = false;
-    free_box_wait_ = 0;
+  /// The dynamic obstacles changed (their version): the free box is dropped when it may hold
+  /// one now (a part's box meets it), or when `shown` (an index part shown again may hold the
+  /// object, free while it was hidden). Removing or hiding only frees space; a part whose box
+  /// misses the free box can neither touch nor hold an object inside it.
+  void obstacles_changed(const DynamicObstacles* overlay, bool shown) {
+    bool meets = shown || overlay == nullptr;
+    if (free_box_valid_ && !meets)
+      overlay->for_each_in_box(free_box_, [&](const DynamicObstacles::Part&) {
+        meets = true;
+        return false;
+      });
+    if (meets) free_box_valid_ = false, free_box_wait_ = 0;
   }
 
  private:

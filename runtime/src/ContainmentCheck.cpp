@@ -79,11 +79,11 @@ void ContainmentCheck::check_obstacle_inside_object(const geometry::Box& box, Pl
 }
 
 void ContainmentCheck::check_dynamic(const geometry::Box& box, PlacedObject& object,
-                                     bool solid_query, QueryResult& result) {
+                                     PlacedObject& placed, bool solid_query, QueryResult& result) {
   if (overlay_ == nullptr || result.collides) return;
   const PairSide flying{*model_, object, box};
   overlay_->for_each_in_box(box, [&](const DynamicObstacles::Part& part) {
-    PlacedObject placed(*part.model);
+    placed.rebind(*part.model);
     placed.place(part.pose);
     const PairSide obstacle{*part.model, placed, part.world_box};
     if (holds_a_component(obstacle, flying))

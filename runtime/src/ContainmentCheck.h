@@ -48,8 +48,9 @@ class ContainmentCheck {
              QueryResult& result, Clock::time_point start);
   /// The same against the dynamic obstacles whose boxes meet `box`: the object inside a closed
   /// one, or (unless `solid_query`: the solid's own test found those) one inside the object.
-  void check_dynamic(const geometry::Box& box, PlacedObject& object, bool solid_query,
-                     QueryResult& result);
+  /// `placed`: scratch, rebound to each obstacle.
+  void check_dynamic(const geometry::Box& box, PlacedObject& object, PlacedObject& placed,
+                     bool solid_query, QueryResult& result);
 
  private:
   void check_object_inside_obstacle(PlacedObject& object, std::span<const ShardPin> pins,

@@ -42,6 +42,12 @@ DynamicObstacles::CellKey DynamicObstacles::key(std::int64_t x, std::int64_t y, 
   return (CellKey(x & kMask) << 42) | (CellKey(y & kMask) << 21) | CellKey(z & kMask);
 }
 
+std::array<std::int64_t, 3> DynamicObstacles::coordinates(CellKey key) {
+  constexpr CellKey kMask = (CellKey(1) << 21) - 1;
+  return {std::int64_t((key >> 42) & kMask), std::int64_t((key >> 21) & kMask),
+          std::int64_t(key & kMask)};
+}
+
 DynamicObstacles::CellRange DynamicObstacles::cells_of(const geometry::Box& box) const {
   // Cells counted from the mesh box's low corner, clamped to it (a part outside it shares the
   // border cells). The map from a coordinate to its cell is monotone, rounding included, and
@@ -172,6 +178,7 @@ void DynamicObstacles::show_part(std::uint32_t part) {
     throw InputError("cannot show part " + std::to_string(part) + ": the index lists " +
                      std::to_string(hidden_.size()) + " parts");
   if (hidden_[part]) hidden_[part] = 0, --hidden_count_;
+  ++shows_;
   ++version_;
 }
 

@@ -86,8 +86,9 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   parts.containment.begin_step(overlay);
   // A changed overlay may have put a part into the free box.
   if (overlay != nullptr && overlay->version() != parts.obstacles_version) {
-    parts.coherence.obstacles_changed();
+    parts.coherence.obstacles_changed(overlay, overlay->shows() != parts.obstacles_shows);
     parts.obstacles_version = overlay->version();
+    parts.obstacles_shows = overlay->shows();
   }
 
   // 1. The pose and the world box. A step that may end inside the free box reads no clock
@@ -194,13 +195,13 @@ void FlyingObject::test_region(const geometry::Box& box, const QueryOptions& opt
     ShardPin local_pin;
     phase_two.test_shard(region.acquire(k, local_pin, counters), parts.obstacles.get());
   }
-  if (parts.obstacles && !phase_two.stopped()) phase_two.test_dynamic_parts(*parts.obstacles);
+  if (parts.obstacles && !phase_two.stopped()) phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
   phase_two.finish();
   const auto loop_end = Clock::now();
   counters.test_seconds = std::max(
       0.0, std::chrono::duration<double>(loop_end - loop_start).count() - counters.shard_seconds);
   if (!result.collides) parts.containment.check(box, parts.object, region.pins(), result, loop_end);
-  parts.containment.check_dynamic(box, parts.object, solid_query, result);
+  parts.containment.check_dynamic(box, parts.object, parts.obstacle, solid_query, result);
 }
 
 geometry::Box FlyingObject::shapes_box(const geometry::Box& box) const {
@@ -219,9 +220,9 @@ void FlyingObject::test_obstacles_alone(const geometry::Box& box, const QueryOpt
   parts.shapes.prepare(*model_, parts.object, box, reach, own_frame, solid_query, shapes_box(box));
   PhaseTwo phase_two(*index_, *model_, parts.object, parts.shapes, parts.solid, parts.coherence,
                      parts.containment, parts.met_triangles, options, solid_query, box, result);
-  phase_two.test_dynamic_parts(*parts.obstacles);
+  phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
   phase_two.finish();
-  parts.containment.check_dynamic(box, parts.object, solid_query, result);
+  parts.containment.check_dynamic(box, parts.object, parts.obstacle, solid_query, result);
 }
 
 void FlyingObject::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacles) {
@@ -229,8 +230,9 @@ void FlyingObject::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacl
     throw InputError("dynamic obstacles on another index (" + obstacles->index()->path().string() +
                      ") than the flying object's (" + index_->path().string() + ")");
   parts_->obstacles = std::move(obstacles);
-  parts_->coherence.obstacles_changed();  // the free box did not know them
+  parts_->coherence.obstacles_changed(nullptr, true);  // the free box did not know them
   parts_->obstacles_version = parts_->obstacles ? parts_->obstacles->version() : 0;
+  parts_->obstacles_shows = parts_->obstacles ? parts_->obstacles->shows() : 0;
 }
 
 geometry::ContactGeometry FlyingObject::dynamic_contact_geometry(const Contact& contact) {

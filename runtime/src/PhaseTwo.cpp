@@ -167,9 +167,9 @@ void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
     shard.for_each_box_candidate(box_, meets_own_box, visit);
 }
 
-void PhaseTwo::test_dynamic_parts(const DynamicObstacles& overlay) {
+void PhaseTwo::test_dynamic_parts(const DynamicObstacles& overlay, PlacedObject& placed) {
   overlay.for_each_in_box(box_, [&](const DynamicObstacles::Part& part) {
-    PlacedObject placed(*part.model);
+    placed.rebind(*part.model);
     placed.place(part.pose);
     // The step's box in the part's frame: its corners taken there (rounded, so grown far
     // beyond the rounding: it only prunes; each triangle is decided on world coordinates).

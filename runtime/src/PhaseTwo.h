@@ -33,7 +33,8 @@ class PhaseTwo {
   void test_shard(const Shard& shard, const DynamicObstacles* overlay = nullptr);
   /// The dynamic parts whose boxes meet the step's box: each part triangle near the box (its
   /// BVH, the box taken into its frame) through the same phase II as a shard's candidate.
-  void test_dynamic_parts(const DynamicObstacles& overlay);
+  /// `placed`: scratch, rebound to each part.
+  void test_dynamic_parts(const DynamicObstacles& overlay, PlacedObject& placed);
   /// first_hit found its contact: the other shards need not be tested.
   bool stopped() const { return stop_; }
   /// With all contacts, each pair once.

@@ -317,6 +317,47 @@ TEST(DynamicObstacles, APartInsertedIntoTheFreeBoxIsSeenOnTheNextStep) {
   EXPECT_NE(flying.contact_geometry(result.contacts[0]).shape, geometry::ContactShape::none);
 }
 
+// Steps of 0.001 along x from `pose` until the object sits in a free box; false if it never does.
+bool settle_in_free_box(FlyingObject& flying, Pose& pose) {
+  QueryResult result;
+  for (int i = 0; i < 40; ++i) {
+    pose.translation[0] += 0.001;
+    flying.query(pose, {}, result);
+    if (result.collides) return false;
+    if (result.counters.in_free_box) return true;
+  }
+  return false;
+}
+
+TEST(DynamicObstacles, TheFreeBoxSurvivesFarChangesOnly) {
+  auto overlay = std::make_shared<DynamicObstacles>(scene().index);
+  FlyingObject flying(scene().index, shape(116, 0.05, 1));
+  flying.set_obstacles(overlay);
+  Pose pose{{0.47, 0.2, 0.72}, {1, 0, 0, 0}};
+  ASSERT_TRUE(settle_in_free_box(flying, pose));
+  // Far away: the free box stays.
+  const DynamicPartId far = overlay->insert(part_model(116, 0.05, 2), Pose{{0.9, 0.9, 0.1}, {1, 0, 0, 0}});
+  EXPECT_TRUE(flying.query(pose).counters.in_free_box);
+  overlay->move(far, Pose{{0.85, 0.9, 0.1}, {1, 0, 0, 0}});
+  EXPECT_TRUE(flying.query(pose).counters.in_free_box);
+  // Near, not touching (2 thousandths apart; the free box reaches beyond the object's box by
+  // at least an eighth of its extent): the free box goes, the answer is still free.
+  overlay->insert(part_model(116, 0.01, 3), Pose{{pose.translation[0] + 0.032, pose.translation[1], pose.translation[2]}, {1, 0, 0, 0}});
+  const QueryResult near = flying.query(pose);
+  EXPECT_FALSE(near.counters.in_free_box);
+  EXPECT_FALSE(near.collides);
+  // Inside solid 4 while it is hidden: free, in a free box; shown again, the next step collides.
+  Pose inside{{0.47, 0.5, 0.5}, {1, 0, 0, 0}};
+  overlay->hide_part(4);
+  FlyingObject small(scene().index, shape(116, 0.02, 1));
+  small.set_obstacles(overlay);
+  ASSERT_TRUE(settle_in_free_box(small, inside));
+  overlay->show_part(4);
+  const QueryResult shown = small.query(inside);
+  EXPECT_TRUE(shown.collides);
+  EXPECT_EQ(shown.containment, Containment::object_inside_obstacle);
+}
+
 TEST(DynamicObstacles, SolidShapesSweptMotionAndOtherAccuracies) {
   // Hull, box and swept answers with dynamic parts are those of the same shapes on the static
   // index plus the parts: a superset of the mesh's contacts (never missing one).

@@ -18,7 +18,8 @@
 /// steps of the FlyingObjects that hold the overlay; steps of any number of FlyingObjects on
 /// any threads may read it at once while nothing changes it (every read is const and keeps no
 /// scratch). Each change bumps version(): a FlyingObject that sees a new version drops its
-/// free box, so a part inserted into the free box is seen on the very next step.
+/// free box when a part's box meets it or a part was shown, so a part inserted into the free
+/// box is seen on the very next step (and a part moving far away costs the free box nothing).
 
 #include <algorithm>
 #include <array>
@@ -95,6 +96,8 @@ class DynamicObstacles {
 
   /// Bumped by every change.
   std::uint64_t version() const { return version_; }
+  /// Bumped by every show_part (a shown part may hold an object that was free while hidden).
+  std::uint64_t shows() const { return shows_; }
   double cell_size() const { return cell_size_; }
   const std::shared_ptr<const CollisionIndex>& index() const { return index_; }
 
@@ -119,6 +122,7 @@ class DynamicObstacles {
   geometry::Box placed_box(const ObjectModel& model, const Pose& pose, DynamicPartId id) const;
   CellRange cells_of(const geometry::Box& box) const;
   static CellKey key(std::int64_t x, std::int64_t y, std::int64_t z);
+  static std::array<std::int64_t, 3> coordinates(CellKey key);
   void add_to_grid(std::uint32_t slot);
   void remove_from_grid(std::uint32_t slot);
   std::uint32_t slot_of(DynamicPartId id, const char* action) const;
@@ -133,35 +137,45 @@ class DynamicObstacles {
   std::vector<std::uint8_t> hidden_;  ///< by index part
   std::uint32_t hidden_count_ = 0;
   std::uint64_t version_ = 0;
-  // A query's duplicates (a part in several cells) are found by sorting its hits: no scratch
-  // is kept, so queries from several threads share nothing.
+  std::uint64_t shows_ = 0;
 };
 
 template <class Visit>
 void DynamicObstacles::for_each_in_box(const geometry::Box& box, Visit&& visit) const {
   if (parts_.empty()) return;
-  auto visit_id = [&](DynamicPartId id) {
+  for (const DynamicPartId id : wide_) {
     const Part& part = parts_[slot_.at(id)];
-    return !geometry::boxes_overlap(part.world_box, box) || visit(part);
-  };
-  for (const DynamicPartId id : wide_)
-    if (!visit_id(id)) return;
-  const CellRange range = cells_of(box);
-  std::vector<DynamicPartId> found;
-  if (range.count() > grid_.size()) {
-    // A box wider than the occupied cells: every cell's parts.
-    for (const auto& [cell, ids] : grid_) found.insert(found.end(), ids.begin(), ids.end());
-  } else {
-    for (std::int64_t x = range.lo[0]; x <= range.hi[0]; ++x)
-      for (std::int64_t y = range.lo[1]; y <= range.hi[1]; ++y)
-        for (std::int64_t z = range.lo[2]; z <= range.hi[2]; ++z)
-          if (const auto cell = grid_.find(key(x, y, z)); cell != grid_.end())
-            found.insert(found.end(), cell->second.begin(), cell->second.end());
+    if (geometry::boxes_overlap(part.world_box, box) && !visit(part)) return;
   }
-  std::sort(found.begin(), found.end());
-  found.erase(std::unique(found.begin(), found.end()), found.end());
-  for (const DynamicPartId id : found)
-    if (!visit_id(id)) return;
+  const CellRange range = cells_of(box);
+  // A part in several cells is visited in one: the first cell it shares with the box (no
+  // scratch to deduplicate with, so readers share nothing and visits may nest).
+  auto visit_cell = [&](std::int64_t x, std::int64_t y, std::int64_t z,
+                        const std::vector<DynamicPartId>& ids) {
+    for (const DynamicPartId id : ids) {
+      const Part& part = parts_[slot_.at(id)];
+      if (!geometry::boxes_overlap(part.world_box, box)) continue;
+      const CellRange own = cells_of(part.world_box);
+      if (x != std::max(own.lo[0], range.lo[0]) || y != std::max(own.lo[1], range.lo[1]) ||
+          z != std::max(own.lo[2], range.lo[2]))
+        continue;
+      if (!visit(part)) return false;
+    }
+    return true;
+  };
+  if (range.count() > grid_.size()) {
+    // A box wider than the occupied cells: every occupied cell.
+    for (const auto& [cell, ids] : grid_) {
+      const auto [x, y, z] = coordinates(cell);
+      if (!visit_cell(x, y, z, ids)) return;
+    }
+    return;
+  }
+  for (std::int64_t x = range.lo[0]; x <= range.hi[0]; ++x)
+    for (std::int64_t y = range.lo[1]; y <= range.hi[1]; ++y)
+      for (std::int64_t z = range.lo[2]; z <= range.hi[2]; ++z)
+        if (const auto cell = grid_.find(key(x, y, z)); cell != grid_.end())
+          if (!visit_cell(x, y, z, cell->second)) return;
 }
 
 }  // namespace tetrapage
