@@ -69,7 +69,8 @@ tetrapage_status tetrapage_group_destroy(tetrapage_group* group) {
   });
 }
 
-tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group, tetrapage_obstacles* obstacles) {
+tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group,
+                                               tetrapage_obstacles* obstacles) {
   return guarded(__func__, [&] {
     const auto state = group_state(group);
     state->has_result = false;

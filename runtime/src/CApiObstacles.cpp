@@ -55,7 +55,8 @@ std::shared_ptr<const tetrapage::DynamicObstacles> tetrapage::capi::obstacles_of
 
 extern "C" {
 
-tetrapage_status tetrapage_obstacles_create(tetrapage_index* index, tetrapage_obstacles** obstacles) {
+tetrapage_status tetrapage_obstacles_create(tetrapage_index* index,
+                                            tetrapage_obstacles** obstacles) {
   if (obstacles) *obstacles = nullptr;
   return guarded(__func__, [&] {
     const auto state = index_state(index);
@@ -89,7 +90,8 @@ tetrapage_status tetrapage_obstacles_insert(tetrapage_obstacles* obstacles, cons
 
 tetrapage_status tetrapage_obstacles_move(tetrapage_obstacles* obstacles, uint32_t id,
                                           const double pose[7]) {
-  return guarded(__func__, [&] { obstacles_state(obstacles)->obstacles->move(id, pose_from(pose)); });
+  return guarded(__func__,
+                 [&] { obstacles_state(obstacles)->obstacles->move(id, pose_from(pose)); });
 }
 
 tetrapage_status tetrapage_obstacles_remove(tetrapage_obstacles* obstacles, uint32_t id) {
@@ -116,8 +118,9 @@ tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
   });
 }
 
-tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object, uint32_t* parts,
-                                                     size_t capacity, size_t* written) {
+tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object,
+                                                     uint32_t* parts, size_t capacity,
+                                                     size_t* written) {
   if (written) *written = 0;
   return guarded(__func__, [&] {
     const auto state = object_state(object);

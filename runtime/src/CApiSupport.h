@@ -189,7 +189,8 @@ inline tetrapage_status guarded(const char* function, Body&& body) noexcept {
 /// A mesh from the C arrays (vertices: 3 doubles each; triangles: 3 vertex indices each).
 /// @throw InputError for a vertex index out of range, naming the triangle.
 inline tetrapage::TriangleSoup object_soup(const double* vertices, std::size_t vertex_count,
-                                    const std::uint32_t* triangles, std::size_t triangle_count) {
+                                           const std::uint32_t* triangles,
+                                           std::size_t triangle_count) {
   tetrapage::TriangleSoup soup;
   soup.vertices.resize(vertex_count);
   for (std::size_t v = 0; v < vertex_count; ++v)
@@ -214,7 +215,8 @@ inline tetrapage::TriangleSoup object_soup(const double* vertices, std::size_t v
 /// The overlay of an obstacles handle, for the objects and groups that attach it (null for a
 /// null handle). Defined in CApiObstacles.cpp, with its table.
 /// @throw StaleHandle for a destroyed or foreign handle.
-std::shared_ptr<const tetrapage::DynamicObstacles> obstacles_of(const tetrapage_obstacles* obstacles);
+std::shared_ptr<const tetrapage::DynamicObstacles> obstacles_of(
+    const tetrapage_obstacles* obstacles);
 
 /// The int a C caller passed as an enum, read without loading it as the C++ enum: any int may
 /// arrive, and loading one outside the enumerators' range is undefined behaviour in C++.

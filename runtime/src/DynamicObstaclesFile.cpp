@@ -22,8 +22,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <type_traits>
 
@@ -50,7 +50,8 @@ void write_part(std::ostream& out, const DynamicObstacles::Part& part) {
   for (const double x : part.pose.translation) out << ' ' << hex(x);
   for (const double x : part.pose.rotation) out << ' ' << hex(x);
   out << "\nmesh " << mesh.vertices.size() << ' ' << mesh.triangles.size() << '\n';
-  for (const auto& v : mesh.vertices) out << "v " << hex(v[0]) << ' ' << hex(v[1]) << ' ' << hex(v[2]) << '\n';
+  for (const auto& v : mesh.vertices)
+    out << "v " << hex(v[0]) << ' ' << hex(v[1]) << ' ' << hex(v[2]) << '\n';
   for (const auto& t : mesh.triangles) out << "f " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
   out << "end\n";
 }
@@ -135,7 +136,8 @@ ReadPart read_part(LineReader& reader) {
   auto header = reader.record("part");
   std::uint64_t fields[2];
   reader.numbers(header, fields, 2);
-  if (fields[0] == 0 || fields[0] >= 0xffffffffu) reader.fail("bad part id " + std::to_string(fields[0]));
+  if (fields[0] == 0 || fields[0] >= 0xffffffffu)
+    reader.fail("bad part id " + std::to_string(fields[0]));
   part.id = DynamicPartId(fields[0]);
   part.name = reader.next_line("the part's name");
   if (part.name.size() != fields[1])
@@ -181,14 +183,16 @@ void DynamicObstacles::save(const std::filesystem::path& path) const {
     // In id order: the file does not depend on the order of removals.
     std::vector<const Part*> sorted;
     for (const Part& part : parts_) sorted.push_back(&part);
-    std::sort(sorted.begin(), sorted.end(), [](const Part* a, const Part* b) { return a->id < b->id; });
+    std::sort(sorted.begin(), sorted.end(),
+              [](const Part* a, const Part* b) { return a->id < b->id; });
     for (const Part* part : sorted) write_part(out, *part);
     out.flush();
     if (!out) throw IoError(temporary.string() + ": cannot write the dynamic obstacles");
   }
   std::error_code error;
   std::filesystem::rename(temporary, path, error);
-  if (error) throw IoError(path.string() + ": cannot write the dynamic obstacles: " + error.message());
+  if (error)
+    throw IoError(path.string() + ": cannot write the dynamic obstacles: " + error.message());
 }
 
 DynamicObstacles DynamicObstacles::load(std::shared_ptr<const CollisionIndex> index,

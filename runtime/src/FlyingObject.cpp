@@ -150,9 +150,8 @@ void FlyingObject::outside_model(QueryResult& result) {
 
 bool FlyingObject::step_in_new_free_box(const geometry::Box& box, QueryResult& result) {
   Parts& parts = *parts_;
-  const Coherence::NewFreeBox found =
-      parts.coherence.look_for_free_box(box, parts.region, *index_, parts.obstacles.get(),
-                                        result.counters);
+  const Coherence::NewFreeBox found = parts.coherence.look_for_free_box(
+      box, parts.region, *index_, parts.obstacles.get(), result.counters);
   if (!found.found) return false;
   if (!found.connected) {
     parts.containment.check(box, parts.object, parts.region.pins(), result, found.at);
@@ -195,7 +194,8 @@ void FlyingObject::test_region(const geometry::Box& box, const QueryOptions& opt
     ShardPin local_pin;
     phase_two.test_shard(region.acquire(k, local_pin, counters), parts.obstacles.get());
   }
-  if (parts.obstacles && !phase_two.stopped()) phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
+  if (parts.obstacles && !phase_two.stopped())
+    phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
   phase_two.finish();
   const auto loop_end = Clock::now();
   counters.test_seconds = std::max(
@@ -247,8 +247,9 @@ geometry::ContactGeometry FlyingObject::dynamic_contact_geometry(const Contact& 
                      " or the object no triangle " + std::to_string(contact.object_triangle));
   PlacedObject placed(*part->model);
   placed.place(part->pose);
-  return geometry::contact_geometry(placed.world_triangle(std::uint32_t(contact.environment_triangle)),
-                                    parts_->object.world_triangle(contact.object_triangle));
+  return geometry::contact_geometry(
+      placed.world_triangle(std::uint32_t(contact.environment_triangle)),
+      parts_->object.world_triangle(contact.object_triangle));
 }
 
 const std::shared_ptr<const DynamicObstacles>& FlyingObject::obstacles() const {

@@ -30,7 +30,8 @@ struct FlyingObject::Parts {
   std::shared_ptr<const DynamicObstacles> obstacles;  ///< merged into every query, or null
   std::uint64_t obstacles_version = 0;
   std::uint64_t obstacles_shows = 0;  ///< the overlay's shows() then
-  PlacedObject obstacle;  ///< scratch: a dynamic obstacle placed (rebound to each in turn)  ///< the overlay's version the free box was found with
+  PlacedObject obstacle;  ///< scratch: a dynamic obstacle placed (rebound to each in turn)  ///<
+                          ///< the overlay's version the free box was found with
 };
 
 }  // namespace tetrapage

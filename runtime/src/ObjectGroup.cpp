@@ -82,7 +82,8 @@ const std::shared_ptr<const ObjectModel>& ObjectGroup::model(std::size_t object)
 }
 
 void ObjectGroup::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacles) {
-  if (!index_ && obstacles) throw InputError("a group without an index has no environment to add obstacles to");
+  if (!index_ && obstacles)
+    throw InputError("a group without an index has no environment to add obstacles to");
   for (FlyingObject& flying : parts_->flying) flying.set_obstacles(obstacles);
 }
 

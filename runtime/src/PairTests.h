@@ -91,8 +91,8 @@ class RelativeFrame {
 // boxes meet, decided by the exact test on both placed triangles. `found(first_triangle,
 // second_triangle)` returns whether to go on.
 template <class Found>
-inline void find_triangle_pairs(const PairSide& first, const PairSide& second, GroupCounters& counters,
-                         Found&& found) {
+inline void find_triangle_pairs(const PairSide& first, const PairSide& second,
+                                GroupCounters& counters, Found&& found) {
   const RelativeFrame frame(first, second);
   first.model.bvh.for_each_pair(
       second.model.bvh,

@@ -52,8 +52,9 @@ void PhaseTwo::add_contact(const Source& source, std::uint32_t object_triangle) 
   if (!all_) stop_ = true;
 }
 
-void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environment, const std::array<Vec3, 3>& framed,
-                         const geometry::Box& query, double grow) {
+void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environment,
+                         const std::array<Vec3, 3>& framed, const geometry::Box& query,
+                         double grow) {
   // Object triangles that can meet the environment triangle lie within `grow` of its
   // plane, in the object's frame (its corners taken there round by less than `grow`).
   const Vec3& p0 = framed[0];

@@ -66,7 +66,8 @@ TriangleSoup moved(TriangleSoup soup, const Vec3& by) {
 Pose random_pose(Random& random, double lo, double hi) {
   Pose pose;
   pose.translation = {random.uniform(lo, hi), random.uniform(lo, hi), random.uniform(lo, hi)};
-  pose.rotation = unit_quaternion({random.normal(), random.normal(), random.normal(), random.normal()});
+  pose.rotation =
+      unit_quaternion({random.normal(), random.normal(), random.normal(), random.normal()});
   return pose;
 }
 
@@ -88,8 +89,8 @@ const Scene& scene() {
     {
       MeshWriter writer(ply);
       const std::vector<std::pair<Vec3, std::uint64_t>> placed = {
-          {{0.2, 0.2, 0.2}, 116}, {{0.75, 0.25, 0.3}, 300}, {{0.3, 0.75, 0.7}, 116},
-          {{0.7, 0.7, 0.75}, 300}, {{0.5, 0.5, 0.5}, 116}, {{0.2, 0.8, 0.2}, 300}};
+          {{0.2, 0.2, 0.2}, 116},  {{0.75, 0.25, 0.3}, 300}, {{0.3, 0.75, 0.7}, 116},
+          {{0.7, 0.7, 0.75}, 300}, {{0.5, 0.5, 0.5}, 116},   {{0.2, 0.8, 0.2}, 300}};
       for (std::size_t k = 0; k < placed.size(); ++k) {
         const TriangleSoup part = moved(shape(placed[k].second, 0.28, k + 1), placed[k].first);
         writer.add_part(part.vertices, part.triangles, "solid" + std::to_string(k));
@@ -117,14 +118,18 @@ TriangleSoup reference_world(const DynamicObstacles& overlay) {
   TriangleSoup world;
   std::vector<std::uint32_t> new_part(soup.part_count(), 0xffffffffu);
   for (std::uint32_t p = 0; p < soup.part_count(); ++p)
-    if (!overlay.hidden(p)) new_part[p] = std::uint32_t(world.part_names.size()), world.part_names.push_back(soup.part_names[p]);
+    if (!overlay.hidden(p))
+      new_part[p] = std::uint32_t(world.part_names.size()),
+      world.part_names.push_back(soup.part_names[p]);
   std::vector<std::uint32_t> vertex_of(soup.vertices.size(), 0xffffffffu);
   for (std::size_t t = 0; t < soup.triangles.size(); ++t) {
     if (new_part[soup.part_of[t]] == 0xffffffffu) continue;
     TriangleIndices copy;
     for (int c = 0; c < 3; ++c) {
       std::uint32_t& v = vertex_of[soup.triangles[t][c]];
-      if (v == 0xffffffffu) v = std::uint32_t(world.vertices.size()), world.vertices.push_back(soup.vertices[soup.triangles[t][c]]);
+      if (v == 0xffffffffu)
+        v = std::uint32_t(world.vertices.size()),
+        world.vertices.push_back(soup.vertices[soup.triangles[t][c]]);
       copy[c] = v;
     }
     world.triangles.push_back(copy);
@@ -133,7 +138,8 @@ TriangleSoup reference_world(const DynamicObstacles& overlay) {
   for (const auto& part : overlay.parts()) {
     const auto base = std::uint32_t(world.vertices.size());
     const auto rotation = rotation_matrix(part.pose.rotation);
-    for (const auto& v : part.model->mesh.vertices) world.vertices.push_back(apply_pose(rotation, part.pose.translation, v));
+    for (const auto& v : part.model->mesh.vertices)
+      world.vertices.push_back(apply_pose(rotation, part.pose.translation, v));
     for (const auto& t : part.model->mesh.triangles) {
       world.triangles.push_back({base + t[0], base + t[1], base + t[2]});
       world.part_of.push_back(std::uint32_t(world.part_names.size()));
@@ -144,8 +150,9 @@ TriangleSoup reference_world(const DynamicObstacles& overlay) {
 }
 
 // Each dynamic triangle pair that meets, by CGAL's exact predicates on the placed triangles.
-std::set<std::pair<std::uint64_t, std::uint32_t>> dynamic_pairs_by_cgal(const DynamicObstacles& overlay, DynamicPartId id,
-                                                                        const TriangleSoup& object, const Pose& pose) {
+std::set<std::pair<std::uint64_t, std::uint32_t>> dynamic_pairs_by_cgal(
+    const DynamicObstacles& overlay, DynamicPartId id, const TriangleSoup& object,
+    const Pose& pose) {
   const auto* part = overlay.find(id);
   const auto placed = [](const TriangleSoup& soup, const Pose& p, const TriangleIndices& t) {
     const auto r = rotation_matrix(p.rotation);
@@ -170,8 +177,8 @@ struct Tally {
 };
 
 // One pose against the reference, first_hit and all_contacts; `tally` counts.
-void check_pose(FlyingObject& flying, const ReferenceCollider& reference, const DynamicObstacles& overlay,
-                const Pose& pose, Tally& tally, bool check_pairs) {
+void check_pose(FlyingObject& flying, const ReferenceCollider& reference,
+                const DynamicObstacles& overlay, const Pose& pose, Tally& tally, bool check_pairs) {
   const ReferenceCollider::Answer expected = reference.query(pose);
   ++tally.poses;
   tally.touching += expected.surfaces_touch;
@@ -180,14 +187,16 @@ void check_pose(FlyingObject& flying, const ReferenceCollider& reference, const 
     QueryOptions options;
     options.mode = mode;
     const QueryResult got = flying.query(pose, options);
-    const bool agree = got.collides == expected.collides && !got.contacts.empty() == expected.surfaces_touch &&
-                       (got.containment == Containment::object_inside_obstacle) == expected.object_inside &&
-                       (got.containment == Containment::obstacle_inside_object) == expected.obstacle_inside;
+    const bool agree =
+        got.collides == expected.collides && !got.contacts.empty() == expected.surfaces_touch &&
+        (got.containment == Containment::object_inside_obstacle) == expected.object_inside &&
+        (got.containment == Containment::obstacle_inside_object) == expected.obstacle_inside;
     if (!agree && ++tally.wrong <= 5)
-      ADD_FAILURE() << "mode " << int(mode) << " pose t=(" << pose.translation[0] << ", " << pose.translation[1] << ", "
-                    << pose.translation[2] << "): runtime " << got.collides << "/" << got.contacts.size() << "/"
-                    << int(got.containment) << ", reference " << expected.collides << "/" << expected.surfaces_touch
-                    << "/" << expected.object_inside << expected.obstacle_inside;
+      ADD_FAILURE() << "mode " << int(mode) << " pose t=(" << pose.translation[0] << ", "
+                    << pose.translation[1] << ", " << pose.translation[2] << "): runtime "
+                    << got.collides << "/" << got.contacts.size() << "/" << int(got.containment)
+                    << ", reference " << expected.collides << "/" << expected.surfaces_touch << "/"
+                    << expected.object_inside << expected.obstacle_inside;
     for (const Contact& c : got.contacts) {
       if (c.dynamic_part == kNoDynamicPart) {
         EXPECT_FALSE(overlay.hidden(c.environment_part)) << "a hidden part's triangle was reported";
@@ -201,7 +210,8 @@ void check_pose(FlyingObject& flying, const ReferenceCollider& reference, const 
     // Every dynamic pair CGAL finds, and no other.
     std::map<DynamicPartId, std::set<std::pair<std::uint64_t, std::uint32_t>>> got_pairs;
     for (const Contact& c : got.contacts)
-      if (c.dynamic_part != kNoDynamicPart) got_pairs[c.dynamic_part].insert({c.environment_triangle, c.object_triangle});
+      if (c.dynamic_part != kNoDynamicPart)
+        got_pairs[c.dynamic_part].insert({c.environment_triangle, c.object_triangle});
     for (const auto& part : overlay.parts()) {
       const auto cgal = dynamic_pairs_by_cgal(overlay, part.id, flying.object(), pose);
       if (!cgal.empty() || got_pairs.count(part.id)) {
@@ -211,21 +221,23 @@ void check_pose(FlyingObject& flying, const ReferenceCollider& reference, const 
   }
 }
 
-void check_poses(FlyingObject& flying, const DynamicObstacles& overlay, Random& random, int count, Tally& tally,
-                 bool check_pairs = false) {
+void check_poses(FlyingObject& flying, const DynamicObstacles& overlay, Random& random, int count,
+                 Tally& tally, bool check_pairs = false) {
   const ReferenceCollider reference(reference_world(overlay), flying.object());
   for (int i = 0; i < count; ++i) {
     // Half the poses near a dynamic part, where contacts are.
     Pose pose = random_pose(random, 0.05, 0.95);
     if (i % 2 == 0 && overlay.size() > 0) {
       const auto& part = overlay.parts()[random.below(overlay.size())];
-      for (int a = 0; a < 3; ++a) pose.translation[a] = part.pose.translation[a] + random.uniform(-0.12, 0.12);
+      for (int a = 0; a < 3; ++a)
+        pose.translation[a] = part.pose.translation[a] + random.uniform(-0.12, 0.12);
     }
     check_pose(flying, reference, overlay, pose, tally, check_pairs);
   }
 }
 
-std::shared_ptr<const ObjectModel> part_model(std::uint64_t triangles, double size, std::uint64_t seed) {
+std::shared_ptr<const ObjectModel> part_model(std::uint64_t triangles, double size,
+                                              std::uint64_t seed) {
   return std::make_shared<const ObjectModel>(shape(triangles, size, seed));
 }
 
@@ -238,8 +250,8 @@ TEST(DynamicObstacles, AnswersEqualTheReferenceThroughInsertMoveRemoveHideShow) 
   check_poses(flying, *overlay, random, 40, tally);  // no part: the static scene alone
   std::vector<DynamicPartId> ids;
   for (int k = 0; k < 6; ++k)
-    ids.push_back(overlay->insert(part_model(k % 2 ? 300 : 116, 0.15, 20 + k), random_pose(random, 0.15, 0.85),
-                                  "dynamic" + std::to_string(k)));
+    ids.push_back(overlay->insert(part_model(k % 2 ? 300 : 116, 0.15, 20 + k),
+                                  random_pose(random, 0.15, 0.85), "dynamic" + std::to_string(k)));
   check_poses(flying, *overlay, random, 60, tally, true);
   overlay->hide_part(1);
   overlay->hide_part(4);
@@ -251,8 +263,10 @@ TEST(DynamicObstacles, AnswersEqualTheReferenceThroughInsertMoveRemoveHideShow) 
   overlay->hide_part(6);  // the open sheet
   ids.push_back(overlay->insert(part_model(116, 0.4, 3), random_pose(random, 0.3, 0.7), "big"));
   // Beyond the index's mesh box (its top is the solids' top, z = 0.89), and straddling it.
-  ids.push_back(overlay->insert(part_model(300, 0.15, 4), Pose{{0.5, 0.5, 1.02}, {1, 0, 0, 0}}, "above"));
-  ids.push_back(overlay->insert(part_model(116, 0.15, 5), Pose{{0.45, 0.2, 0.9}, {1, 0, 0, 0}}, "straddling"));
+  ids.push_back(
+      overlay->insert(part_model(300, 0.15, 4), Pose{{0.5, 0.5, 1.02}, {1, 0, 0, 0}}, "above"));
+  ids.push_back(overlay->insert(part_model(116, 0.15, 5), Pose{{0.45, 0.2, 0.9}, {1, 0, 0, 0}},
+                                "straddling"));
   check_poses(flying, *overlay, random, 80, tally, true);
   EXPECT_EQ(tally.wrong, 0);
   EXPECT_GT(tally.touching, 40);
@@ -270,8 +284,10 @@ TEST(DynamicObstacles, ContainmentBothWaysAndHiddenSolids) {
   small.set_obstacles(overlay);
   large.set_obstacles(overlay);
   // A big closed dynamic sphere around the small object, a small one inside the large object.
-  const DynamicPartId big = overlay->insert(part_model(116, 0.2, 1), Pose{{0.5, 0.25, 0.75}, {1, 0, 0, 0}}, "big");
-  const DynamicPartId tiny = overlay->insert(part_model(116, 0.03, 1), Pose{{0.5, 0.75, 0.3}, {1, 0, 0, 0}}, "tiny");
+  const DynamicPartId big =
+      overlay->insert(part_model(116, 0.2, 1), Pose{{0.5, 0.25, 0.75}, {1, 0, 0, 0}}, "big");
+  const DynamicPartId tiny =
+      overlay->insert(part_model(116, 0.03, 1), Pose{{0.5, 0.75, 0.3}, {1, 0, 0, 0}}, "tiny");
   QueryResult in = small.query(Pose{{0.5, 0.25, 0.75}, {1, 0, 0, 0}});
   EXPECT_EQ(in.containment, Containment::object_inside_obstacle);
   EXPECT_EQ(in.containing_dynamic_part, big);
@@ -307,7 +323,9 @@ TEST(DynamicObstacles, APartInsertedIntoTheFreeBoxIsSeenOnTheNextStep) {
     in_free_box = result.counters.in_free_box;
   }
   ASSERT_TRUE(in_free_box);
-  overlay->insert(part_model(116, 0.05, 2), Pose{{pose.translation[0] + 0.02, pose.translation[1], pose.translation[2]}, {1, 0, 0, 0}});
+  overlay->insert(
+      part_model(116, 0.05, 2),
+      Pose{{pose.translation[0] + 0.02, pose.translation[1], pose.translation[2]}, {1, 0, 0, 0}});
   flying.query(pose, {}, result);
   EXPECT_TRUE(result.collides);
   EXPECT_FALSE(result.counters.in_free_box);
@@ -336,13 +354,16 @@ TEST(DynamicObstacles, TheFreeBoxSurvivesFarChangesOnly) {
   Pose pose{{0.47, 0.2, 0.72}, {1, 0, 0, 0}};
   ASSERT_TRUE(settle_in_free_box(flying, pose));
   // Far away: the free box stays.
-  const DynamicPartId far = overlay->insert(part_model(116, 0.05, 2), Pose{{0.9, 0.9, 0.1}, {1, 0, 0, 0}});
+  const DynamicPartId far =
+      overlay->insert(part_model(116, 0.05, 2), Pose{{0.9, 0.9, 0.1}, {1, 0, 0, 0}});
   EXPECT_TRUE(flying.query(pose).counters.in_free_box);
   overlay->move(far, Pose{{0.85, 0.9, 0.1}, {1, 0, 0, 0}});
   EXPECT_TRUE(flying.query(pose).counters.in_free_box);
   // Near, not touching (2 thousandths apart; the free box reaches beyond the object's box by
   // at least an eighth of its extent): the free box goes, the answer is still free.
-  overlay->insert(part_model(116, 0.01, 3), Pose{{pose.translation[0] + 0.032, pose.translation[1], pose.translation[2]}, {1, 0, 0, 0}});
+  overlay->insert(
+      part_model(116, 0.01, 3),
+      Pose{{pose.translation[0] + 0.032, pose.translation[1], pose.translation[2]}, {1, 0, 0, 0}});
   const QueryResult near = flying.query(pose);
   EXPECT_FALSE(near.counters.in_free_box);
   EXPECT_FALSE(near.collides);
@@ -363,7 +384,8 @@ TEST(DynamicObstacles, SolidShapesSweptMotionAndOtherAccuracies) {
   // index plus the parts: a superset of the mesh's contacts (never missing one).
   auto overlay = std::make_shared<DynamicObstacles>(scene().index);
   Random random(3);
-  for (int k = 0; k < 8; ++k) overlay->insert(part_model(116, 0.12, 40 + k), random_pose(random, 0.15, 0.85));
+  for (int k = 0; k < 8; ++k)
+    overlay->insert(part_model(116, 0.12, 40 + k), random_pose(random, 0.15, 0.85));
   FlyingObject mesh(scene().index, shape(300, 0.12, 9)), solid(scene().index, shape(300, 0.12, 9));
   mesh.set_obstacles(overlay);
   solid.set_obstacles(overlay);
@@ -375,7 +397,8 @@ TEST(DynamicObstacles, SolidShapesSweptMotionAndOtherAccuracies) {
       QueryOptions options;
       options.shape = shape;
       const QueryResult coarse = solid.query(pose, options);
-      EXPECT_TRUE(coarse.collides || !exact.collides) << "shape " << int(shape) << " missed a collision, step " << i;
+      EXPECT_TRUE(coarse.collides || !exact.collides)
+          << "shape " << int(shape) << " missed a collision, step " << i;
     }
     QueryOptions near;
     near.accuracy = geometry::Accuracy::within(0.01);
@@ -389,9 +412,11 @@ TEST(DynamicObstacles, SolidShapesSweptMotionAndOtherAccuracies) {
 TEST(DynamicObstacles, AGroupsObjectsAnswerAsLoneObjects) {
   auto overlay = std::make_shared<DynamicObstacles>(scene().index);
   Random random(31);
-  for (int k = 0; k < 8; ++k) overlay->insert(part_model(116, 0.15, 80 + k), random_pose(random, 0.15, 0.85));
+  for (int k = 0; k < 8; ++k)
+    overlay->insert(part_model(116, 0.15, 80 + k), random_pose(random, 0.15, 0.85));
   overlay->hide_part(0);
-  const std::vector<std::shared_ptr<const ObjectModel>> models = {part_model(116, 0.12, 7), part_model(300, 0.12, 8)};
+  const std::vector<std::shared_ptr<const ObjectModel>> models = {part_model(116, 0.12, 7),
+                                                                  part_model(300, 0.12, 8)};
   ObjectGroup group(scene().index, models);
   group.set_obstacles(overlay);
   FlyingObject a(scene().index, models[0]), b(scene().index, models[1]);
@@ -409,7 +434,9 @@ TEST(DynamicObstacles, AGroupsObjectsAnswerAsLoneObjects) {
 TEST(DynamicObstacles, SaveAndLoadGiveTheSameAnswers) {
   auto overlay = std::make_shared<DynamicObstacles>(scene().index);
   Random random(21);
-  for (int k = 0; k < 5; ++k) overlay->insert(part_model(k % 2 ? 300 : 116, 0.15, 60 + k), random_pose(random, 0.15, 0.85), "part with spaces " + std::to_string(k));
+  for (int k = 0; k < 5; ++k)
+    overlay->insert(part_model(k % 2 ? 300 : 116, 0.15, 60 + k), random_pose(random, 0.15, 0.85),
+                    "part with spaces " + std::to_string(k));
   overlay->remove(2);
   overlay->hide_part(3);
   const fs::path path = scene().folder / "overlay.tpo";
@@ -475,7 +502,8 @@ TEST(DynamicObstacles, DamagedFilesFailWithAFormatErrorNamingTheFile) {
     copy.replace(copy.find(from), from.size(), to);
     return copy;
   };
-  expect_format_error(replaced("tetrapage-dynamic-obstacles 1", "tetrapage-dynamic-obstacles 2"), "version");
+  expect_format_error(replaced("tetrapage-dynamic-obstacles 1", "tetrapage-dynamic-obstacles 2"),
+                      "version");
   expect_format_error(replaced("hidden 1 2", "hidden 1 99"), "hidden part beyond the index");
   expect_format_error(replaced("mesh ", "mesh 4000000000"), "huge count");
   expect_format_error(replaced("\nf ", "\nf 99999 "), "vertex out of range");
@@ -487,11 +515,13 @@ TEST(DynamicObstacles, DamagedFilesFailWithAFormatErrorNamingTheFile) {
 
 TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
   tetrapage_index* index = nullptr;
-  ASSERT_EQ(tetrapage_open((scene().folder / "scene.tpi").c_str(), TETRAPAGE_DEFAULT_BUDGET_BYTES, &index), TETRAPAGE_OK);
+  ASSERT_EQ(tetrapage_open((scene().folder / "scene.tpi").c_str(), TETRAPAGE_DEFAULT_BUDGET_BYTES,
+                           &index),
+            TETRAPAGE_OK);
   const TriangleSoup object = shape(116, 0.12, 7);
   tetrapage_object* flying = nullptr;
-  ASSERT_EQ(tetrapage_object_create(index, &object.vertices[0][0], object.vertices.size(), &object.triangles[0][0],
-                                    object.triangles.size(), &flying),
+  ASSERT_EQ(tetrapage_object_create(index, &object.vertices[0][0], object.vertices.size(),
+                                    &object.triangles[0][0], object.triangles.size(), &flying),
             TETRAPAGE_OK);
   tetrapage_obstacles* obstacles = nullptr;
   ASSERT_EQ(tetrapage_obstacles_create(index, &obstacles), TETRAPAGE_OK);
@@ -503,11 +533,12 @@ TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
   for (int k = 0; k < 6; ++k) {
     const TriangleSoup part = shape(116, 0.15, 70 + k);
     const Pose pose = random_pose(random, 0.15, 0.85);
-    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2], pose.rotation[0],
-                         pose.rotation[1],    pose.rotation[2],    pose.rotation[3]};
+    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2],
+                         pose.rotation[0],    pose.rotation[1],    pose.rotation[2],
+                         pose.rotation[3]};
     std::uint32_t id = 0;
-    ASSERT_EQ(tetrapage_obstacles_insert(obstacles, &part.vertices[0][0], part.vertices.size(), &part.triangles[0][0],
-                                         part.triangles.size(), p, "p", &id),
+    ASSERT_EQ(tetrapage_obstacles_insert(obstacles, &part.vertices[0][0], part.vertices.size(),
+                                         &part.triangles[0][0], part.triangles.size(), p, "p", &id),
               TETRAPAGE_OK);
     EXPECT_EQ(id, overlay->insert(part, pose, "p"));
   }
@@ -518,10 +549,12 @@ TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
   int dynamic = 0;
   for (int i = 0; i < 100; ++i) {
     const Pose pose = random_pose(random, 0.1, 0.9);
-    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2], pose.rotation[0],
-                         pose.rotation[1],    pose.rotation[2],    pose.rotation[3]};
+    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2],
+                         pose.rotation[0],    pose.rotation[1],    pose.rotation[2],
+                         pose.rotation[3]};
     int collides = 0;
-    ASSERT_EQ(tetrapage_query(flying, p, TETRAPAGE_ACCURACY_EXACT, 0.0, 0, &collides), TETRAPAGE_OK);
+    ASSERT_EQ(tetrapage_query(flying, p, TETRAPAGE_ACCURACY_EXACT, 0.0, 0, &collides),
+              TETRAPAGE_OK);
     const QueryResult expected = cxx.query(pose);
     EXPECT_EQ(collides != 0, expected.collides);
     std::uint32_t part = 0;
@@ -540,8 +573,9 @@ TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
   ASSERT_EQ(tetrapage_group_set_obstacles(group, obstacles), TETRAPAGE_OK);
   for (int i = 0; i < 50; ++i) {
     const Pose pose = random_pose(random, 0.1, 0.9);
-    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2], pose.rotation[0],
-                         pose.rotation[1],    pose.rotation[2],    pose.rotation[3]};
+    const double p[7] = {pose.translation[0], pose.translation[1], pose.translation[2],
+                         pose.rotation[0],    pose.rotation[1],    pose.rotation[2],
+                         pose.rotation[3]};
     std::size_t pairs = 0, written = 0;
     int collides = 0;
     ASSERT_EQ(tetrapage_group_step(group, p, 0, &pairs), TETRAPAGE_OK);
@@ -555,7 +589,8 @@ TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
   ASSERT_EQ(tetrapage_obstacles_load(index, path.c_str(), &loaded), TETRAPAGE_OK);
   EXPECT_NE(loaded, nullptr);
   EXPECT_EQ(tetrapage_obstacles_destroy(loaded), TETRAPAGE_OK);
-  EXPECT_EQ(tetrapage_obstacles_load(index, (path + ".missing").c_str(), &loaded), TETRAPAGE_ERROR_FORMAT);
+  EXPECT_EQ(tetrapage_obstacles_load(index, (path + ".missing").c_str(), &loaded),
+            TETRAPAGE_ERROR_FORMAT);
   EXPECT_EQ(loaded, nullptr);
   EXPECT_EQ(tetrapage_object_set_obstacles(flying, nullptr), TETRAPAGE_OK);
   EXPECT_EQ(tetrapage_obstacles_destroy(obstacles), TETRAPAGE_OK);

@@ -434,7 +434,8 @@ typedef struct tetrapage_obstacles tetrapage_obstacles;
 
 /* An empty overlay on `index`.
    Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
-tetrapage_status tetrapage_obstacles_create(tetrapage_index* index, tetrapage_obstacles** obstacles);
+tetrapage_status tetrapage_obstacles_create(tetrapage_index* index,
+                                            tetrapage_obstacles** obstacles);
 
 /* Releases the overlay's handle (objects that hold it keep it until detached). A null one is
    ignored. Errors: TETRAPAGE_ERROR_STALE_HANDLE. */
@@ -470,13 +471,15 @@ tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
 
 /* The same for every object of a group (their environment queries; null: none).
    Errors: TETRAPAGE_ERROR_INPUT (an overlay on another index), TETRAPAGE_ERROR_STALE_HANDLE. */
-tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group, tetrapage_obstacles* obstacles);
+tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group,
+                                               tetrapage_obstacles* obstacles);
 
 /* Per contact of the last query (as tetrapage_get_contacts), its dynamic part's id or 0 for a
    part of the index: the first min(capacity, count), their number to *written.
    Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
-tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object, uint32_t* parts,
-                                                     size_t capacity, size_t* written);
+tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object,
+                                                     uint32_t* parts, size_t capacity,
+                                                     size_t* written);
 
 /* Writes the overlay to `path`; reads one back on `index` (same ids, names, poses, meshes and
    hidden parts).

@@ -129,7 +129,7 @@ class DynamicObstacles {
 
   std::shared_ptr<const CollisionIndex> index_;
   double cell_size_ = 1;
-  std::vector<Part> parts_;                               ///< dense: removal swaps in the last
+  std::vector<Part> parts_;                                ///< dense: removal swaps in the last
   std::unordered_map<DynamicPartId, std::uint32_t> slot_;  ///< id -> position in parts_
   std::unordered_map<CellKey, std::vector<DynamicPartId>> grid_;
   std::vector<DynamicPartId> wide_;  ///< parts wider than kMaxCellsPerPart cells
