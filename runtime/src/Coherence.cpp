@@ -112,12 +112,16 @@ bool Coherence::find_free_box(const geometry::Box& box, SearchedRegion& region,
         });
   }
   // The dynamic obstacles' boxes are cut like triangle boxes (their version is checked by
-  // every step: a change drops the free box).
-  if (found && overlay != nullptr)
-    overlay->for_each_in_box(grown, [&](const DynamicObstacles::Part& part) {
-      found = cut(part.world_box);
+  // every step: a change drops the free box). They may stand outside the mesh's box, where
+  // the step's box may reach beyond `grown`: one meeting the step's box fails the search.
+  if (found && overlay != nullptr) {
+    geometry::Box reach = grown;
+    reach.extend(box);
+    overlay->for_each_in_box(reach, [&](const DynamicObstacles::Part& part) {
+      found = !geometry::boxes_overlap(part.world_box, box) && cut(part.world_box);
       return found;
     });
+  }
   // A failed search keeps the last free box: it still holds no triangle.
   if (found) free_box_ = grown, free_box_valid_ = true;
   return found;

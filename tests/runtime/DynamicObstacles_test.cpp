@@ -19,6 +19,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -268,6 +269,13 @@ TEST(DynamicObstacles, AnswersEqualTheReferenceThroughInsertMoveRemoveHideShow) 
   ids.push_back(overlay->insert(part_model(116, 0.15, 5), Pose{{0.45, 0.2, 0.9}, {1, 0, 0, 0}},
                                 "straddling"));
   check_poses(flying, *overlay, random, 80, tally, true);
+  {
+    // Rising through the mesh box's top into the part above it: the step's box straddles the
+    // mesh box, whose free boxes stop at its top (a free box once missed the part there).
+    const ReferenceCollider reference(reference_world(*overlay), flying.object());
+    for (double z = 0.8; z < 1.0; z += 0.004)
+      check_pose(flying, reference, *overlay, Pose{{0.47, 0.52, z}, {1, 0, 0, 0}}, tally, false);
+  }
   EXPECT_EQ(tally.wrong, 0);
   EXPECT_GT(tally.touching, 40);
   EXPECT_GT(tally.poses - tally.touching, 40);
@@ -429,6 +437,35 @@ TEST(DynamicObstacles, AGroupsObjectsAnswerAsLoneObjects) {
     EXPECT_EQ(got.environment[1].contacts, b.query(poses[1]).contacts);
   }
   EXPECT_THROW(ObjectGroup(nullptr, models).set_obstacles(overlay), InputError);
+}
+
+TEST(DynamicObstacles, ObjectsOnSeveralThreadsShareOneOverlay) {
+  auto overlay = std::make_shared<DynamicObstacles>(scene().index);
+  Random random(41);
+  for (int k = 0; k < 50; ++k)
+    overlay->insert(part_model(116, 0.08, 90 + k % 5), random_pose(random, 0.1, 0.9));
+  overlay->hide_part(2);
+  std::vector<Pose> poses;
+  for (int i = 0; i < 400; ++i) poses.push_back(random_pose(random, 0.05, 0.95));
+  const auto model = part_model(116, 0.1, 7);
+  auto answers = [&](std::size_t begin, std::size_t end) {
+    FlyingObject flying(scene().index, model);
+    flying.set_obstacles(overlay);
+    std::vector<std::vector<Contact>> found;
+    QueryOptions options;
+    options.mode = QueryMode::all_contacts;
+    for (std::size_t i = begin; i < end; ++i)
+      found.push_back(flying.query(poses[i], options).contacts);
+    return found;
+  };
+  const auto expected = answers(0, poses.size());
+  std::vector<std::vector<std::vector<Contact>>> got(4);
+  std::vector<std::thread> threads;
+  for (std::size_t t = 0; t < 4; ++t)
+    threads.emplace_back([&, t] { got[t] = answers(t * 100, t * 100 + 100); });
+  for (auto& thread : threads) thread.join();
+  for (std::size_t t = 0; t < 4; ++t)
+    for (std::size_t i = 0; i < 100; ++i) EXPECT_EQ(got[t][i], expected[t * 100 + i]);
 }
 
 TEST(DynamicObstacles, SaveAndLoadGiveTheSameAnswers) {
