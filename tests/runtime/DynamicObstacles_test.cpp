@@ -341,6 +341,10 @@ TEST(DynamicObstacles, APartInsertedIntoTheFreeBoxIsSeenOnTheNextStep) {
   EXPECT_NE(result.contacts[0].dynamic_part, kNoDynamicPart);
   // The contact's geometry is the dynamic triangle's.
   EXPECT_NE(flying.contact_geometry(result.contacts[0]).shape, geometry::ContactShape::none);
+  // The distance query decides touching with the overlay: 0, at the dynamic contact.
+  const DistanceResult touching = flying.distance(pose);
+  EXPECT_EQ(touching.distance, 0.0);
+  EXPECT_EQ(touching.environment_part, Contact::kDynamicPart);
 }
 
 // Steps of 0.001 along x from `pose` until the object sits in a free box; false if it never does.
