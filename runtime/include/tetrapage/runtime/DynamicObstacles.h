@@ -14,6 +14,12 @@
 /// every query scans. The grid covers the index's mesh box: parts outside it are answered
 /// too, but share its border cells (slower when many stand there).
 ///
+/// Limits: a swept step (Motion::swept) sweeps the object, not the parts (each is taken at
+/// its current pose). FlyingObject::distance decides touching with the overlay but measures
+/// the distance to the index's parts only, hidden ones included. Where a hidden closed part
+/// encloses a visible one that holds the object, the index's interior walk may name the hidden
+/// one only, and the object is then reported free.
+///
 /// Threading: changes (insert, move, remove, hide, show, load) from one thread, between the
 /// steps of the FlyingObjects that hold the overlay; steps of any number of FlyingObjects on
 /// any threads may read it at once while nothing changes it (every read is const and keeps no
