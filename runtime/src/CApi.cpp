@@ -47,29 +47,6 @@ tetrapage::geometry::Accuracy to_accuracy(int accuracy, double parameter) {
   throw tetrapage::InputError("unknown accuracy " + std::to_string(accuracy));
 }
 
-tetrapage::TriangleSoup object_soup(const double* vertices, std::size_t vertex_count,
-                                    const std::uint32_t* triangles, std::size_t triangle_count) {
-  tetrapage::TriangleSoup soup;
-  soup.vertices.resize(vertex_count);
-  for (std::size_t v = 0; v < vertex_count; ++v)
-    soup.vertices[v] = {vertices[3 * v], vertices[3 * v + 1], vertices[3 * v + 2]};
-  soup.triangles.resize(triangle_count);
-  for (std::size_t t = 0; t < triangle_count; ++t) {
-    for (int c = 0; c < 3; ++c) {
-      const std::uint32_t vertex = triangles[3 * t + c];
-      // FlyingObject checks too; saying it here names the C arrays.
-      if (vertex >= vertex_count)
-        throw tetrapage::InputError("triangle " + std::to_string(t) + " refers to vertex " +
-                                    std::to_string(vertex) + " but there are " +
-                                    std::to_string(vertex_count) + " vertices");
-      soup.triangles[t][c] = vertex;
-    }
-  }
-  soup.part_of.assign(triangle_count, 0);
-  soup.part_names = {"object"};
-  return soup;
-}
-
 }  // namespace
 
 extern "C" {

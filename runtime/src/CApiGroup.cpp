@@ -69,6 +69,15 @@ tetrapage_status tetrapage_group_destroy(tetrapage_group* group) {
   });
 }
 
+tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group,
+                                               tetrapage_obstacles* obstacles) {
+  return guarded(__func__, [&] {
+    const auto state = group_state(group);
+    state->has_result = false;
+    state->group.set_obstacles(obstacles_of(obstacles));
+  });
+}
+
 tetrapage_status tetrapage_group_step(tetrapage_group* group, const double* poses, int all_contacts,
                                       size_t* colliding_pairs) {
   if (colliding_pairs) *colliding_pairs = 0;

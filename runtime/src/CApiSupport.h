@@ -20,6 +20,7 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/tetrapage.h"
 
@@ -184,6 +185,38 @@ inline tetrapage_status guarded(const char* function, Body&& body) noexcept {
     return fail(TETRAPAGE_ERROR_INTERNAL, function, "unknown exception");
   }
 }
+
+/// A mesh from the C arrays (vertices: 3 doubles each; triangles: 3 vertex indices each).
+/// @throw InputError for a vertex index out of range, naming the triangle.
+inline tetrapage::TriangleSoup object_soup(const double* vertices, std::size_t vertex_count,
+                                           const std::uint32_t* triangles,
+                                           std::size_t triangle_count) {
+  tetrapage::TriangleSoup soup;
+  soup.vertices.resize(vertex_count);
+  for (std::size_t v = 0; v < vertex_count; ++v)
+    soup.vertices[v] = {vertices[3 * v], vertices[3 * v + 1], vertices[3 * v + 2]};
+  soup.triangles.resize(triangle_count);
+  for (std::size_t t = 0; t < triangle_count; ++t) {
+    for (int c = 0; c < 3; ++c) {
+      const std::uint32_t vertex = triangles[3 * t + c];
+      // FlyingObject checks too; saying it here names the C arrays.
+      if (vertex >= vertex_count)
+        throw tetrapage::InputError("triangle " + std::to_string(t) + " refers to vertex " +
+                                    std::to_string(vertex) + " but there are " +
+                                    std::to_string(vertex_count) + " vertices");
+      soup.triangles[t][c] = vertex;
+    }
+  }
+  soup.part_of.assign(triangle_count, 0);
+  soup.part_names = {"object"};
+  return soup;
+}
+
+/// The overlay of an obstacles handle, for the objects and groups that attach it (null for a
+/// null handle). Defined in CApiObstacles.cpp, with its table.
+/// @throw StaleHandle for a destroyed or foreign handle.
+std::shared_ptr<const tetrapage::DynamicObstacles> obstacles_of(
+    const tetrapage_obstacles* obstacles);
 
 /// The int a C caller passed as an enum, read without loading it as the C++ enum: any int may
 /// arrive, and loading one outside the enumerators' range is undefined behaviour in C++.

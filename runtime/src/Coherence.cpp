@@ -6,6 +6,7 @@ namespace tetrapage {
 
 Coherence::NewFreeBox Coherence::look_for_free_box(const geometry::Box& box, SearchedRegion& region,
                                                    const CollisionIndex& index,
+                                                   const DynamicObstacles* overlay,
                                                    StepCounters& counters) {
   NewFreeBox result;
   if (free_box_wait_ > 0) {
@@ -15,7 +16,7 @@ Coherence::NewFreeBox Coherence::look_for_free_box(const geometry::Box& box, Sea
   const auto start = Clock::now();
   const geometry::Box last = free_box_;
   const bool had_free_box = free_box_valid_;
-  result.found = find_free_box(box, region, index);
+  result.found = find_free_box(box, region, index, overlay);
   result.at = Clock::now();
   counters.free_box_seconds = std::chrono::duration<double>(result.at - start).count();
   if (!result.found) {
@@ -37,7 +38,7 @@ Coherence::NewFreeBox Coherence::look_for_free_box(const geometry::Box& box, Sea
 }
 
 bool Coherence::find_free_box(const geometry::Box& box, SearchedRegion& region,
-                              const CollisionIndex& index) {
+                              const CollisionIndex& index, const DynamicObstacles* overlay) {
   // The box grown a little on every side (for rotations) and a few steps' motion ahead, within
   // the searched region: its tets' shards hold every triangle that meets it.
   // (0.0625 to 0.25 of the extent, 4 to 16 steps, and regions grown by 0.5 to 1 gave the same
@@ -109,6 +110,17 @@ bool Coherence::find_free_box(const geometry::Box& box, SearchedRegion& region,
         [&](std::uint32_t, const geometry::Triangle& triangle) {
           if (found) found = cut(geometry::box_of(triangle));
         });
+  }
+  // The dynamic obstacles' boxes are cut like triangle boxes (their version is checked by
+  // every step: a change drops the free box). They may stand outside the mesh's box, where
+  // the step's box may reach beyond `grown`: one meeting the step's box fails the search.
+  if (found && overlay != nullptr) {
+    geometry::Box reach = grown;
+    reach.extend(box);
+    overlay->for_each_in_box(reach, [&](const DynamicObstacles::Part& part) {
+      found = !geometry::boxes_overlap(part.world_box, box) && cut(part.world_box);
+      return found;
+    });
   }
   // A failed search keeps the last free box: it still holds no triangle.
   if (found) free_box_ = grown, free_box_valid_ = true;

@@ -13,6 +13,7 @@
 #include "SearchedRegion.h"
 #include "StepClock.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/geometry/Box.h"
 
 namespace tetrapage {
@@ -69,14 +70,30 @@ class Coherence {
     Clock::time_point at;  ///< when the search ended
   };
   /// For a step whose box is outside the free box: a new free box around `box`, unless the
-  /// last searches failed and it waits.
+  /// last searches failed and it waits. It meets no dynamic obstacle of `overlay` either (the
+  /// index's hidden parts still bound it: a smaller free box, never a wrong one).
   NewFreeBox look_for_free_box(const geometry::Box& box, SearchedRegion& region,
-                               const CollisionIndex& index, StepCounters& counters);
+                               const CollisionIndex& index, const DynamicObstacles* overlay,
+                               StepCounters& counters);
+  /// The dynamic obstacles changed (their version): the free box is dropped when it may hold
+  /// one now (a part's box meets it), or when `shown` (an index part shown again may hold the
+  /// object, free while it was hidden). Removing or hiding only frees space; a part whose box
+  /// misses the free box can neither touch nor hold an object inside it.
+  void obstacles_changed(const DynamicObstacles* overlay, bool shown) {
+    bool meets = shown || overlay == nullptr;
+    if (free_box_valid_ && !meets)
+      overlay->for_each_in_box(free_box_, [&](const DynamicObstacles::Part&) {
+        meets = true;
+        return false;
+      });
+    if (meets) free_box_valid_ = false, free_box_wait_ = 0;
+  }
 
  private:
   // After a free step whose box is `box`: a box around it holding no environment triangle
   // (free_box_), grown towards where the object heads; false when none was found.
-  bool find_free_box(const geometry::Box& box, SearchedRegion& region, const CollisionIndex& index);
+  bool find_free_box(const geometry::Box& box, SearchedRegion& region, const CollisionIndex& index,
+                     const DynamicObstacles* overlay);
 
   // The previous query's pose and world box (before the accuracy's growth), for swept motion.
   bool previous_valid_ = false;

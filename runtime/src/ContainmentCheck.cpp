@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 
+#include "PairTests.h"
 #include "tetrapage/runtime/ObjectInteriorGrid.h"
 
 namespace tetrapage {
@@ -29,7 +30,10 @@ void ContainmentCheck::check_object_inside_obstacle(PlacedObject& object,
     const ObstacleQuery inside = locate_in_obstacles(
         *index_, interior_tets_[c], object.world_vertex(model_->component_vertices[c]),
         interior_memos_[c], pins);
-    if (inside.containment == ObstacleContainment::inside) {
+    // A hidden part holds nothing. (Where it encloses a visible closed part that holds the
+    // object, the walk names one of the two: see DynamicObstacles' limits.)
+    if (inside.containment == ObstacleContainment::inside &&
+        !(overlay_ != nullptr && overlay_->hidden(index_->component_part(inside.component)))) {
       result.collides = true;
       result.containment = Containment::object_inside_obstacle;
       result.containing_component = inside.component;
@@ -72,6 +76,28 @@ void ContainmentCheck::check_obstacle_inside_object(const geometry::Box& box, Pl
   enclosed_.resize(undecided);
   for (std::size_t i = 0; i < enclosed_.size() && !result.collides; ++i)
     if (crossing_parity_holds(*model_, object, enclosed_[i].second, box)) inside(enclosed_[i].first);
+}
+
+void ContainmentCheck::check_dynamic(const geometry::Box& box, PlacedObject& object,
+                                     PlacedObject& placed, bool solid_query, QueryResult& result) {
+  if (overlay_ == nullptr || result.collides) return;
+  const PairSide flying{*model_, object, box};
+  overlay_->for_each_in_box(box, [&](const DynamicObstacles::Part& part) {
+    placed.rebind(*part.model);
+    placed.place(part.pose);
+    const PairSide obstacle{*part.model, placed, part.world_box};
+    if (holds_a_component(obstacle, flying))
+      result.containment = Containment::object_inside_obstacle;
+    else if (!solid_query && holds_a_component(flying, obstacle))
+      result.containment = Containment::obstacle_inside_object;
+    else
+      return true;
+    result.collides = true;
+    result.containing_part = Contact::kDynamicPart;
+    result.containing_component = 0;
+    result.containing_dynamic_part = part.id;
+    return false;
+  });
 }
 
 bool crossing_parity_holds(const ObjectModel& model, PlacedObject& object, const geometry::Point& p,

@@ -12,6 +12,7 @@
 #include "PlacedObject.h"
 #include "StepClock.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
@@ -31,7 +32,11 @@ class ContainmentCheck {
   ContainmentCheck(const CollisionIndex& index, const ObjectModel& model)
       : index_(&index), model_(&model) {}
 
-  void begin_step() { enclosed_.clear(); }
+  /// The dynamic obstacles of the next steps (null: none): their hidden parts hold nothing.
+  void begin_step(const DynamicObstacles* overlay) {
+    enclosed_.clear();
+    overlay_ = overlay;
+  }
   /// An environment component whose box lies in the object's box (only those can lie inside
   /// the object), with a vertex of a candidate triangle of it.
   void note_enclosed(std::uint32_t component, const geometry::Point& vertex) {
@@ -41,6 +46,11 @@ class ContainmentCheck {
   /// shards the walks may read without pinning; `start`: now, for its clock.
   void check(const geometry::Box& box, PlacedObject& object, std::span<const ShardPin> pins,
              QueryResult& result, Clock::time_point start);
+  /// The same against the dynamic obstacles whose boxes meet `box`: the object inside a closed
+  /// one, or (unless `solid_query`: the solid's own test found those) one inside the object.
+  /// `placed`: scratch, rebound to each obstacle.
+  void check_dynamic(const geometry::Box& box, PlacedObject& object, PlacedObject& placed,
+                     bool solid_query, QueryResult& result);
 
  private:
   void check_object_inside_obstacle(PlacedObject& object, std::span<const ShardPin> pins,
@@ -49,6 +59,7 @@ class ContainmentCheck {
                                     QueryResult& result);
   const CollisionIndex* index_;
   const ObjectModel* model_;
+  const DynamicObstacles* overlay_ = nullptr;
   // Per step: the environment components whose boxes lie in the object's box (only those can
   // lie inside the object), each with a vertex of a candidate triangle of theirs.
   std::vector<std::pair<std::uint32_t, geometry::Point>> enclosed_;

@@ -30,6 +30,7 @@ void report_touching(const QueryResult& touch, DistanceResult& result) {
 
 geometry::ContactGeometry FlyingObject::contact_geometry(const Contact& contact) {
   if (contact.object_triangle == Contact::kNoObjectTriangle) return {};
+  if (contact.dynamic_part != kNoDynamicPart) return dynamic_contact_geometry(contact);
   const auto stored = index_->stored_triangle(contact.environment_triangle);
   if (!stored)
     throw InputError("contact geometry: the index holds no triangle " +

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <string>
 
 #include "FlyingObjectParts.h"
 #include "PhaseTwo.h"
@@ -18,6 +19,7 @@ void clear_answer(QueryResult& result) {
   result.containment = Containment::none;
   result.containing_part = 0;
   result.containing_component = 0;
+  result.containing_dynamic_part = 0;
   result.contacts.clear();
   result.outside_model = false;
   result.counters = {};
@@ -80,7 +82,14 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   const CollisionIndex& index = *index_;
   clear_answer(result);
   StepCounters& counters = result.counters;
-  parts.containment.begin_step();
+  const DynamicObstacles* overlay = parts.obstacles.get();
+  parts.containment.begin_step(overlay);
+  // A changed overlay may have put a part into the free box.
+  if (overlay != nullptr && overlay->version() != parts.obstacles_version) {
+    parts.coherence.obstacles_changed(overlay, overlay->shows() != parts.obstacles_shows);
+    parts.obstacles_version = overlay->version();
+    parts.obstacles_shows = overlay->shows();
+  }
 
   // 1. The pose and the world box. A step that may end inside the free box reads no clock
   // before it knows (two reads were a tenth of such a step's time); its box's time is then
@@ -110,10 +119,17 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
     counters.locate_seconds = std::chrono::duration<double>(phase_start - start).count();
 
   // 2.-4. When the box leaves the searched region: the walk, the box search, the shards.
-  if (!geometry::boxes_overlap(box, index.mesh_bounds())) return outside_model(result);
+  // Outside the model, dynamic obstacles may still stand.
+  if (!geometry::boxes_overlap(box, index.mesh_bounds())) {
+    outside_model(result);
+    return test_obstacles_alone(box, options, question.own_frame, question.solid, reach, result);
+  }
   if (!parts.region.contains(box)) {
     // A centre outside the convex mesh: the box meets only the model's empty margin.
-    if (!parts.region.search(box, parts.coherence.motion(), counters)) return outside_model(result);
+    if (!parts.region.search(box, parts.coherence.motion(), counters)) {
+      outside_model(result);
+      return test_obstacles_alone(box, options, question.own_frame, question.solid, reach, result);
+    }
     phase_start = Clock::now();
   }
 
@@ -123,7 +139,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
 
   // 5. Phase I and II over the region's shards whose bounds meet the box, then containment.
   parts.shapes.prepare(*model_, parts.object, box, reach, question.own_frame, question.solid,
-                       index.mesh_bounds());
+                       shapes_box(box));
   test_region(box, options, question.solid, phase_start, result);
 }
 
@@ -134,8 +150,8 @@ void FlyingObject::outside_model(QueryResult& result) {
 
 bool FlyingObject::step_in_new_free_box(const geometry::Box& box, QueryResult& result) {
   Parts& parts = *parts_;
-  const Coherence::NewFreeBox found =
-      parts.coherence.look_for_free_box(box, parts.region, *index_, result.counters);
+  const Coherence::NewFreeBox found = parts.coherence.look_for_free_box(
+      box, parts.region, *index_, parts.obstacles.get(), result.counters);
   if (!found.found) return false;
   if (!found.connected) {
     parts.containment.check(box, parts.object, parts.region.pins(), result, found.at);
@@ -176,13 +192,68 @@ void FlyingObject::test_region(const geometry::Box& box, const QueryOptions& opt
     if (!needs(k)) continue;
     ++counters.shards_touched;
     ShardPin local_pin;
-    phase_two.test_shard(region.acquire(k, local_pin, counters));
+    phase_two.test_shard(region.acquire(k, local_pin, counters), parts.obstacles.get());
   }
+  if (parts.obstacles && !phase_two.stopped())
+    phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
   phase_two.finish();
   const auto loop_end = Clock::now();
   counters.test_seconds = std::max(
       0.0, std::chrono::duration<double>(loop_end - loop_start).count() - counters.shard_seconds);
   if (!result.collides) parts.containment.check(box, parts.object, region.pins(), result, loop_end);
+  parts.containment.check_dynamic(box, parts.object, parts.obstacle, solid_query, result);
+}
+
+geometry::Box FlyingObject::shapes_box(const geometry::Box& box) const {
+  // The pruning shapes' margins scale with the coordinates they meet: the mesh's, and with
+  // dynamic obstacles (which may stand outside it) the step's box's too.
+  geometry::Box covered = index_->mesh_bounds();
+  if (parts_->obstacles) covered.extend(box);
+  return covered;
+}
+
+void FlyingObject::test_obstacles_alone(const geometry::Box& box, const QueryOptions& options,
+                                        bool own_frame, bool solid_query, double reach,
+                                        QueryResult& result) {
+  Parts& parts = *parts_;
+  if (!parts.obstacles || parts.obstacles->size() == 0) return;
+  parts.shapes.prepare(*model_, parts.object, box, reach, own_frame, solid_query, shapes_box(box));
+  PhaseTwo phase_two(*index_, *model_, parts.object, parts.shapes, parts.solid, parts.coherence,
+                     parts.containment, parts.met_triangles, options, solid_query, box, result);
+  phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
+  phase_two.finish();
+  parts.containment.check_dynamic(box, parts.object, parts.obstacle, solid_query, result);
+}
+
+void FlyingObject::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacles) {
+  if (obstacles && obstacles->index() != index_)
+    throw InputError("dynamic obstacles on another index (" + obstacles->index()->path().string() +
+                     ") than the flying object's (" + index_->path().string() + ")");
+  parts_->obstacles = std::move(obstacles);
+  parts_->coherence.obstacles_changed(nullptr, true);  // the free box did not know them
+  parts_->obstacles_version = parts_->obstacles ? parts_->obstacles->version() : 0;
+  parts_->obstacles_shows = parts_->obstacles ? parts_->obstacles->shows() : 0;
+}
+
+geometry::ContactGeometry FlyingObject::dynamic_contact_geometry(const Contact& contact) {
+  const DynamicObstacles::Part* part =
+      parts_->obstacles ? parts_->obstacles->find(contact.dynamic_part) : nullptr;
+  if (part == nullptr)
+    throw InputError("contact geometry: no dynamic part " + std::to_string(contact.dynamic_part));
+  if (contact.environment_triangle >= part->model->mesh.triangles.size() ||
+      contact.object_triangle >= model_->mesh.triangles.size())
+    throw InputError("contact geometry: dynamic part " + std::to_string(contact.dynamic_part) +
+                     " has no triangle " + std::to_string(contact.environment_triangle) +
+                     " or the object no triangle " + std::to_string(contact.object_triangle));
+  PlacedObject placed(*part->model);
+  placed.place(part->pose);
+  return geometry::contact_geometry(
+      placed.world_triangle(std::uint32_t(contact.environment_triangle)),
+      parts_->object.world_triangle(contact.object_triangle));
+}
+
+const std::shared_ptr<const DynamicObstacles>& FlyingObject::obstacles() const {
+  return parts_->obstacles;
 }
 
 }  // namespace tetrapage

@@ -17,7 +17,7 @@ namespace tetrapage {
 
 struct FlyingObject::Parts {
   Parts(const CollisionIndex& index, const ObjectModel& model)
-      : object(model), region(index), containment(index, model), distance(index) {}
+      : object(model), region(index), containment(index, model), distance(index), obstacle(model) {}
   PlacedObject object;           ///< step 1: the pose, the placed vertices, the world box
   SearchedRegion region;         ///< steps 2 to 4: the walk, the box search, the shards' pins
   Coherence coherence;           ///< the previous pose and box, and the free box
@@ -27,6 +27,11 @@ struct FlyingObject::Parts {
   TriangleIdSet met_triangles;   ///< the triangles phase I has met this step
   DistanceSearch distance;       ///< the closest pair, and the last one (coherence)
   QueryResult touch;             ///< scratch: the collision step of a distance query
+  std::shared_ptr<const DynamicObstacles> obstacles;  ///< merged into every query, or null
+  std::uint64_t obstacles_version = 0;
+  std::uint64_t obstacles_shows = 0;  ///< the overlay's shows() then
+  PlacedObject obstacle;  ///< scratch: a dynamic obstacle placed (rebound to each in turn)  ///<
+                          ///< the overlay's version the free box was found with
 };
 
 }  // namespace tetrapage

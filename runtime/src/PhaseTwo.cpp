@@ -36,19 +36,25 @@ PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, Placed
   met_triangles_.clear();
 }
 
-void PhaseTwo::add_contact(const Shard& shard, std::uint32_t local, std::uint32_t object_triangle) {
+void PhaseTwo::add_contact(const Source& source, std::uint32_t object_triangle) {
   result_.collides = true;
   if (all_ || result_.contacts.empty()) {
-    const std::uint32_t component = shard.component_id(local);
-    result_.contacts.push_back(
-        {index_.component_part(component), shard.triangle_id(local), object_triangle, component});
+    if (source.part != kNoDynamicPart) {
+      result_.contacts.push_back(
+          {Contact::kDynamicPart, source.local, object_triangle, 0, source.part});
+    } else {
+      const std::uint32_t component = source.shard->component_id(source.local);
+      result_.contacts.push_back({index_.component_part(component),
+                                  source.shard->triangle_id(source.local), object_triangle,
+                                  component, kNoDynamicPart});
+    }
   }
   if (!all_) stop_ = true;
 }
 
-void PhaseTwo::test_mesh(const Shard& shard, std::uint32_t local,
-                         const geometry::Triangle& environment, const std::array<Vec3, 3>& framed,
-                         const geometry::Box& query, double grow) {
+void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environment,
+                         const std::array<Vec3, 3>& framed, const geometry::Box& query,
+                         double grow) {
   // Object triangles that can meet the environment triangle lie within `grow` of its
   // plane, in the object's frame (its corners taken there round by less than `grow`).
   const Vec3& p0 = framed[0];
@@ -74,13 +80,12 @@ void PhaseTwo::test_mesh(const Shard& shard, std::uint32_t local,
     if (!geometry::triangles_collide(environment, object_.world_triangle(object_triangle),
                                      options_.accuracy))
       return true;
-    add_contact(shard, local, object_triangle);
+    add_contact(source, object_triangle);
     return all_;
   });
 }
 
-void PhaseTwo::test_candidate(const Shard& shard, std::uint32_t local,
-                              const geometry::Triangle& environment) {
+void PhaseTwo::test_candidate(const Source& source, const geometry::Triangle& environment) {
   // The environment triangle in the object's frame (rounded: it only prunes).
   const std::array<Vec3, 3> framed{object_.to_object_frame(environment[0]),
                                    object_.to_object_frame(environment[1]),
@@ -106,11 +111,12 @@ void PhaseTwo::test_candidate(const Shard& shard, std::uint32_t local,
     if (!solid_.built) solid_.build(options_, model_, object_, coherence_);
     ++counters_.triangle_tests;
     if (solid_.collides(environment, options_.accuracy, shapes_.reach()))
-      add_contact(shard, local, Contact::kNoObjectTriangle);
+      add_contact(source, Contact::kNoObjectTriangle);
     return;
   }
-  note_if_enclosed(shard, local, environment);
-  test_mesh(shard, local, environment, framed, query, grow);
+  // (A dynamic part inside the object is found by ContainmentCheck::check_dynamic.)
+  if (source.shard != nullptr) note_if_enclosed(*source.shard, source.local, environment);
+  test_mesh(source, environment, framed, query, grow);
 }
 
 void PhaseTwo::note_if_enclosed(const Shard& shard, std::uint32_t local,
@@ -125,7 +131,10 @@ void PhaseTwo::note_if_enclosed(const Shard& shard, std::uint32_t local,
     containment_.note_enclosed(component, environment[0]);
 }
 
-void PhaseTwo::test_shard(const Shard& shard) {
+void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
+  // Hidden parts are skipped before anything else: not a candidate, no contact, no
+  // containment (the step answers as if the index did not hold them).
+  const DynamicObstacles* mask = overlay != nullptr && overlay->hides_any() ? overlay : nullptr;
   const bool same_copies =
       index_.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
   // The leaf the visited triangles come from (each leaf's triangles follow its test) lies
@@ -133,6 +142,7 @@ void PhaseTwo::test_shard(const Shard& shard) {
   bool in_leaf_inside_object = false;
   auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
     if (stop_) return;  // the shard query cannot be cut short; skip the rest
+    if (mask != nullptr && mask->hidden(index_.component_part(shard.component_id(local)))) return;
     if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
       ++counters_.repeats;
       return;
@@ -141,7 +151,7 @@ void PhaseTwo::test_shard(const Shard& shard) {
       note_if_enclosed(shard, local, environment);
       return;
     }
-    test_candidate(shard, local, environment);
+    test_candidate(Source{&shard, local, kNoDynamicPart}, environment);
   };
   // An R-tree leaf's box holds its triangles: a leaf that reaches only the object's inside
   // holds no triangle near its surface (a grid cell's triangles reach beyond the cell).
@@ -158,11 +168,36 @@ void PhaseTwo::test_shard(const Shard& shard) {
     shard.for_each_box_candidate(box_, meets_own_box, visit);
 }
 
+void PhaseTwo::test_dynamic_parts(const DynamicObstacles& overlay, PlacedObject& placed) {
+  overlay.for_each_in_box(box_, [&](const DynamicObstacles::Part& part) {
+    placed.rebind(*part.model);
+    placed.place(part.pose);
+    // The step's box in the part's frame: its corners taken there (rounded, so grown far
+    // beyond the rounding: it only prunes; each triangle is decided on world coordinates).
+    geometry::Box query;
+    double margin = 0;
+    for (int c = 0; c < 8; ++c) {
+      const geometry::Point corner{c & 1 ? box_.hi[0] : box_.lo[0], c & 2 ? box_.hi[1] : box_.lo[1],
+                                   c & 4 ? box_.hi[2] : box_.lo[2]};
+      query.extend(placed.to_object_frame(corner));
+      margin = std::max(margin, placed.frame_margin(corner));
+    }
+    query = geometry::inflated(query, margin);
+    part.model->bvh.for_each_in_box(query, [&](std::uint32_t triangle) {
+      test_candidate(Source{nullptr, triangle, part.id}, placed.world_triangle(triangle));
+      return !stop_;
+    });
+    return !stop_;
+  });
+}
+
 void PhaseTwo::finish() {
   if (!all_ || result_.contacts.size() <= 1) return;
   // A triangle that crosses regions is stored in each of their shards, and float copies are
   // each tested (above): report a pair once.
-  auto key = [](const Contact& c) { return std::tie(c.environment_triangle, c.object_triangle); };
+  auto key = [](const Contact& c) {
+    return std::tie(c.dynamic_part, c.environment_triangle, c.object_triangle);
+  };
   std::sort(result_.contacts.begin(), result_.contacts.end(),
             [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
   result_.contacts.erase(std::unique(result_.contacts.begin(), result_.contacts.end()),

@@ -12,6 +12,7 @@
 #include "PlacedObject.h"
 #include "PruningShapes.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/Shard.h"
@@ -28,18 +29,28 @@ class PhaseTwo {
            ContainmentCheck& containment, TriangleIdSet& met_triangles, const QueryOptions& options,
            bool solid_query, const geometry::Box& box, QueryResult& result);
 
-  void test_shard(const Shard& shard);
+  /// The shard's candidates, but for those of the parts `overlay` hides (when given).
+  void test_shard(const Shard& shard, const DynamicObstacles* overlay = nullptr);
+  /// The dynamic parts whose boxes meet the step's box: each part triangle near the box (its
+  /// BVH, the box taken into its frame) through the same phase II as a shard's candidate.
+  /// `placed`: scratch, rebound to each part.
+  void test_dynamic_parts(const DynamicObstacles& overlay, PlacedObject& placed);
   /// first_hit found its contact: the other shards need not be tested.
   bool stopped() const { return stop_; }
   /// With all contacts, each pair once.
   void finish();
 
  private:
-  void test_candidate(const Shard& shard, std::uint32_t local,
-                      const geometry::Triangle& environment);
-  void test_mesh(const Shard& shard, std::uint32_t local, const geometry::Triangle& environment,
+  // Where a candidate comes from: a shard's local triangle, or a dynamic part's triangle.
+  struct Source {
+    const Shard* shard = nullptr;
+    std::uint32_t local = 0;  ///< the shard's local triangle, or the dynamic part's triangle
+    DynamicPartId part = kNoDynamicPart;
+  };
+  void test_candidate(const Source& source, const geometry::Triangle& environment);
+  void test_mesh(const Source& source, const geometry::Triangle& environment,
                  const std::array<Vec3, 3>& framed, const geometry::Box& query, double grow);
-  void add_contact(const Shard& shard, std::uint32_t local, std::uint32_t object_triangle);
+  void add_contact(const Source& source, std::uint32_t object_triangle);
   void note_if_enclosed(const Shard& shard, std::uint32_t local,
                         const geometry::Triangle& environment);
 

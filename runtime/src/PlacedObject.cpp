@@ -11,6 +11,16 @@ PlacedObject::PlacedObject(const ObjectModel& model)
       world_(model.mesh.vertices.size()),
       world_step_(model.mesh.vertices.size(), ~std::uint64_t{0}) {}
 
+void PlacedObject::rebind(const ObjectModel& model) {
+  model_ = &model;
+  // Entries keep steps older than the next place()'s: stale for the new model too.
+  if (world_.size() < model.mesh.vertices.size()) {
+    world_.resize(model.mesh.vertices.size());
+    world_step_.resize(model.mesh.vertices.size(), ~std::uint64_t{0});
+  }
+  extreme_ = {};
+}
+
 void PlacedObject::place(const Pose& pose) {
   const double n = pose.rotation[0] * pose.rotation[0] + pose.rotation[1] * pose.rotation[1] +
                    pose.rotation[2] * pose.rotation[2] + pose.rotation[3] * pose.rotation[3];

@@ -19,6 +19,9 @@ namespace tetrapage {
 class PlacedObject {
  public:
   explicit PlacedObject(const ObjectModel& model);
+  /// Another model (a scratch placement reused for many, e.g. the dynamic obstacles a step
+  /// meets: no allocation once the largest was seen). Call place() before anything else.
+  void rebind(const ObjectModel& model);
 
   /// Takes `pose` as the current placement (a new step: earlier world vertices are stale).
   /// @throw InputError for a non-finite or non-unit pose, or a translation beyond

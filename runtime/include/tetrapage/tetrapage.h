@@ -422,6 +422,74 @@ tetrapage_status tetrapage_group_pair_triangles(const tetrapage_group* group, si
 tetrapage_status tetrapage_group_environment(const tetrapage_group* group, int* collides, size_t capacity,
                                              size_t* written);
 
+/* ---- Dynamic obstacles (DynamicObstacles.h) ----
+   An overlay of parts inserted, moved and removed at run time on one index, and of index parts
+   hidden from the answers. An object given the overlay (tetrapage_object_set_obstacles)
+   answers as if the index held its visible parts plus the dynamic parts: a contact with a
+   dynamic part has environment_part 0xFFFFFFFE, environment_triangle the triangle's index in
+   that part's mesh, and its id in tetrapage_get_contact_dynamic_parts. Changes from one
+   thread, between the steps of the objects that hold the overlay. A pose is 7 doubles (tx, ty,
+   tz, qw, qx, qy, qz) as in tetrapage_query. */
+typedef struct tetrapage_obstacles tetrapage_obstacles;
+
+/* An empty overlay on `index`.
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_obstacles_create(tetrapage_index* index,
+                                            tetrapage_obstacles** obstacles);
+
+/* Releases the overlay's handle (objects that hold it keep it until detached). A null one is
+   ignored. Errors: TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_obstacles_destroy(tetrapage_obstacles* obstacles);
+
+/* A new dynamic part: its mesh as in tetrapage_object_create, at `pose`, named `name` (may be
+   null). Its id (never 0, never reused) goes to *id.
+   Errors: TETRAPAGE_ERROR_INPUT (a mesh the object constructor rejects, a bad pose),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_obstacles_insert(tetrapage_obstacles* obstacles, const double* vertices,
+                                            size_t vertex_count, const uint32_t* triangles,
+                                            size_t triangle_count, const double pose[7],
+                                            const char* name, uint32_t* id);
+
+/* Moves or removes dynamic part `id`.
+   Errors: TETRAPAGE_ERROR_INPUT (an unknown id, a bad pose), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_obstacles_move(tetrapage_obstacles* obstacles, uint32_t id,
+                                          const double pose[7]);
+tetrapage_status tetrapage_obstacles_remove(tetrapage_obstacles* obstacles, uint32_t id);
+
+/* Hides part `part` of the index (hidden non-zero) or shows it again (0).
+   Errors: TETRAPAGE_ERROR_INPUT (a part the index does not list), TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_obstacles_hide_part(tetrapage_obstacles* obstacles, uint32_t part,
+                                               int hidden);
+
+/* Merges the overlay into every later query of `object` (null obstacles: none again).
+   Errors: TETRAPAGE_ERROR_INPUT (an overlay on another index), TETRAPAGE_ERROR_INVALID_ARGUMENT,
+           TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
+                                                tetrapage_obstacles* obstacles);
+
+/* The same for every object of a group (their environment queries; null: none).
+   Errors: TETRAPAGE_ERROR_INPUT (an overlay on another index), TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group,
+                                               tetrapage_obstacles* obstacles);
+
+/* Per contact of the last query (as tetrapage_get_contacts), its dynamic part's id or 0 for a
+   part of the index: the first min(capacity, count), their number to *written.
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object,
+                                                     uint32_t* parts, size_t capacity,
+                                                     size_t* written);
+
+/* Writes the overlay to `path`; reads one back on `index` (same ids, names, poses, meshes and
+   hidden parts).
+   Errors: TETRAPAGE_ERROR_IO (cannot write), TETRAPAGE_ERROR_FORMAT (a missing, truncated or
+           malformed file, or one that does not fit the index; the message names the file),
+           TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+tetrapage_status tetrapage_obstacles_save(const tetrapage_obstacles* obstacles, const char* path);
+tetrapage_status tetrapage_obstacles_load(tetrapage_index* index, const char* path,
+                                          tetrapage_obstacles** obstacles);
+
 #ifdef __cplusplus
 }
 #endif

@@ -25,6 +25,7 @@
 #include "tetrapage/runtime/BoxSearch.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/DistanceQuery.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/ImpactQuery.h"
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/ObstacleInterior.h"
@@ -74,13 +75,18 @@ struct QueryOptions {
 
 /// One contact: an environment triangle (its part, connected component and model-wide id) and
 /// an object triangle (kNoObjectTriangle when the object was checked as a solid: hull, box, or
-/// swept).
+/// swept). A contact with a dynamic obstacle (DynamicObstacles.h) has dynamic_part set to the
+/// part's id, environment_triangle the triangle's index in that part's mesh, environment_part
+/// kDynamicPart and environment_component 0; a contact with the index has dynamic_part 0.
 struct Contact {
   static constexpr std::uint32_t kNoObjectTriangle = 0xffffffffu;
+  /// environment_part of a contact with a dynamic obstacle (no part of the index).
+  static constexpr std::uint32_t kDynamicPart = 0xfffffffeu;
   std::uint32_t environment_part = 0;
   std::uint64_t environment_triangle = 0;
   std::uint32_t object_triangle = 0;
   std::uint32_t environment_component = 0;
+  std::uint32_t dynamic_part = 0;  ///< the dynamic obstacle's id, or 0 (kNoDynamicPart)
   bool operator==(const Contact&) const = default;
 };
 
@@ -135,6 +141,9 @@ struct QueryResult {
   Containment containment = Containment::none;
   std::uint32_t containing_part = 0;       ///< the environment part of a containment
   std::uint32_t containing_component = 0;  ///< the environment component of a containment
+  /// A dynamic obstacle's id when it holds the object or the object holds it (then
+  /// containing_part is Contact::kDynamicPart and containing_component 0); else 0.
+  std::uint32_t containing_dynamic_part = 0;
   /// first_hit: the first contact found; all_contacts: every pair (unordered).
   std::vector<Contact> contacts;
   /// The object's box lies entirely outside the model's coarse mesh (nothing to touch).
@@ -197,6 +206,14 @@ class FlyingObject {
   /// @throw InputError for a tolerance not in (0, 1], and what query() throws.
   ImpactResult time_of_impact(const Pose& from, const Pose& to, const ImpactOptions& options = {});
 
+  /// Dynamic obstacles merged into every later query (and the index's parts they hide masked
+  /// from it), or none (null). The overlay must be on this object's index; it may change
+  /// between steps (DynamicObstacles.h: its threading rule), never during one. The distance
+  /// query decides touching with them, but measures distance to the index's parts only.
+  /// @throw InputError for an overlay on another index.
+  void set_obstacles(std::shared_ptr<const DynamicObstacles> obstacles);
+  const std::shared_ptr<const DynamicObstacles>& obstacles() const;
+
   /// The world box of the object at `pose` (hill-climbing on the hull), slightly enlarged to
   /// cover the rounding of the placement.
   geometry::Box world_box(const Pose& pose);
@@ -219,6 +236,13 @@ class FlyingObject {
   // Phases I and II over the region's shards that the step needs, then containment.
   void test_region(const geometry::Box& box, const QueryOptions& options, bool solid_query,
                    std::chrono::steady_clock::time_point loop_start, QueryResult& result);
+  // contact_geometry of a contact with a dynamic obstacle (at the overlay's current pose).
+  geometry::ContactGeometry dynamic_contact_geometry(const Contact& contact);
+  // A step whose box met no tet of the mesh: the dynamic obstacles alone.
+  void test_obstacles_alone(const geometry::Box& box, const QueryOptions& options, bool own_frame,
+                            bool solid_query, double reach, QueryResult& result);
+  // The box whose coordinates bound what the pruning shapes meet (their margins).
+  geometry::Box shapes_box(const geometry::Box& box) const;
 
   std::shared_ptr<const CollisionIndex> index_;
   std::shared_ptr<const ObjectModel> model_;

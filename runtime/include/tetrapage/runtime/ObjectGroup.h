@@ -109,6 +109,11 @@ class ObjectGroup {
   const std::shared_ptr<const ObjectModel>& model(std::size_t object) const;
   const std::shared_ptr<const CollisionIndex>& index() const { return index_; }
 
+  /// Dynamic obstacles merged into every object's environment query (FlyingObject::
+  /// set_obstacles); null: none. Object/object pairs are not affected.
+  /// @throw InputError for an overlay on another index, or a group without an index.
+  void set_obstacles(std::shared_ptr<const DynamicObstacles> obstacles);
+
   /// One step: object i at poses[i]. Reuses `result`'s buffers.
   /// @throw InputError for a pose count other than size(), or as FlyingObject::query for a bad
   ///        pose (naming the object); what the environment queries throw.
