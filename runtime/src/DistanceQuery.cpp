@@ -24,6 +24,7 @@ void report_touching(const QueryResult& touch, DistanceResult& result) {
   result.environment_triangle = contact.environment_triangle;
   result.environment_part = contact.environment_part;
   result.object_triangle = contact.object_triangle;
+  result.dynamic_part = contact.dynamic_part;
 }
 
 }  // namespace
@@ -68,7 +69,7 @@ void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,
     result.from_free_box = true;
     return;
   }
-  parts.distance.measure(*model_, parts.object, box, options.max_distance, result);
+  parts.distance.measure(*model_, parts.object, box, options.max_distance, parts.obstacles.get(), result);
 }
 
 }  // namespace tetrapage

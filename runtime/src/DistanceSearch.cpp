@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/Shard.h"
 
 namespace tetrapage {
@@ -19,7 +20,12 @@ bool beyond(double lower_bound, double reach) { return lower_bound * (1 - 0x1p-4
 
 void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
                              const geometry::Box& world_box, double max_distance,
-                             DistanceResult& result) {
+                             const DynamicObstacles* obstacles, DistanceResult& result) {
+  // A changed overlay may have moved or hidden the last pair's triangle.
+  const std::uint64_t version = obstacles ? obstacles->version() : 0;
+  if (obstacles != obstacles_ || version != obstacles_version_) has_last_ = false;
+  obstacles_ = obstacles;
+  obstacles_version_ = version;
   model_ = &model;
   object_ = &object;
   world_box_ = world_box;
@@ -40,7 +46,8 @@ void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
     ++result.pair_tests;
     const Pair last = last_;
     offer(geometry::triangle_distance(last.environment, object.world_triangle(last.object_triangle)),
-          last.environment, last.environment_triangle, last.environment_part, last.object_triangle);
+          last.environment, last.environment_triangle, last.environment_part, last.object_triangle,
+          last.dynamic_part);
   }
   // Without a bound yet, a radius grown until it holds some triangle; then the triangles
   // within the best distance found.
@@ -53,6 +60,7 @@ void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
     if (reach_ <= radius || geometry::box_contains(search_box, index_->mesh_bounds())) break;
     radius = found_ ? reach_ : 2 * radius;
   }
+  if (obstacles) measure_dynamic_parts(*obstacles);
   report(max_distance);
 }
 
@@ -76,6 +84,7 @@ void DistanceSearch::report(double max_distance) {
   result.environment_triangle = best_.environment_triangle;
   result.environment_part = best_.environment_part;
   result.object_triangle = best_.object_triangle;
+  result.dynamic_part = best_.dynamic_part;
   has_last_ = true;
   last_ = best_;
 }
@@ -122,7 +131,7 @@ void DistanceSearch::measure_pending() {
   for (const Pending& candidate : pending_) {
     if (beyond(candidate.lower_bound, reach_)) break;
     if (geometry::triangle_outside_ball(candidate.environment, ball_centre_, ball_radius_ + reach_)) continue;
-    measure_triangle(candidate.environment, candidate.id, candidate.part);
+    measure_triangle(candidate.environment, candidate.id, candidate.part, 0);
   }
   pending_.clear();
 }
@@ -137,15 +146,41 @@ void DistanceSearch::collect_shard(const Shard& shard, const geometry::Box& sear
   auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
     const std::uint64_t id = shard.triangle_id(local);
     if (same_copies && !met_.insert(id)) return;
+    const std::uint32_t part = index_->component_part(shard.component_id(local));
+    if (obstacles_ && obstacles_->hidden(part)) return;
     const double lower_bound = lower_bound_to(geometry::box_of(environment));
     if (beyond(lower_bound, reach_)) return;
-    pending_.push_back({lower_bound, environment, id, index_->component_part(shard.component_id(local))});
+    pending_.push_back({lower_bound, environment, id, part});
   };
   shard.for_each_box_candidate(search_box, near, visit);
 }
 
+void DistanceSearch::measure_dynamic_parts(const DynamicObstacles& obstacles) {
+  auto measure_part = [&](const DynamicObstacles::Part& part) {
+    if (beyond(lower_bound_to(part.world_box), reach_)) return true;
+    const TriangleSoup& mesh = part.model->mesh;
+    const auto rotation = rotation_matrix(part.pose.rotation);
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      geometry::Triangle placed;
+      for (int c = 0; c < 3; ++c)
+        placed[c] = apply_pose(rotation, part.pose.translation, mesh.vertices[mesh.triangles[t][c]]);
+      if (beyond(lower_bound_to(geometry::box_of(placed)), reach_) ||
+          geometry::triangle_outside_ball(placed, ball_centre_, ball_radius_ + reach_))
+        continue;
+      measure_triangle(placed, t, Contact::kDynamicPart, part.id);
+    }
+    return true;
+  };
+  // Without a bound yet (nothing in the index), every part; else those within reach.
+  if (!std::isfinite(reach_)) {
+    for (const DynamicObstacles::Part& part : obstacles.parts()) measure_part(part);
+    return;
+  }
+  obstacles.for_each_in_box(geometry::inflated(world_box_, reach_), measure_part);
+}
+
 void DistanceSearch::measure_triangle(const geometry::Triangle& environment, std::uint64_t id,
-                                      std::uint32_t part) {
+                                      std::uint32_t part, std::uint32_t dynamic_part) {
   ++result_->candidates;
   // The triangle in the object's frame, its box grown far beyond the frame change's rounding:
   // the BVH prunes by distances there, and every pair is measured on world coordinates.
@@ -179,21 +214,23 @@ void DistanceSearch::measure_triangle(const geometry::Triangle& environment, std
         const geometry::Triangle placed = object_->world_triangle(object_triangle);
         if (geometry::farther_than_cheaply(environment, placed, reach_, axis_)) return true;
         ++result_->pair_tests;
-        offer(geometry::triangle_distance(environment, placed), environment, id, part, object_triangle);
+        offer(geometry::triangle_distance(environment, placed), environment, id, part, object_triangle,
+              dynamic_part);
         return true;
       });
 }
 
 void DistanceSearch::offer(const geometry::TriangleDistance& distance,
                            const geometry::Triangle& environment, std::uint64_t id,
-                           std::uint32_t part, std::uint32_t object_triangle) {
+                           std::uint32_t part, std::uint32_t object_triangle,
+                           std::uint32_t dynamic_part) {
   lowest_bound_ = std::min(lowest_bound_, distance.lower_bound);
   lowest_upper_ = std::min(lowest_upper_, distance.upper_bound);
   // No pair farther than a pair's upper bound can be the closest.
   reach_ = std::min(reach_, distance.upper_bound);
   if (found_ && distance.distance >= best_.distance.distance) return;
   found_ = true;
-  best_ = {distance, environment, id, part, object_triangle};
+  best_ = {distance, environment, id, part, object_triangle, dynamic_part};
   for (int a = 0; a < 3; ++a) axis_[a] = distance.on_second[a] - distance.on_first[a];
 }
 

@@ -12,6 +12,7 @@
 #include "SearchedRegion.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/DistanceQuery.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/TriangleIdSet.h"
 #include "tetrapage/runtime/geometry/TriangleDistance.h"
@@ -24,8 +25,9 @@ class DistanceSearch {
 
   /// The distance from the object placed in `object` (world box `world_box`), known to touch
   /// nothing, to the environment, within `max_distance`: fills `result` (apart or farther).
+  /// Dynamic obstacles (null: none) count too, and their hidden parts do not.
   void measure(const ObjectModel& model, PlacedObject& object, const geometry::Box& world_box,
-               double max_distance, DistanceResult& result);
+               double max_distance, const DynamicObstacles* obstacles, DistanceResult& result);
   /// The closest pair is unknown (the object touched something, or the index changed hands).
   void forget_last_pair() { has_last_ = false; }
 
@@ -36,6 +38,7 @@ class DistanceSearch {
     std::uint64_t environment_triangle = 0;
     std::uint32_t environment_part = 0;
     std::uint32_t object_triangle = 0;
+    std::uint32_t dynamic_part = 0;  ///< the dynamic obstacle's id, or 0 for the index's
   };
   // The triangles that meet `search_box` (the world box grown by the search's radius), from
   // the searched region's shards or, for a box centred beyond the coarse mesh, from every
@@ -45,9 +48,12 @@ class DistanceSearch {
   void report(double max_distance);
   // The environment triangle against the object's BVH, nearest first.
   void measure_triangle(const geometry::Triangle& environment, std::uint64_t id,
-                        std::uint32_t part);
+                        std::uint32_t part, std::uint32_t dynamic_part);
   void offer(const geometry::TriangleDistance& distance, const geometry::Triangle& environment,
-             std::uint64_t id, std::uint32_t part, std::uint32_t object_triangle);
+             std::uint64_t id, std::uint32_t part, std::uint32_t object_triangle,
+             std::uint32_t dynamic_part);
+  // The dynamic obstacles' triangles within reach, after the index's.
+  void measure_dynamic_parts(const DynamicObstacles& obstacles);
   // Collects the shard's triangles that may lie within reach into pending_.
   void collect_shard(const Shard& shard, const geometry::Box& search_box);
   // Measures pending_ nearest first, until the next lies beyond the reach.
@@ -64,6 +70,8 @@ class DistanceSearch {
     std::uint64_t id;
     std::uint32_t part;
   };
+  const DynamicObstacles* obstacles_ = nullptr;
+  std::uint64_t obstacles_version_ = 0;  ///< the overlay's version of the last pair
   std::vector<Pending> pending_;  ///< the candidates of a search, measured nearest first
   geometry::Point ball_centre_{};  ///< the object's bounding ball, placed
   double ball_radius_ = 0;         ///< with the placement's rounding

@@ -8,9 +8,14 @@
 // answers; damaged files fail with a FormatError naming the file; the C API answers as C++.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/intersections.h>
+
+#include <limits>
 
 #include <algorithm>
 #include <filesystem>
@@ -78,12 +83,20 @@ struct Scene {
   TriangleSoup soup;  ///< as read back: part k is the index's part k
   std::shared_ptr<const CollisionIndex> index;
   fs::path folder;
+  Scene() = default;
+  Scene(Scene&& other) noexcept
+      : soup(std::move(other.soup)), index(std::move(other.index)), folder(std::exchange(other.folder, {})) {}
+  ~Scene() {
+    std::error_code ignored;
+    if (!folder.empty()) fs::remove_all(folder, ignored);
+  }
 };
 
 const Scene& scene() {
   static const Scene built = [] {
     Scene s;
-    s.folder = fs::path(TETRAPAGE_TEST_TMP) / "dynamic";
+    // One folder per process: ctest runs each test in its own, two at a time.
+    s.folder = fs::path(TETRAPAGE_TEST_TMP) / ("dynamic-" + std::to_string(::getpid()));
     fs::remove_all(s.folder);
     fs::create_directories(s.folder);
     const fs::path ply = s.folder / "scene.ply";
@@ -283,6 +296,81 @@ TEST(DynamicObstacles, AnswersEqualTheReferenceThroughInsertMoveRemoveHideShow) 
   EXPECT_EQ(ids.back(), 9u);
   EXPECT_THROW(overlay->move(ids[4], Pose{}), InputError);
   EXPECT_THROW(overlay->hide_part(7), InputError);
+}
+
+// The distance query sees the dynamic parts and not the hidden ones: against CGAL's distance
+// over every triangle pair of the visible world (reference_world), on a coherent flight
+// through inserts, moves and hides.
+TEST(DynamicObstacles, DistancesAreTheVisibleWorldsExactDistance) {
+  using Exact = CGAL::Exact_predicates_exact_constructions_kernel;
+  auto overlay = std::make_shared<DynamicObstacles>(scene().index);
+  const TriangleSoup object = shape(116, 0.06, 7);
+  FlyingObject flying(scene().index, object);
+  flying.set_obstacles(overlay);
+  Random random(29);
+  const auto exact = [](const std::array<Vec3, 3>& t) {
+    return Exact::Triangle_3({t[0][0], t[0][1], t[0][2]}, {t[1][0], t[1][1], t[1][2]}, {t[2][0], t[2][1], t[2][2]});
+  };
+  int apart = 0, on_dynamic = 0;
+  std::vector<DynamicPartId> ids;
+  for (int round = 0; round < 4; ++round) {
+    if (round == 1)
+      for (int k = 0; k < 4; ++k) ids.push_back(overlay->insert(part_model(116, 0.15, 40 + k), random_pose(random, 0.15, 0.85)));
+    if (round == 2) overlay->hide_part(0), overlay->hide_part(4), overlay->move(ids[0], random_pose(random, 0.15, 0.85));
+    if (round == 3) overlay->remove(ids[1]), overlay->show_part(0);
+    const TriangleSoup world = reference_world(*overlay);
+    std::vector<Exact::Triangle_3> environment;
+    for (std::size_t t = 0; t < world.triangle_count(); ++t) environment.push_back(exact(world.corners(t)));
+    // Beside the first dynamic part once there is one (its closest triangles are then often
+    // the part's), else anywhere.
+    Pose start = random_pose(random, 0.1, 0.9);
+    if (!ids.empty()) {
+      start.translation = overlay->find(ids[0])->pose.translation;
+      start.translation[1] += 0.13;
+    }
+    for (int i = 0; i < 6; ++i) {
+      Pose pose = start;
+      pose.translation[0] += 0.01 * i;
+      const DistanceResult got = flying.distance(pose);
+      if (got.separation != Separation::apart) continue;
+      ++apart;
+      on_dynamic += got.dynamic_part != 0;
+      // CGAL's double kernel picks the pairs near the least distance (its error is far below the
+      // 1 % margin); the exact kernel measures those.
+      std::vector<std::array<Vec3, 3>> placed(object.triangle_count());
+      std::vector<double> inexact(environment.size() * placed.size());
+      double least_inexact = std::numeric_limits<double>::infinity();
+      for (std::size_t o = 0; o < placed.size(); ++o) {
+        placed[o] = object.corners(o);
+        for (Vec3& v : placed[o]) v = apply_pose(pose, v);
+        const auto& q = placed[o];
+        const K::Triangle_3 moved({q[0][0], q[0][1], q[0][2]}, {q[1][0], q[1][1], q[1][2]}, {q[2][0], q[2][1], q[2][2]});
+        for (std::size_t e = 0; e < environment.size(); ++e) {
+          const auto& w = world.corners(e);
+          const K::Triangle_3 fixed({w[0][0], w[0][1], w[0][2]}, {w[1][0], w[1][1], w[1][2]}, {w[2][0], w[2][1], w[2][2]});
+          inexact[o * environment.size() + e] = CGAL::squared_distance(fixed, moved);
+          least_inexact = std::min(least_inexact, inexact[o * environment.size() + e]);
+        }
+      }
+      Exact::FT least = -1;
+      for (std::size_t o = 0; o < placed.size(); ++o)
+        for (std::size_t e = 0; e < environment.size(); ++e)
+          if (inexact[o * environment.size() + e] <= 1.01 * least_inexact) {
+            const Exact::FT d = CGAL::squared_distance(environment[e], exact(placed[o]));
+            if (least < 0 || d < least) least = d;
+          }
+      EXPECT_LE(Exact::FT(got.lower_bound) * Exact::FT(got.lower_bound), least) << "round " << round << " pose " << i;
+      EXPECT_GE(Exact::FT(got.upper_bound) * Exact::FT(got.upper_bound), least) << "round " << round << " pose " << i;
+      if (got.dynamic_part != 0) {
+        EXPECT_EQ(got.environment_part, Contact::kDynamicPart);
+        EXPECT_NE(overlay->find(got.dynamic_part), nullptr);
+      } else {
+        EXPECT_FALSE(overlay->hidden(got.environment_part));
+      }
+    }
+  }
+  EXPECT_GT(apart, 10);
+  EXPECT_GT(on_dynamic, 0);  // some closest pairs lie on the dynamic parts
 }
 
 TEST(DynamicObstacles, ContainmentBothWaysAndHiddenSolids) {

@@ -52,6 +52,10 @@ struct DistanceResult {
   std::uint64_t environment_triangle = kNoTriangle;
   std::uint32_t environment_part = 0;
   std::uint32_t object_triangle = 0;
+  /// The closest triangle belongs to a dynamic obstacle (DynamicObstacles.h) with this id:
+  /// environment_part is then Contact::kDynamicPart and environment_triangle the triangle's
+  /// index in that part's mesh; 0 for the index's triangles.
+  std::uint32_t dynamic_part = 0;
   /// Touching without contact: which body holds the other (its part in containing_part).
   Containment containment{};
   std::uint32_t containing_part = 0;
