@@ -81,7 +81,7 @@ class Coherence {
   /// misses the free box can neither touch nor hold an object inside it.
   void obstacles_changed(const DynamicObstacles* overlay, bool shown) {
     bool meets = shown || overlay == nullptr;
-    if (free_box_valid_ && !meets)
+    if (free_box_valid_ && !meets && overlay != nullptr)
       overlay->for_each_in_box(free_box_, [&](const DynamicObstacles::Part&) {
         meets = true;
         return false;

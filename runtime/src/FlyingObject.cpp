@@ -230,7 +230,7 @@ void FlyingObject::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacl
     throw InputError("dynamic obstacles on another index (" + obstacles->index()->path().string() +
                      ") than the flying object's (" + index_->path().string() + ")");
   parts_->obstacles = std::move(obstacles);
-  parts_->coherence.obstacles_changed(nullptr, true);  // the free box did not know them
+  parts_->coherence.drop_free_box();  // the free box did not know them
   parts_->obstacles_version = parts_->obstacles ? parts_->obstacles->version() : 0;
   parts_->obstacles_shows = parts_->obstacles ? parts_->obstacles->shows() : 0;
 }

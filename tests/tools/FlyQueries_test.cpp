@@ -9,6 +9,7 @@
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -19,6 +20,7 @@
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/formats/Pose.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 #include "tetrapage/runtime/PoseMotion.h"
 
 namespace tetrapage {
@@ -179,6 +181,43 @@ TEST_F(FlyQueries, ImpactRowsBracketTheFirstContact) {
     }
   }
   EXPECT_GT(hits, 2);
+}
+
+TEST_F(FlyQueries, ObstaclesSavedBesideTheIndexCount) {
+  // A crate saved as a dynamic obstacle on the flight's way: fly --obstacles answers as brute
+  // force over the scene and the placed crate.
+  auto index = std::make_shared<const CollisionIndex>(folder_ / "scene.tpi");
+  TriangleSoup crate;
+  test::add_box(crate, {-0.05, -0.05, -0.05}, {0.05, 0.05, 0.05});
+  const Pose crate_pose{poses_[60].translation, {1, 0, 0, 0}};
+  {
+    DynamicObstacles obstacles(index);
+    obstacles.insert(crate, crate_pose, "crate");
+    obstacles.save(folder_ / "scene.obstacles");
+  }
+  fly("--obstacles " + path("scene.obstacles") + " --answers " + path("o.csv"));
+  const auto rows = read_rows(folder_ / "o.csv", "step,collides");
+  ASSERT_EQ(rows.size(), poses_.size());
+  int crate_hits = 0;
+  for (const auto& row : rows) {
+    const Pose& pose = poses_[std::stoul(row[0])];
+    // Touching the crate's faces, or wholly inside the (axis-aligned) crate.
+    bool inside = true;
+    for (const Vec3& v : object_.vertices) {
+      const Vec3 w = apply_pose(pose, v);
+      for (int a = 0; a < 3; ++a) inside = inside && std::fabs(w[a] - crate_pose.translation[a]) < 0.05;
+    }
+    const bool with_crate = inside || touches(crate, &crate_pose, object_, pose);
+    crate_hits += with_crate;
+    EXPECT_EQ(row[1], with_crate || touches(environment_, nullptr, object_, pose) ? "1" : "0") << "step " << row[0];
+  }
+  EXPECT_GT(crate_hits, 0);
+  std::string out;
+  std::ofstream(folder_ / "bad.obstacles") << "not an overlay\n";
+  EXPECT_NE(test::run_cli("fly " + path("scene.tpi") + " --object " + path("object.ply") + " --path " +
+                              path("flight3.csv") + " --obstacles " + path("bad.obstacles"),
+                          out),
+            0);
 }
 
 TEST_F(FlyQueries, SeveralObjectsAnswerAsBruteForce) {

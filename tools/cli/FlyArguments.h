@@ -5,17 +5,19 @@
 #include <chrono>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "TessellationArguments.h"
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
 
 namespace tetrapage::cli {
 
 struct FlyArguments {
-  std::filesystem::path index, answers, check, report, contacts;
+  std::filesystem::path index, answers, check, report, contacts, obstacles;
   /// One object and its pose file, or several (an ObjectGroup): as many of each.
   std::vector<std::filesystem::path> objects, paths;
   std::string object_unit;
@@ -38,6 +40,9 @@ struct FlyArguments {
 TriangleSoup load_object(const FlyArguments& args, const std::filesystem::path& path);
 /// The index's options: --memory and the paging flags.
 CollisionIndexOptions fly_index_options(const FlyArguments& args);
+/// The dynamic obstacles saved in --obstacles (DynamicObstacles::save), or null without it.
+std::shared_ptr<const DynamicObstacles> load_obstacles(const FlyArguments& args,
+                                                        const std::shared_ptr<const CollisionIndex>& index);
 /// Several objects flying at once: an ObjectGroup step per pose (--query collide only).
 void run_fly_group(const FlyArguments& args);
 

@@ -53,6 +53,12 @@ TriangleSoup load_object(const FlyArguments& args, const std::filesystem::path& 
   return object;
 }
 
+std::shared_ptr<const DynamicObstacles> load_obstacles(const FlyArguments& args,
+                                                        const std::shared_ptr<const CollisionIndex>& index) {
+  if (args.obstacles.empty()) return nullptr;
+  return std::make_shared<const DynamicObstacles>(DynamicObstacles::load(index, args.obstacles));
+}
+
 CollisionIndexOptions fly_index_options(const FlyArguments& args) {
   CollisionIndexOptions index_options;
   index_options.memory_budget_bytes = parse_byte_size(args.memory);
@@ -144,7 +150,7 @@ void run_fly(const FlyArguments& args) {
                      std::to_string(args.paths.size()) + " --path: give one pose file per object");
   if (args.objects.size() > 1) return run_fly_group(args);
   check_outputs_writable({args.answers, args.report, args.contacts},
-                         {args.index, args.objects[0], args.paths[0], args.check});
+                         {args.index, args.objects[0], args.paths[0], args.check, args.obstacles});
   QueryOptions query_options;
   query_options.accuracy = geometry::parse_accuracy(args.accuracy);
   query_options.mode = args.all_contacts ? QueryMode::all_contacts : QueryMode::first_hit;
@@ -158,6 +164,7 @@ void run_fly(const FlyArguments& args) {
   auto model = std::async(std::launch::async, [&] { return std::make_shared<const ObjectModel>(object_mesh); });
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   FlyingObject object(index, model.get());
+  object.set_obstacles(load_obstacles(args, index));
   std::optional<ContactFile> contact_file;
   if (!args.contacts.empty()) contact_file.emplace(args.contacts, *index, object.object());
   double preload_seconds = 0;
@@ -341,6 +348,10 @@ void add_fly_command(CLI::App& app) {
                       "--query toi: the width of the certified bracket of the contact time, in the motion's time "
                       "[0, 1] between two poses")
       ->capture_default_str();
+  command->add_option("--obstacles", args->obstacles,
+                      "Dynamic obstacles saved beside the index (DynamicObstacles::save, tetrapage_obstacles_save): "
+                      "their parts count as obstacles, the index parts they hide do not")
+      ->check(CLI::ExistingFile);
   command->add_option("--answers", args->answers,
                       "Write the answers as CSV: step,collides for --query collide; one row per contact, or per "
                       "step with the distance or the time of impact, for the other queries (docs/USAGE.md)");

@@ -66,6 +66,7 @@ void run_fly_group(const FlyArguments& args) {
   std::vector<std::filesystem::path> inputs{args.index};
   inputs.insert(inputs.end(), args.objects.begin(), args.objects.end());
   inputs.insert(inputs.end(), args.paths.begin(), args.paths.end());
+  if (!args.obstacles.empty()) inputs.push_back(args.obstacles);
   const std::filesystem::path outputs[] = {args.answers, args.report};
   check_outputs_writable(outputs, inputs);
   GroupQueryOptions options;
@@ -78,6 +79,7 @@ void run_fly_group(const FlyArguments& args) {
   const std::vector<std::vector<Pose>> flights = read_flights(args);
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   ObjectGroup group(index, models);
+  group.set_obstacles(load_obstacles(args, index));
   std::optional<CsvFile> answers;
   if (!args.answers.empty()) answers.emplace(args.answers, "step,object,collides,environment,objects", "answers file");
 
