@@ -470,6 +470,60 @@ json run_impact(const Workload& w, FclPeers& fcl, const Arguments& args) {
   return out;
 }
 
+// Every contact pair with its geometry: tetrapage's all_contacts query and contact_geometry per
+// pair (exact topology; points, segments or polygons, both normals) against FCL's collide with
+// enable_contact (a point, a normal and a penetration depth per pair, decided in floating point).
+json run_contacts(const Workload& w, FclPeers& fcl) {
+  constexpr std::size_t kMost = 1u << 20;
+  FlyingObject flying(w.index, w.object);
+  std::vector<std::size_t> mine(w.poses.size()), theirs(w.poses.size());
+  QueryResult result;
+  Row tetrapage;
+  tetrapage.name = "tetrapage all_contacts + contact_geometry";
+  tetrapage.description = "FlyingObject::query (all_contacts) and contact_geometry of every pair";
+  tetrapage.seconds = time_steps(0, w.poses.size(), true, [&](std::size_t i) {
+    flying.query(w.poses[i], QueryOptions{.mode = QueryMode::all_contacts}, result);
+    std::size_t shapes = 0;
+    for (const Contact& contact : result.contacts)
+      shapes += flying.contact_geometry(contact).shape != geometry::ContactShape::none ? 1 : 0;
+    mine[i] = shapes;
+  });
+  std::vector<Row> rows;
+  for (auto& model : fcl.models) {
+    Row row;
+    row.name = std::string("FCL ") + to_string(model->volume()) + " collide, enable_contact";
+    row.description = "fcl::collide with CollisionRequest(2^20, true): every contact";
+    row.seconds = time_steps(0, w.poses.size(), true, [&](std::size_t i) { theirs[i] = model->contacts(w.poses[i], kMost); });
+    std::uint64_t differ = 0, steps = 0, pairs_mine = 0, pairs_fcl = 0;
+    for (std::size_t i = 0; i < w.poses.size(); ++i) {
+      differ += mine[i] != theirs[i] ? 1 : 0;
+      steps += mine[i] > 0 ? 1 : 0;
+      pairs_mine += mine[i];
+      pairs_fcl += theirs[i];
+    }
+    row.extra = {{"steps_with_contacts", steps}, {"steps_where_counts_differ", differ},
+                 {"pairs_tetrapage", pairs_mine}, {"pairs_fcl", pairs_fcl}};
+    rows.push_back(std::move(row));
+  }
+  std::printf("\n### Contacts with their geometry, %zu poses (one untimed pass before each timed one)\n\n",
+              w.poses.size());
+  std::printf("| row | steps/s | p50 us | p99 us | max us | tetrapage steps/s / row's | contact pairs tetrapage / FCL; "
+              "steps whose counts differ (of steps with contacts) |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---|\n");
+  print_row(tetrapage, tetrapage, "-");
+  for (const auto& row : rows) {
+    const json& e = row.extra;
+    print_row(row, tetrapage,
+              std::to_string(e["pairs_tetrapage"].get<std::uint64_t>()) + " / " +
+                  std::to_string(e["pairs_fcl"].get<std::uint64_t>()) + "; " +
+                  std::to_string(e["steps_where_counts_differ"].get<std::uint64_t>()) + " (of " +
+                  std::to_string(e["steps_with_contacts"].get<std::uint64_t>()) + ")");
+  }
+  json out = {{"tetrapage", tetrapage.to_json()}, {"fcl", json::array()}};
+  for (const auto& row : rows) out["fcl"].push_back(row.to_json());
+  return out;
+}
+
 void run(const Arguments& args) {
   check_writable(args.report);
   if (args.max_distance && !(*args.max_distance >= 0)) throw InputError("--max-distance must be >= 0");
@@ -497,6 +551,7 @@ void run(const Arguments& args) {
               fcl.build_seconds[1], double(fcl.models[1]->structure_bytes()) / double(1 << 20));
   const json distance = run_distance(w, fcl, args);
   const json impact = run_impact(w, fcl, args);
+  const json contacts = run_contacts(w, fcl);
   if (!args.report.empty())
     write_report(args.report, {{"command", "bench distance"},
                                {"scene", args.scene.string()},
@@ -510,7 +565,8 @@ void run(const Arguments& args) {
                                {"fcl_structure_bytes",
                                 {{"OBBRSS", fcl.models[0]->structure_bytes()}, {"RSS", fcl.models[1]->structure_bytes()}}},
                                {"distance", distance},
-                               {"time_of_impact", impact}});
+                               {"time_of_impact", impact},
+                               {"contacts", contacts}});
 }
 
 }  // namespace

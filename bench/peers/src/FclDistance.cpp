@@ -24,6 +24,7 @@ class FclDistance::Impl {
   virtual FclImpactAnswer time_of_impact(const Pose& from, const Pose& to, FclImpactSolver solver,
                                          std::size_t samples) = 0;
   virtual bool collides(const Pose& pose) = 0;
+  virtual std::size_t contacts(const Pose& pose, std::size_t most) = 0;
 };
 
 namespace {
@@ -92,6 +93,13 @@ class Models final : public FclDistance::Impl {
     return result.isCollision();
   }
 
+  std::size_t contacts(const Pose& pose, std::size_t most) override {
+    object_.setTransform(fcl_model::transform_of(pose));
+    fcl::CollisionResultd result;
+    fcl::collide(&environment_, &object_, fcl::CollisionRequestd(most, /*enable_contact=*/true), result);
+    return result.numContacts();
+  }
+
  private:
   std::shared_ptr<fcl::BVHModel<BV>> environment_model_, object_model_;
   fcl::CollisionObjectd environment_, object_;
@@ -119,5 +127,6 @@ FclImpactAnswer FclDistance::time_of_impact(const Pose& from, const Pose& to, Fc
   return impl_->time_of_impact(from, to, solver, samples);
 }
 bool FclDistance::collides(const Pose& pose) { return impl_->collides(pose); }
+std::size_t FclDistance::contacts(const Pose& pose, std::size_t most) { return impl_->contacts(pose, most); }
 
 }  // namespace tetrapage

@@ -75,6 +75,9 @@ class FclDistance {
   /// fcl::collide at `pose` (first contact only): FCL's discrete answer, to check its
   /// continuous ones against.
   bool collides(const Pose& pose);
+  /// Every contact at `pose` (fcl::collide with enable_contact, up to `most`): FCL's contact
+  /// geometry (a point, a normal and a penetration depth per triangle pair); returns how many.
+  std::size_t contacts(const Pose& pose, std::size_t most);
 
   class Impl;  // keeps FCL's headers out of every includer (public only for FclDistance.cpp)
 
