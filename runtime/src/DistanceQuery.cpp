@@ -32,15 +32,25 @@ void report_touching(const QueryResult& touch, DistanceResult& result) {
 geometry::ContactGeometry FlyingObject::contact_geometry(const Contact& contact) {
   if (contact.object_triangle == Contact::kNoObjectTriangle) return {};
   if (contact.dynamic_part != kNoDynamicPart) return dynamic_contact_geometry(contact);
+  if (contact.object_triangle >= model_->mesh.triangles.size())
+    throw InputError("contact geometry: the object has no triangle " +
+                     std::to_string(contact.object_triangle));
+  const geometry::Triangle placed = parts_->object.world_triangle(contact.object_triangle);
+  // The triangle phase II tested (a float copy is its shard's own); a contact the last step
+  // did not report is looked up in the index.
+  // Callers walk the contacts in order: the search starts where the last one was found.
+  const ContactTriangles& tested = parts_->contact_triangles;
+  for (std::size_t k = 0; k < tested.size(); ++k) {
+    const std::size_t at = (parts_->contact_cursor + k) % tested.size();
+    if (tested[at].first != contact.environment_triangle) continue;
+    parts_->contact_cursor = at;
+    return geometry::contact_geometry(tested[at].second, placed);
+  }
   const auto stored = index_->stored_triangle(contact.environment_triangle);
   if (!stored)
     throw InputError("contact geometry: the index holds no triangle " +
                      std::to_string(contact.environment_triangle));
-  if (contact.object_triangle >= model_->mesh.triangles.size())
-    throw InputError("contact geometry: the object has no triangle " +
-                     std::to_string(contact.object_triangle));
-  return geometry::contact_geometry(stored->corners,
-                                    parts_->object.world_triangle(contact.object_triangle));
+  return geometry::contact_geometry(stored->corners, placed);
 }
 
 void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,

@@ -81,6 +81,7 @@ void FlyingObject::query(const Pose& pose, const QueryOptions& options, QueryRes
   Parts& parts = *parts_;
   const CollisionIndex& index = *index_;
   clear_answer(result);
+  parts.contact_triangles.clear();
   StepCounters& counters = result.counters;
   const DynamicObstacles* overlay = parts.obstacles.get();
   parts.containment.begin_step(overlay);
@@ -184,7 +185,7 @@ void FlyingObject::test_region(const geometry::Box& box, const QueryOptions& opt
   };
   region.prefetch_needed(needs);
   PhaseTwo phase_two(index, *model_, parts.object, shapes, parts.solid, parts.coherence,
-                     parts.containment, parts.met_triangles, options, solid_query, box, result);
+                     parts.containment, parts.met_triangles, parts.contact_triangles, options, solid_query, box, result);
   // One clock pair around the loop (a free step is a few microseconds; a clock read per shard
   // cost a tenth of it): the tests' time is the loop's less the acquisitions'.
   for (std::size_t k = 0; k < region.size() && !phase_two.stopped(); ++k) {
@@ -219,7 +220,7 @@ void FlyingObject::test_obstacles_alone(const geometry::Box& box, const QueryOpt
   if (!parts.obstacles || parts.obstacles->size() == 0) return;
   parts.shapes.prepare(*model_, parts.object, box, reach, own_frame, solid_query, shapes_box(box));
   PhaseTwo phase_two(*index_, *model_, parts.object, parts.shapes, parts.solid, parts.coherence,
-                     parts.containment, parts.met_triangles, options, solid_query, box, result);
+                     parts.containment, parts.met_triangles, parts.contact_triangles, options, solid_query, box, result);
   phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
   phase_two.finish();
   parts.containment.check_dynamic(box, parts.object, parts.obstacle, solid_query, result);

@@ -7,6 +7,7 @@
 #include "ContainmentCheck.h"
 #include "DistanceSearch.h"
 #include "ObjectSolid.h"
+#include "PhaseTwo.h"
 #include "PlacedObject.h"
 #include "PruningShapes.h"
 #include "SearchedRegion.h"
@@ -25,6 +26,8 @@ struct FlyingObject::Parts {
   ObjectSolid solid;             ///< per-step scratch: the object as a solid
   ContainmentCheck containment;  ///< one body inside the other, for a step without contact
   TriangleIdSet met_triangles;   ///< the triangles phase I has met this step
+  ContactTriangles contact_triangles;  ///< the step's contacts' index triangles, as tested
+  std::size_t contact_cursor = 0;      ///< where contact_geometry found the last one
   DistanceSearch distance;       ///< the closest pair, and the last one (coherence)
   QueryResult touch;             ///< scratch: the collision step of a distance query
   std::shared_ptr<const DynamicObstacles> obstacles;  ///< merged into every query, or null

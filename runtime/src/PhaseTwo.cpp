@@ -13,8 +13,8 @@ namespace tetrapage {
 PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, PlacedObject& object,
                    const PruningShapes& shapes, ObjectSolid& solid, const Coherence& coherence,
                    ContainmentCheck& containment, TriangleIdSet& met_triangles,
-                   const QueryOptions& options, bool solid_query, const geometry::Box& box,
-                   QueryResult& result)
+                   ContactTriangles& contact_triangles, const QueryOptions& options,
+                   bool solid_query, const geometry::Box& box, QueryResult& result)
     : index_(index),
       model_(model),
       object_(object),
@@ -23,6 +23,7 @@ PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, Placed
       coherence_(coherence),
       containment_(containment),
       met_triangles_(met_triangles),
+      contact_triangles_(contact_triangles),
       options_(options),
       solid_query_(solid_query),
       all_(options.mode == QueryMode::all_contacts),
@@ -36,7 +37,8 @@ PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, Placed
   met_triangles_.clear();
 }
 
-void PhaseTwo::add_contact(const Source& source, std::uint32_t object_triangle) {
+void PhaseTwo::add_contact(const Source& source, const geometry::Triangle& environment,
+                           std::uint32_t object_triangle) {
   result_.collides = true;
   if (all_ || result_.contacts.empty()) {
     if (source.part != kNoDynamicPart) {
@@ -44,9 +46,11 @@ void PhaseTwo::add_contact(const Source& source, std::uint32_t object_triangle) 
           {Contact::kDynamicPart, source.local, object_triangle, 0, source.part});
     } else {
       const std::uint32_t component = source.shard->component_id(source.local);
-      result_.contacts.push_back({index_.component_part(component),
-                                  source.shard->triangle_id(source.local), object_triangle,
-                                  component, kNoDynamicPart});
+      const std::uint64_t id = source.shard->triangle_id(source.local);
+      result_.contacts.push_back(
+          {index_.component_part(component), id, object_triangle, component, kNoDynamicPart});
+      if (contact_triangles_.empty() || contact_triangles_.back().first != id)
+        contact_triangles_.emplace_back(id, environment);
     }
   }
   if (!all_) stop_ = true;
@@ -80,7 +84,7 @@ void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environ
     if (!geometry::triangles_collide(environment, object_.world_triangle(object_triangle),
                                      options_.accuracy))
       return true;
-    add_contact(source, object_triangle);
+    add_contact(source, environment, object_triangle);
     return all_;
   });
 }
@@ -111,7 +115,7 @@ void PhaseTwo::test_candidate(const Source& source, const geometry::Triangle& en
     if (!solid_.built) solid_.build(options_, model_, object_, coherence_);
     ++counters_.triangle_tests;
     if (solid_.collides(environment, options_.accuracy, shapes_.reach()))
-      add_contact(source, Contact::kNoObjectTriangle);
+      add_contact(source, environment, Contact::kNoObjectTriangle);
     return;
   }
   // (A dynamic part inside the object is found by ContainmentCheck::check_dynamic.)

@@ -17,8 +17,14 @@
 #include "tetrapage/runtime/ObjectModel.h"
 #include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/TriangleIdSet.h"
+#include <utility>
+#include <vector>
 
 namespace tetrapage {
+
+/// The environment triangle of each contact of a step with an index triangle, as phase II
+/// tested it (its id and corners): the contacts' geometry then needs no lookup by id.
+using ContactTriangles = std::vector<std::pair<std::uint64_t, geometry::Triangle>>;
 
 class PhaseTwo {
  public:
@@ -26,8 +32,9 @@ class PhaseTwo {
   /// `solid_query` (built on the first candidate that needs it), results into `result`.
   PhaseTwo(const CollisionIndex& index, const ObjectModel& model, PlacedObject& object,
            const PruningShapes& shapes, ObjectSolid& solid, const Coherence& coherence,
-           ContainmentCheck& containment, TriangleIdSet& met_triangles, const QueryOptions& options,
-           bool solid_query, const geometry::Box& box, QueryResult& result);
+           ContainmentCheck& containment, TriangleIdSet& met_triangles,
+           ContactTriangles& contact_triangles, const QueryOptions& options, bool solid_query,
+           const geometry::Box& box, QueryResult& result);
 
   /// The shard's candidates, but for those of the parts `overlay` hides (when given).
   void test_shard(const Shard& shard, const DynamicObstacles* overlay = nullptr);
@@ -50,7 +57,8 @@ class PhaseTwo {
   void test_candidate(const Source& source, const geometry::Triangle& environment);
   void test_mesh(const Source& source, const geometry::Triangle& environment,
                  const std::array<Vec3, 3>& framed, const geometry::Box& query, double grow);
-  void add_contact(const Source& source, std::uint32_t object_triangle);
+  void add_contact(const Source& source, const geometry::Triangle& environment,
+                   std::uint32_t object_triangle);
   void note_if_enclosed(const Shard& shard, std::uint32_t local,
                         const geometry::Triangle& environment);
 
@@ -62,6 +70,7 @@ class PhaseTwo {
   const Coherence& coherence_;
   ContainmentCheck& containment_;
   TriangleIdSet& met_triangles_;
+  ContactTriangles& contact_triangles_;
   const QueryOptions& options_;
   const bool solid_query_;
   const bool all_;

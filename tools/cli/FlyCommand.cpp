@@ -76,6 +76,8 @@ class QueryStep {
  public:
   QueryStep(const FlyArguments& args, const QueryOptions& options, const CollisionIndex& index)
       : query_(parse_fly_query(args.query)), options_(options) {
+    if (!args.contacts.empty() && (query_ == FlyQuery::distance || query_ == FlyQuery::time_of_impact))
+      throw InputError(std::string("fly: --contacts lists a collision query's contacts, not --query ") + args.query);
     if (query_ == FlyQuery::contacts) options_.mode = QueryMode::all_contacts;
     distance_options_.max_distance = args.max_distance;
     impact_options_.tolerance = args.toi_tolerance;
@@ -166,7 +168,7 @@ void run_fly(const FlyArguments& args) {
   FlyingObject object(index, model.get());
   object.set_obstacles(load_obstacles(args, index));
   std::optional<ContactFile> contact_file;
-  if (!args.contacts.empty()) contact_file.emplace(args.contacts, *index, object.object());
+  if (!args.contacts.empty()) contact_file.emplace(args.contacts, *index);
   double preload_seconds = 0;
   if (args.preload) {
     if (index->total_shard_bytes() > index_options.memory_budget_bytes)
@@ -203,7 +205,7 @@ void run_fly(const FlyArguments& args) {
     tets_visited += result.counters.tets_visited;
     shards_touched += result.counters.shards_touched;
     check.record(i, answers[i]);
-    if (contact_file) contact_file->write_step(i, poses[i], result);
+    if (contact_file) contact_file->write_step(i, object, result);
     progress.advance();
   }
   progress.finish();

@@ -2,8 +2,9 @@
 /// @file ContactFile.h
 /// The contacts of a flight as CSV (`fly --contacts`), one row per contact:
 ///   step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z
-/// kind is "surface" (an environment triangle meets an object triangle; x,y,z is one point of
-/// their intersection, computed exactly and rounded to double), "solid" (the object was
+/// kind is "surface" (an environment triangle meets an object triangle; x,y,z is a point of
+/// their intersection: the mean of FlyingObject::contact_geometry's corners, within 2^-40 of
+/// the coordinates' magnitude), "solid" (the object was
 /// checked as a solid: hull, box or swept; no object triangle nor point), "object_inside" or
 /// "obstacle_inside" (containment: part is the containing or contained environment part, and
 /// the triangle and point fields are empty). Names are quoted as CSV quotes them.
@@ -21,19 +22,14 @@
 
 namespace tetrapage {
 
-/// One point where two triangles meet (both closed), computed with CGAL's exact constructions
-/// and rounded to double; nullopt when they do not meet.
-std::optional<Vec3> triangle_intersection_point(const std::array<Vec3, 3>& a,
-                                                const std::array<Vec3, 3>& b);
-
 class ContactFile {
  public:
   /// Opens `path` under a temporary name (removed unless commit() runs). @throw IoError.
-  ContactFile(const std::filesystem::path& path, const CollisionIndex& index,
-              const TriangleSoup& object);
+  ContactFile(const std::filesystem::path& path, const CollisionIndex& index);
 
   /// The rows of one step's answer. @throw IoError; what the index throws paging a shard in.
-  void write_step(std::uint64_t step, const Pose& pose, const QueryResult& result);
+  /// `object` answered `result` last (its contacts' geometry is read from it).
+  void write_step(std::uint64_t step, FlyingObject& object, const QueryResult& result);
   std::uint64_t rows() const { return file_.rows(); }
   /// Flushes and renames the file into place. @throw IoError.
   void commit() { file_.commit(); }
@@ -44,11 +40,6 @@ class ContactFile {
 
   CsvFile file_;
   const CollisionIndex& index_;
-  const TriangleSoup& object_;
-  // The environment triangle of the last surface row: all_contacts lists one triangle's pairs
-  // together, and looking it up pages shards in.
-  std::uint64_t last_id_ = ~std::uint64_t{0};
-  std::optional<CollisionIndex::StoredTriangle> last_triangle_;
 };
 
 }  // namespace tetrapage
