@@ -84,6 +84,7 @@ struct Variant {
   const char* name;
   double scale;
   Vec3 offset;
+  const char* extension = "ply";  ///< stl: float input, one part
 };
 std::ostream& operator<<(std::ostream& out, const Variant& v) { return out << v.name; }
 
@@ -94,7 +95,7 @@ class Distance : public ::testing::TestWithParam<Variant> {
     folder_ = fs::path(TETRAPAGE_TEST_TMP) / (std::string("distance-") + v.name + "-" + std::to_string(::getpid()));
     fs::remove_all(folder_);
     fs::create_directories(folder_);
-    const fs::path input = folder_ / "scene.ply";
+    const fs::path input = folder_ / (std::string("scene.") + v.extension);
     {
       MeshWriter writer(input);
       const TriangleSoup soup = placed(mixed_scene(), v.scale, v.offset);
@@ -306,7 +307,8 @@ TEST_P(Distance, TimeOfImpactBracketsTheFirstContact) {
 INSTANTIATE_TEST_SUITE_P(Scales, Distance,
                          ::testing::Values(Variant{"unit", 1.0, {0, 0, 0}}, Variant{"tiny", 1e-9, {0, 0, 0}},
                                            Variant{"huge", 1e9, {0, 0, 0}},
-                                           Variant{"far", 1.0, {1e6, -3e6, 2e6}}),
+                                           Variant{"far", 1.0, {1e6, -3e6, 2e6}},
+                                           Variant{"float_stl", 1.0, {0.5, 0.5, 0.5}, "stl"}),
                          [](const auto& variant) { return std::string(variant.param.name); });
 
 // A foreign mesh (CGAL's couplingdown, 3714 triangles) with the cube flown past it: the exact
