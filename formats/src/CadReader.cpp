@@ -311,6 +311,24 @@ void silence_occt_messages() {
 
 }  // namespace
 
+void set_deflection(TessellationOptions& options, const std::string& text, std::string_view what) {
+  std::string number = text;
+  const bool relative = !number.empty() && number.back() == '%';
+  if (relative) number.pop_back();
+  std::size_t used = 0;
+  double value = 0;
+  try {
+    value = std::stod(number, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != number.size() || number.empty() || !(value > 0) || !std::isfinite(value))
+    throw InputError(std::string(what) + " '" + text +
+                     "': expected a positive length (0.01) or percentage (0.1%)");
+  options.relative_deflection = relative;
+  options.deflection = relative ? value / 100 : value;
+}
+
 bool is_cad_path(const std::filesystem::path& path) {
   const std::string extension = detail::lower_extension(path);
   return extension == ".step" || extension == ".stp" || extension == ".p21" || is_iges_path(path);

@@ -7,15 +7,21 @@
 
 namespace tetrapage {
 
-Progress::Progress(std::string label, std::uint64_t total, bool enabled)
+Progress::Progress(std::string label, std::uint64_t total, bool enabled,
+                   ProgressCallback callback)
     : label_(std::move(label)),
       total_(total),
+      callback_(std::move(callback)),
       enabled_(enabled),
       terminal_(enabled && ::isatty(STDERR_FILENO) == 1),
       start_(std::chrono::steady_clock::now()),
-      last_draw_(start_) {}
+      last_draw_(start_) {
+  last_notified_ = start_;
+}
 
 Progress::~Progress() {
+  // A destructor must not throw: the callback is told of the end only by finish().
+  callback_ = nullptr;
   if (enabled_ && !finished_ && done_ > 0) finish();
 }
 
@@ -27,6 +33,7 @@ void Progress::advance(std::uint64_t units) { set(done_ + units); }
 
 void Progress::set(std::uint64_t done) {
   done_ = done;
+  if (callback_) notify(false);
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   // A terminal gets at most 10 redraws a second; a log gets a line per 10% (or per 5 s).
@@ -46,8 +53,16 @@ void Progress::finish() {
   if (finished_) return;
   finished_ = true;
   if (total_ && done_ < total_) done_ = total_;
+  if (callback_) notify(true);
   // A log already holds the line for this count; a terminal needs its closing newline.
   if (enabled_ && (terminal_ || done_ != last_drawn_done_)) draw(true);
+}
+
+void Progress::notify(bool final_call) {
+  const auto now = std::chrono::steady_clock::now();
+  if (!final_call && now - last_notified_ < std::chrono::milliseconds(100)) return;
+  last_notified_ = now;
+  callback_(label_, done_, total_);
 }
 
 void Progress::draw(bool final_line) {

@@ -166,7 +166,8 @@ void bin_triangles(IngestedModel& model, const TetMesh& mesh,
     if (!pairs) s.out.resize(buckets.size());
     return s;
   });
-  Progress progress("binning triangles", model.triangle_count, options.progress);
+  Progress progress("binning triangles", model.triangle_count, options.progress,
+                    options.on_progress);
   const MortonGrid model_grid(model.bounds);
   if (pairs)
     bin_in_memory_soups(model.soups, mesh, model_grid, bucket_of, buckets, states, progress);

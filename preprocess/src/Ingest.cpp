@@ -189,7 +189,7 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
   const std::vector<InputPiece> jobs = input_pieces(inputs);
   // Parsing, edge parity, bounds and centroids run on all threads, a few soups at once; the
   // soups are appended in input order on one.
-  Progress progress("reading parts", jobs.size(), options.progress);
+  Progress progress("reading parts", jobs.size(), options.progress, options.on_progress);
   const std::size_t in_flight = ingest_depth(jobs, options.memory_bytes,
                                              std::size_t(tbb::this_task_arena::max_concurrency()));
   produce_in_parallel_consume_in_order(

@@ -166,7 +166,8 @@ void classify(Classification& c, std::vector<std::uint32_t> tets, bool show_prog
   const std::vector<std::vector<std::uint32_t>> pass_components =
       plan_passes(c, tets, of_component);
   Progress progress("classifying interiors", c.model.triangle_count * pass_components.size(),
-                    c.options.progress && show_progress);
+                    c.options.progress && show_progress,
+                    show_progress ? c.options.on_progress : ProgressCallback{});
   for (const auto& pass : pass_components) {
     ++c.passes;
     std::vector<std::vector<std::uint32_t>> asked(components);

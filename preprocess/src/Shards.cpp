@@ -111,7 +111,7 @@ ShardTables build_shards(std::span<CopyBucket> buckets, std::span<const std::uin
   const double query_extent = query_extent_for(options, model.bounds);
   summary.query_extent = query_extent;
   const ShardCostModel cost_model;
-  Progress progress("building shards", tet_count, options.progress);
+  Progress progress("building shards", tet_count, options.progress, options.on_progress);
   for (auto& bucket : buckets) {
     BucketCopies copies = bucket.take();
     // The copies in (tet rank, id) order: each tet's then lie side by side.

@@ -1,8 +1,5 @@
 #include "TessellationArguments.h"
 
-#include <cmath>
-
-#include "tetrapage/formats/Error.h"
 
 namespace tetrapage::cli {
 
@@ -27,20 +24,7 @@ void TessellationArguments::add_to(CLI::App* command) {
 
 TessellationOptions TessellationArguments::options(bool show_progress) const {
   TessellationOptions options;
-  std::string text = deflection;
-  options.relative_deflection = !text.empty() && text.back() == '%';
-  if (options.relative_deflection) text.pop_back();
-  std::size_t used = 0;
-  double value = 0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used != text.size() || text.empty() || !(value > 0) || !std::isfinite(value))
-    throw InputError("--deflection '" + deflection +
-                     "': expected a positive length (0.01) or percentage (0.1%)");
-  options.deflection = options.relative_deflection ? value / 100 : value;
+  set_deflection(options, deflection, "--deflection");
   options.angular_deflection = angular_deflection;
   options.skip_bad_parts = skip_bad_parts;
   options.show_progress = show_progress;

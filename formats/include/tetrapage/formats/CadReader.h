@@ -6,6 +6,8 @@
 /// all threads, and placed at each of its instances.
 
 #include <filesystem>
+#include <string>
+#include <string_view>
 
 #include "tetrapage/formats/TriangleSoup.h"
 
@@ -27,6 +29,11 @@ struct TessellationOptions {
   /// Print progress per shape on stderr.
   bool show_progress = false;
 };
+
+/// Sets options.deflection from `text`: a percentage of each shape's bounding-box diagonal
+/// ("0.1%") or a length in millimetres ("0.01").
+/// @throw InputError naming `what` (the option) and the text when it is neither, or not positive.
+void set_deflection(TessellationOptions& options, const std::string& text, std::string_view what);
 
 /// Whether `path` has a STEP (.step, .stp, .p21) or IGES (.iges, .igs) extension.
 bool is_cad_path(const std::filesystem::path& path);

@@ -5,15 +5,26 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <string_view>
 
 namespace tetrapage {
+
+/// Told of progress as it is drawn (at most 10 times a second, and once at the end): the label,
+/// the units done and the total (0 if unknown). Called from whichever thread advances the
+/// Progress; an exception it throws stops the work that advanced it.
+using ProgressCallback =
+    std::function<void(std::string_view label, std::uint64_t done, std::uint64_t total)>;
 
 class Progress {
  public:
   /// @param label what is being done ("reading parts", "writing scene").
   /// @param total units of work, 0 if unknown.
-  Progress(std::string label, std::uint64_t total, bool enabled = true);
+  /// @param enabled draw on stderr.
+  /// @param callback also (or instead) tell this callback, if set.
+  Progress(std::string label, std::uint64_t total, bool enabled = true,
+           ProgressCallback callback = {});
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
@@ -32,8 +43,12 @@ class Progress {
  private:
   void draw(bool final_line);
 
+  void notify(bool final_call);
+
   std::string label_;
   std::uint64_t total_;
+  ProgressCallback callback_;
+  std::chrono::steady_clock::time_point last_notified_;
   std::uint64_t done_ = 0;
   bool enabled_;
   bool terminal_;

@@ -16,6 +16,7 @@
 
 #include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/Progress.h"
 #include "tetrapage/runtime/ShardKind.h"
 
 namespace tetrapage {
@@ -51,6 +52,10 @@ struct PreprocessOptions {
   double query_extent = 0;
   /// Progress bars (or lines) on stderr.
   bool progress = false;
+  /// Told of each stage's progress (Progress.h), whether or not `progress` draws it: from the
+  /// preprocess's threads, at most 10 times a second per stage. What it throws stops the run,
+  /// which then leaves nothing at the output.
+  ProgressCallback on_progress;
   /// The length unit of inputs that state none (plain meshes): "m", "mm", "in", ...; STEP and
   /// IGES files are read in millimetres, and a manifest states its units.
   std::string length_unit;

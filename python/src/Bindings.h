@@ -1,0 +1,112 @@
+#pragma once
+// What the binding files share: the wrappers that own the C++ objects, the conversions between
+// numpy arrays and tetrapage's types, and one bind_* function per concept (Module.cpp calls them).
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/ObjectModel.h"
+
+namespace tetrapage::python {
+
+namespace py = pybind11;
+
+/// A mesh as Python sees it: the soup and the unit its file stated.
+struct Mesh {
+  TriangleSoup soup;
+  std::string length_unit;
+};
+
+/// An opened index (shared by every object made from it, on any thread).
+struct Index {
+  std::shared_ptr<const CollisionIndex> index;
+};
+
+/// A dynamic-obstacle overlay. Changes take the lock exclusively, queries of the objects that
+/// hold the overlay share it: Python threads may change it while others fly (the C++ overlay
+/// asks its caller to keep changes and steps apart).
+struct Obstacles {
+  std::shared_ptr<DynamicObstacles> overlay;
+  std::shared_ptr<std::shared_mutex> lock = std::make_shared<std::shared_mutex>();
+};
+
+/// Poses read from a (7,), (K,7), (4,4) or (K,4,4) array: whether it held one pose.
+struct PoseBatch {
+  std::vector<Pose> poses;
+  bool single = false;
+};
+
+/// @throw InputError naming `what` for a wrong dtype or shape, a matrix that is not a rigid
+///        motion (rotation block not orthonormal with determinant +1, last row not 0 0 0 1).
+PoseBatch poses_from_array(py::handle value, std::string_view what);
+/// Exactly one pose.
+Pose pose_from_array(py::handle value, std::string_view what);
+/// A soup of one part from (N,3) vertices (floating or integer) and (M,3) integer triangles.
+/// @throw InputError naming the array and the entry for a wrong dtype or shape, a negative or
+///        out-of-range index.
+TriangleSoup soup_from_arrays(py::handle vertices, py::handle triangles);
+/// A Mesh, or a (vertices, triangles) pair.
+TriangleSoup soup_from_mesh_like(py::handle value, std::string_view what);
+/// A float64 array of the given shape holding `values` (copied).
+py::array_t<double> double_array(const double* values, std::vector<py::ssize_t> shape);
+/// A (2,3) array: the box's lo and hi rows.
+py::array_t<double> box_array(const Vec3& lo, const Vec3& hi);
+/// A memory budget: None (the library's default), a byte count, or a size text ("256M").
+std::uint64_t memory_bytes(py::handle value, std::uint64_t default_bytes);
+
+void bind_errors(py::module_& module);
+void bind_meshes(py::module_& module);
+void bind_preprocess(py::module_& module);
+void bind_index(py::module_& module);
+void bind_objects(py::module_& module);
+void bind_groups(py::module_& module);
+void bind_obstacles(py::module_& module);
+
+}  // namespace tetrapage::python
+
+namespace tetrapage::python {
+
+/// A flying object as Python holds it: used by one thread at a time (a second thread waits), with
+/// the overlay it reads, if any.
+struct Object {
+  std::unique_ptr<FlyingObject> flying;
+  std::unique_ptr<std::mutex> busy = std::make_unique<std::mutex>();
+  std::shared_ptr<std::shared_mutex> obstacles_lock;  ///< the overlay's, or null
+  py::object obstacles = py::none();                  ///< the Obstacles it holds, or None
+};
+
+/// An object of `mesh` (a Mesh or a (vertices, triangles) pair) flying through `index`.
+Object make_object(const Index& index, py::handle mesh, py::handle triangles);
+
+/// Query options from their names, as keyword arguments give them.
+/// @throw InputError naming the argument and the values it takes.
+QueryOptions query_options(const std::string& mode, const std::string& accuracy,
+                           const std::string& shape, const std::string& motion);
+
+/// "none", "object_inside_obstacle", "obstacle_inside_object".
+std::string containment_name(Containment containment);
+
+/// One python-side dict of a step's counters.
+py::dict counters_dict(const StepCounters& counters);
+
+}  // namespace tetrapage::python
+
+namespace tetrapage::python {
+
+/// Gives `object` the overlay `obstacles` (an Obstacles, or None for none).
+/// @throw InputError for anything else, or an overlay on another index.
+void set_object_obstacles(Object& object, py::handle obstacles);
+
+}  // namespace tetrapage::python

@@ -1,0 +1,16 @@
+// The compiled part of the `tetrapage` package (python/tetrapage/__init__.py re-exports it).
+
+#include "Bindings.h"
+
+PYBIND11_MODULE(_tetrapage, module) {
+  using namespace tetrapage::python;
+  module.doc() = "tetrapage: exact collision detection in huge CAD models, paged from disk.";
+  module.attr("__version__") = TETRAPAGE_PYTHON_VERSION;
+  bind_errors(module);
+  bind_meshes(module);
+  bind_preprocess(module);
+  bind_index(module);
+  bind_objects(module);
+  bind_groups(module);
+  bind_obstacles(module);
+}

@@ -1,0 +1,486 @@
+// tetrapage.FlyingObject: the collision query over batches of poses (GIL released), the step's
+// contacts as a structured array, distance, and time of impact.
+
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+
+#include "Bindings.h"
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage::python {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One row of QueryAnswer.contacts.
+struct ContactRecord {
+  std::uint32_t part;
+  std::uint32_t component;
+  std::uint64_t environment_triangle;
+  std::int64_t object_triangle;  // -1: the object was checked as a solid
+  std::uint32_t dynamic_part;
+  std::uint8_t shape;  // 0 none, 1 point, 2 segment, 3 polygon
+  std::uint8_t point_count;
+  double point[3];  // the mean of points: a point both triangles share
+  double points[6][3];
+  double environment_normal[3];
+  double object_normal[3];
+};
+
+// One row of FlyingObject.distances.
+struct DistanceRecord {
+  std::uint8_t separation;  // 0 touching, 1 apart, 2 farther
+  double distance;
+  double lower_bound;
+  double upper_bound;
+  double on_environment[3];
+  double on_object[3];
+  std::int64_t environment_triangle;  // -1: none measured
+  std::uint32_t environment_part;
+  std::int64_t object_triangle;
+  std::uint32_t dynamic_part;
+};
+
+struct QueryAnswer {
+  bool collides = false;
+  std::string containment;
+  std::uint32_t containing_part = 0;
+  std::uint32_t containing_dynamic_part = 0;
+  bool outside_model = false;
+  py::object contacts, counters, world_box;
+};
+
+struct DistanceAnswer {
+  DistanceResult result;
+};
+
+struct ImpactAnswer {
+  ImpactResult result;
+};
+
+template <class Enum>
+Enum parse_name(const std::string& text, std::initializer_list<std::pair<const char*, Enum>> names,
+                const char* what) {
+  std::string known;
+  for (const auto& [name, value] : names) {
+    if (text == name) return value;
+    known += (known.empty() ? "" : ", ") + std::string(name);
+  }
+  throw InputError(std::string(what) + " '" + text + "' is not one of " + known);
+}
+
+const char* separation_name(Separation separation) {
+  switch (separation) {
+    case Separation::touching:
+      return "touching";
+    case Separation::apart:
+      return "apart";
+    case Separation::farther:
+      return "farther";
+  }
+  return "?";
+}
+
+const char* impact_name(Impact impact) {
+  switch (impact) {
+    case Impact::none:
+      return "none";
+    case Impact::hit:
+      return "hit";
+    case Impact::unresolved:
+      return "unresolved";
+  }
+  return "?";
+}
+
+// Runs `step` on the object's FlyingObject with the GIL released, this object's lock held (one
+// thread at a time) and its overlay's shared (no change during a step).
+template <class Step>
+void run_step(Object& object, Step&& step) {
+  py::gil_scoped_release unlocked;
+  std::lock_guard busy(*object.busy);
+  std::shared_lock<std::shared_mutex> overlay;
+  if (object.obstacles_lock) overlay = std::shared_lock(*object.obstacles_lock);
+  step(*object.flying);
+}
+
+// A bad pose in a batch is named by its row.
+template <class Query>
+void for_each_pose(const PoseBatch& batch, const char* what, Query&& query) {
+  for (std::size_t k = 0; k < batch.poses.size(); ++k) {
+    try {
+      query(k, batch.poses[k]);
+    } catch (const InputError& error) {
+      throw InputError(batch.single
+                           ? std::string(what) + ": " + error.what()
+                           : std::string(what) + "[" + std::to_string(k) + "]: " + error.what());
+    }
+  }
+}
+
+void fill_geometry(const geometry::ContactGeometry& g, ContactRecord& record) {
+  record.shape = std::uint8_t(g.shape);
+  record.point_count = g.count;
+  double mean[3] = {0, 0, 0};
+  for (int i = 0; i < 6; ++i)
+    for (int a = 0; a < 3; ++a) {
+      record.points[i][a] = i < g.count ? g.points[i][a] : kNaN;
+      if (i < g.count) mean[a] += g.points[i][a] / g.count;
+    }
+  for (int a = 0; a < 3; ++a) {
+    record.point[a] = g.count ? mean[a] : kNaN;
+    record.environment_normal[a] = g.count ? g.first_normal[a] : kNaN;
+    record.object_normal[a] = g.count ? g.second_normal[a] : kNaN;
+  }
+}
+
+// The step's triangles are recorded by phase II: their geometry pages in nothing new.
+void contact_records(FlyingObject& flying, const QueryResult& result, bool geometry,
+                     std::vector<ContactRecord>& records) {
+  records.resize(result.contacts.size());
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const Contact& c = result.contacts[i];
+    ContactRecord& record = records[i];
+    record.part = c.environment_part;
+    record.component = c.environment_component;
+    record.environment_triangle = c.environment_triangle;
+    record.object_triangle =
+        c.object_triangle == Contact::kNoObjectTriangle ? -1 : std::int64_t(c.object_triangle);
+    record.dynamic_part = c.dynamic_part;
+    fill_geometry(geometry ? flying.contact_geometry(c) : geometry::ContactGeometry{}, record);
+  }
+}
+
+QueryAnswer answer_of(const QueryResult& result, py::array contacts) {
+  QueryAnswer answer;
+  answer.collides = result.collides;
+  answer.containment = containment_name(result.containment);
+  answer.containing_part = result.containing_part;
+  answer.containing_dynamic_part = result.containing_dynamic_part;
+  answer.outside_model = result.outside_model;
+  answer.contacts = std::move(contacts);
+  answer.counters = counters_dict(result.counters);
+  answer.world_box = box_array(result.world_box.lo, result.world_box.hi);
+  return answer;
+}
+
+py::object collides(Object& object, py::handle poses, const std::string& accuracy,
+                    const std::string& shape, const std::string& motion) {
+  const PoseBatch batch = poses_from_array(poses, "poses");
+  const QueryOptions options = query_options("first_hit", accuracy, shape, motion);
+  py::array_t<bool> answers(py::ssize_t(batch.poses.size()));
+  bool* out = answers.mutable_data();
+  run_step(object, [&](FlyingObject& flying) {
+    QueryResult result;
+    for_each_pose(batch, "poses", [&](std::size_t k, const Pose& pose) {
+      flying.query(pose, options, result);
+      out[k] = result.collides;
+    });
+  });
+  if (batch.single) return py::bool_(out[0]);
+  return answers;
+}
+
+QueryAnswer query(Object& object, py::handle pose_value, const std::string& mode,
+                  const std::string& accuracy, const std::string& shape, const std::string& motion,
+                  bool geometry) {
+  const PoseBatch batch{{pose_from_array(pose_value, "pose")}, true};
+  const QueryOptions options = query_options(mode, accuracy, shape, motion);
+  QueryResult result;
+  std::vector<ContactRecord> records;
+  run_step(object, [&](FlyingObject& flying) {
+    for_each_pose(batch, "pose", [&](std::size_t, const Pose& pose) {
+      flying.query(pose, options, result);
+      contact_records(flying, result, geometry, records);
+    });
+  });
+  return answer_of(result, py::array_t<ContactRecord>(py::ssize_t(records.size()), records.data()));
+}
+
+DistanceRecord record_of(const DistanceResult& r) {
+  DistanceRecord record{};
+  record.separation = std::uint8_t(r.separation);
+  record.distance = r.distance;
+  record.lower_bound = r.lower_bound;
+  record.upper_bound = r.upper_bound;
+  const bool measured = r.environment_triangle != DistanceResult::kNoTriangle;
+  for (int a = 0; a < 3; ++a) {
+    record.on_environment[a] =
+        measured || r.separation == Separation::touching ? r.on_environment[a] : kNaN;
+    record.on_object[a] = measured || r.separation == Separation::touching ? r.on_object[a] : kNaN;
+  }
+  record.environment_triangle = measured ? std::int64_t(r.environment_triangle) : -1;
+  record.environment_part = r.environment_part;
+  record.object_triangle = measured ? std::int64_t(r.object_triangle) : -1;
+  record.dynamic_part = r.dynamic_part;
+  return record;
+}
+
+py::array distances(Object& object, py::handle poses, double max_distance) {
+  const PoseBatch batch = poses_from_array(poses, "poses");
+  std::vector<DistanceRecord> records(batch.poses.size());
+  run_step(object, [&](FlyingObject& flying) {
+    DistanceResult result;
+    for_each_pose(batch, "poses", [&](std::size_t k, const Pose& pose) {
+      flying.distance(pose, DistanceOptions{max_distance}, result);
+      records[k] = record_of(result);
+    });
+  });
+  return py::array_t<DistanceRecord>(py::ssize_t(records.size()), records.data());
+}
+
+py::object optional_triangle(bool present, std::uint64_t id) {
+  return present ? py::object(py::int_(id)) : py::object(py::none());
+}
+
+void bind_answers(py::module_& module) {
+  PYBIND11_NUMPY_DTYPE(ContactRecord, part, component, environment_triangle, object_triangle,
+                       dynamic_part, shape, point_count, point, points, environment_normal,
+                       object_normal);
+  PYBIND11_NUMPY_DTYPE(DistanceRecord, separation, distance, lower_bound, upper_bound,
+                       on_environment, on_object, environment_triangle, environment_part,
+                       object_triangle, dynamic_part);
+  module.attr("TOUCHING") = std::uint8_t(Separation::touching);
+  module.attr("APART") = std::uint8_t(Separation::apart);
+  module.attr("FARTHER") = std::uint8_t(Separation::farther);
+  module.attr("contact_dtype") = py::dtype::of<ContactRecord>();
+  module.attr("distance_dtype") = py::dtype::of<DistanceRecord>();
+
+  py::class_<QueryAnswer>(module, "QueryAnswer", R"(One collision query's answer.
+collides: surfaces touch, or one body holds the other (containment).
+contacts: structured array, one row per contact (first_hit: at most one): part, component,
+  environment_triangle, object_triangle (-1 for a solid shape), dynamic_part (0: the index's),
+  shape (0 none, 1 point, 2 segment, 3 polygon), point_count, point (a point both triangles
+  share, NaN without geometry), points (6, 3), environment_normal, object_normal.
+counters: what the step did (dict). world_box: (2, 3).)")
+      .def_readonly("collides", &QueryAnswer::collides)
+      .def_readonly("containment", &QueryAnswer::containment)
+      .def_readonly("containing_part", &QueryAnswer::containing_part)
+      .def_readonly("containing_dynamic_part", &QueryAnswer::containing_dynamic_part)
+      .def_readonly("outside_model", &QueryAnswer::outside_model)
+      .def_readonly("contacts", &QueryAnswer::contacts)
+      .def_readonly("counters", &QueryAnswer::counters)
+      .def_readonly("world_box", &QueryAnswer::world_box)
+      .def("__bool__", [](const QueryAnswer& a) { return a.collides; })
+      .def("__repr__", [](const QueryAnswer& a) {
+        return std::string("<tetrapage.QueryAnswer ") + (a.collides ? "collides" : "free") + ", " +
+               std::to_string(py::len(a.contacts)) + " contacts>";
+      });
+
+  py::class_<DistanceAnswer>(module, "DistanceAnswer", R"(One distance query's answer: the true
+distance lies in [lower_bound, upper_bound] (certified); separation is "touching" (distance 0),
+"apart", or "farther" (than max_distance: distance is then the certified lower bound).)")
+      .def_property_readonly(
+          "separation",
+          [](const DistanceAnswer& a) { return separation_name(a.result.separation); })
+      .def_property_readonly("distance", [](const DistanceAnswer& a) { return a.result.distance; })
+      .def_property_readonly("lower_bound",
+                             [](const DistanceAnswer& a) { return a.result.lower_bound; })
+      .def_property_readonly("upper_bound",
+                             [](const DistanceAnswer& a) { return a.result.upper_bound; })
+      .def_property_readonly(
+          "on_environment",
+          [](const DistanceAnswer& a) { return double_array(a.result.on_environment.data(), {3}); })
+      .def_property_readonly(
+          "on_object",
+          [](const DistanceAnswer& a) { return double_array(a.result.on_object.data(), {3}); })
+      .def_property_readonly("environment_triangle",
+                             [](const DistanceAnswer& a) {
+                               return optional_triangle(
+                                   a.result.environment_triangle != DistanceResult::kNoTriangle,
+                                   a.result.environment_triangle);
+                             })
+      .def_property_readonly("environment_part",
+                             [](const DistanceAnswer& a) { return a.result.environment_part; })
+      .def_property_readonly("object_triangle",
+                             [](const DistanceAnswer& a) {
+                               return optional_triangle(
+                                   a.result.environment_triangle != DistanceResult::kNoTriangle,
+                                   a.result.object_triangle);
+                             })
+      .def_property_readonly("dynamic_part",
+                             [](const DistanceAnswer& a) { return a.result.dynamic_part; })
+      .def_property_readonly(
+          "containment",
+          [](const DistanceAnswer& a) { return containment_name(a.result.containment); })
+      .def_property_readonly("containing_part",
+                             [](const DistanceAnswer& a) { return a.result.containing_part; })
+      .def_property_readonly("candidates",
+                             [](const DistanceAnswer& a) { return a.result.candidates; })
+      .def_property_readonly("pair_tests",
+                             [](const DistanceAnswer& a) { return a.result.pair_tests; })
+      .def("__repr__", [](const DistanceAnswer& a) {
+        return std::string("<tetrapage.DistanceAnswer ") + separation_name(a.result.separation) +
+               " " + std::to_string(a.result.distance) + ">";
+      });
+
+  py::class_<ImpactAnswer>(module, "ImpactAnswer", R"(One time-of-impact answer over the motion's
+time [0, 1]: impact "none" (certified free), "hit" (first contact in (free_until, contact_at]),
+or "unresolved" (max_iterations ran out: free up to free_until).)")
+      .def_property_readonly("impact",
+                             [](const ImpactAnswer& a) { return impact_name(a.result.impact); })
+      .def_property_readonly("free_until",
+                             [](const ImpactAnswer& a) { return a.result.free_until; })
+      .def_property_readonly("contact_at",
+                             [](const ImpactAnswer& a) { return a.result.contact_at; })
+      .def_property_readonly("environment_triangle",
+                             [](const ImpactAnswer& a) {
+                               return optional_triangle(a.result.has_contact,
+                                                        a.result.environment_triangle);
+                             })
+      .def_property_readonly("environment_part",
+                             [](const ImpactAnswer& a) { return a.result.environment_part; })
+      .def_property_readonly("object_triangle",
+                             [](const ImpactAnswer& a) {
+                               return optional_triangle(a.result.has_contact,
+                                                        a.result.object_triangle);
+                             })
+      .def_property_readonly("iterations",
+                             [](const ImpactAnswer& a) { return a.result.iterations; })
+      .def("__repr__", [](const ImpactAnswer& a) {
+        return std::string("<tetrapage.ImpactAnswer ") + impact_name(a.result.impact) +
+               " free until " + std::to_string(a.result.free_until) + ">";
+      });
+}
+
+}  // namespace
+
+QueryOptions query_options(const std::string& mode, const std::string& accuracy,
+                           const std::string& shape, const std::string& motion) {
+  QueryOptions options;
+  options.mode = parse_name<QueryMode>(
+      mode, {{"first_hit", QueryMode::first_hit}, {"all_contacts", QueryMode::all_contacts}},
+      "mode");
+  options.accuracy = geometry::parse_accuracy(accuracy);
+  options.shape = parse_name<ObjectShape>(
+      shape, {{"mesh", ObjectShape::mesh}, {"hull", ObjectShape::hull}, {"box", ObjectShape::box}},
+      "shape");
+  options.motion = parse_name<Motion>(
+      motion, {{"discrete", Motion::discrete}, {"swept", Motion::swept}}, "motion");
+  return options;
+}
+
+std::string containment_name(Containment containment) {
+  switch (containment) {
+    case Containment::none:
+      return "none";
+    case Containment::object_inside_obstacle:
+      return "object_inside_obstacle";
+    case Containment::obstacle_inside_object:
+      return "obstacle_inside_object";
+  }
+  return "?";
+}
+
+py::dict counters_dict(const StepCounters& c) {
+  py::dict d;
+  d["searched"] = c.searched;
+  d["tets_crossed"] = c.tets_crossed;
+  d["tets_visited"] = c.tets_visited;
+  d["tets_overlapping"] = c.tets_overlapping;
+  d["shards_touched"] = c.shards_touched;
+  d["shard_misses"] = c.shard_misses;
+  d["candidates"] = c.candidates;
+  d["leaves_inside_object"] = c.leaves_inside_object;
+  d["repeats"] = c.repeats;
+  d["triangle_tests"] = c.triangle_tests;
+  d["in_free_box"] = c.in_free_box;
+  d["found_free_box"] = c.found_free_box;
+  d["locate_seconds"] = c.locate_seconds;
+  d["search_seconds"] = c.search_seconds;
+  d["shard_seconds"] = c.shard_seconds;
+  d["test_seconds"] = c.test_seconds;
+  d["interior_seconds"] = c.interior_seconds;
+  d["free_box_seconds"] = c.free_box_seconds;
+  return d;
+}
+
+Object make_object(const Index& index, py::handle mesh, py::handle triangles) {
+  TriangleSoup soup =
+      triangles.is_none() ? soup_from_mesh_like(mesh, "object") : soup_from_arrays(mesh, triangles);
+  Object object;
+  py::gil_scoped_release unlocked;  // the model's BVH and hull: tens of milliseconds
+  object.flying = std::make_unique<FlyingObject>(index.index, std::move(soup));
+  return object;
+}
+
+void bind_objects(py::module_& module) {
+  bind_answers(module);
+  py::class_<Object>(module, "FlyingObject", R"(A rigid object flying through an Index (made by
+Index.object). Poses are (7,) or (K, 7) arrays of tx, ty, tz, qw, qx, qy, qz (a unit quaternion,
+as in pose files) or (4, 4) / (K, 4, 4) rigid matrices. Queries release the GIL; one object is
+used by one thread at a time (a second waits): give each thread its own object.)")
+      .def("collides", &collides, py::arg("poses"), py::kw_only(), py::arg("accuracy") = "exact",
+           py::arg("shape") = "mesh", py::arg("motion") = "discrete",
+           R"(Whether the object collides at each pose: a bool for one pose, else a (K,) bool array.
+accuracy: "exact" (default), "double_eps", "float_eps", "clearance:D" (within D counts).
+shape: "mesh" (its triangles, and its inside when closed), "hull", "box".
+motion: "discrete" (each pose alone) or "swept" (the hull of the object at the previous and
+the current pose: the poses are consecutive steps).)")
+      .def("query", &query, py::arg("pose"), py::kw_only(), py::arg("mode") = "first_hit",
+           py::arg("accuracy") = "exact", py::arg("shape") = "mesh", py::arg("motion") = "discrete",
+           py::arg("geometry") = true,
+           "One step at `pose`, with its contacts (mode \"first_hit\" or \"all_contacts\") and "
+           "counters: a QueryAnswer. geometry: also where each contact's triangles meet.")
+      .def(
+          "distance",
+          [](Object& object, py::handle pose_value, double max_distance) {
+            const PoseBatch batch{{pose_from_array(pose_value, "pose")}, true};
+            DistanceAnswer answer;
+            run_step(object, [&](FlyingObject& flying) {
+              for_each_pose(batch, "pose", [&](std::size_t, const Pose& pose) {
+                flying.distance(pose, DistanceOptions{max_distance}, answer.result);
+              });
+            });
+            return answer;
+          },
+          py::arg("pose"), py::kw_only(),
+          py::arg("max_distance") = std::numeric_limits<double>::infinity(),
+          "The distance to the environment at `pose`, its closest points and triangles, certified "
+          "by bounds: a DistanceAnswer. Beyond max_distance only \"farther\" is answered (cheap).")
+      .def("distances", &distances, py::arg("poses"), py::kw_only(),
+           py::arg("max_distance") = std::numeric_limits<double>::infinity(),
+           "distance() over (K, 7) or (K, 4, 4) poses: a structured array "
+           "(tetrapage.distance_dtype; "
+           "separation is TOUCHING, APART or FARTHER).")
+      .def(
+          "time_of_impact",
+          [](Object& object, py::handle start, py::handle end, double tolerance,
+             std::uint32_t max_iterations) {
+            const Pose from = pose_from_array(start, "start");
+            const Pose to = pose_from_array(end, "end");
+            ImpactAnswer answer;
+            run_step(object, [&](FlyingObject& flying) {
+              answer.result =
+                  flying.time_of_impact(from, to, ImpactOptions{tolerance, max_iterations});
+            });
+            return answer;
+          },
+          py::arg("start"), py::arg("end"), py::kw_only(), py::arg("tolerance") = 1e-4,
+          py::arg("max_iterations") = 10000,
+          "The first time in [0, 1] at which the object moving from `start` to `end` (translation "
+          "linear, rotation by slerp) touches the environment: an ImpactAnswer whose bracket "
+          "(free_until, contact_at] is at most `tolerance` wide.")
+      .def(
+          "world_box",
+          [](Object& object, py::handle pose_value) {
+            const Pose pose = pose_from_array(pose_value, "pose");
+            geometry::Box box;
+            run_step(object, [&](FlyingObject& flying) { box = flying.world_box(pose); });
+            return box_array({box.lo[0], box.lo[1], box.lo[2]}, {box.hi[0], box.hi[1], box.hi[2]});
+          },
+          py::arg("pose"), "The object's world box at `pose`, (2, 3).")
+      .def_property(
+          "obstacles", [](const Object& o) { return o.obstacles; }, &set_object_obstacles,
+          "The tetrapage.Obstacles merged into every query, or None.")
+      .def_property_readonly("triangles",
+                             [](const Object& o) { return o.flying->object().triangle_count(); })
+      .def_property_readonly(
+          "closed", [](const Object& o) { return o.flying->closed(); },
+          "Some component is closed (obstacles inside it are reported).");
+}
+
+}  // namespace tetrapage::python

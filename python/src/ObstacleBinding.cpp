@@ -1,0 +1,131 @@
+// tetrapage.Obstacles: parts inserted, moved and removed between steps, and index parts hidden.
+
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include "Bindings.h"
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage::python {
+
+namespace {
+
+// A change takes the overlay exclusively: no step of an object holding it runs meanwhile.
+template <class Change>
+auto change(Obstacles& obstacles, Change&& apply) {
+  py::gil_scoped_release unlocked;
+  std::unique_lock exclusive(*obstacles.lock);
+  return apply(*obstacles.overlay);
+}
+
+Obstacles obstacles_of(DynamicObstacles overlay) {
+  Obstacles obstacles;
+  obstacles.overlay = std::make_shared<DynamicObstacles>(std::move(overlay));
+  return obstacles;
+}
+
+}  // namespace
+
+void set_object_obstacles(Object& object, py::handle value) {
+  std::shared_ptr<const DynamicObstacles> overlay;
+  std::shared_ptr<std::shared_mutex> lock;
+  if (!value.is_none()) {
+    if (!py::isinstance<Obstacles>(value))
+      throw InputError("obstacles: a tetrapage.Obstacles or None is expected");
+    const Obstacles& obstacles = value.cast<const Obstacles&>();
+    overlay = obstacles.overlay;
+    lock = obstacles.lock;
+  }
+  {
+    py::gil_scoped_release unlocked;
+    std::lock_guard busy(*object.busy);
+    object.flying->set_obstacles(overlay);
+    object.obstacles_lock = lock;
+  }
+  object.obstacles = py::reinterpret_borrow<py::object>(value);
+}
+
+void bind_obstacles(py::module_& module) {
+  py::class_<Obstacles>(module, "Obstacles", R"(Obstacles that change between steps, merged into the
+queries of every object that holds them (FlyingObject.obstacles = ...): parts inserted, moved
+and removed, and parts of the index hidden. Changes wait for the steps in progress on other
+threads and hold them off while they run.)")
+      .def(py::init([](const Index& index, double cell_size) {
+             return obstacles_of(DynamicObstacles(index.index, cell_size));
+           }),
+           py::arg("index"), py::kw_only(), py::arg("cell_size") = 0.0,
+           "An empty overlay on `index` (cell_size 0: 1/64 of the model's longest side).")
+      .def(
+          "insert",
+          [](Obstacles& obstacles, py::handle mesh, py::handle pose_value, std::string name) {
+            TriangleSoup soup = soup_from_mesh_like(mesh, "mesh");
+            const Pose pose = pose_from_array(pose_value, "pose");
+            return change(obstacles, [&](DynamicObstacles& overlay) {
+              return overlay.insert(std::move(soup), pose, std::move(name));
+            });
+          },
+          py::arg("mesh"), py::arg("pose"), py::arg("name") = "",
+          "Adds a part (a Mesh or a (vertices, triangles) pair) at `pose`; returns its id (> 0), "
+          "the `dynamic_part` of its contacts.")
+      .def(
+          "move",
+          [](Obstacles& obstacles, DynamicPartId id, py::handle pose_value) {
+            const Pose pose = pose_from_array(pose_value, "pose");
+            change(obstacles, [&](DynamicObstacles& overlay) { overlay.move(id, pose); });
+          },
+          py::arg("id"), py::arg("pose"))
+      .def(
+          "remove",
+          [](Obstacles& obstacles, DynamicPartId id) {
+            change(obstacles, [&](DynamicObstacles& overlay) { overlay.remove(id); });
+          },
+          py::arg("id"))
+      .def(
+          "hide_part",
+          [](Obstacles& obstacles, std::uint32_t part) {
+            change(obstacles, [&](DynamicObstacles& overlay) { overlay.hide_part(part); });
+          },
+          py::arg("part"), "Hides a part of the index (its id in Index.parts) from every answer.")
+      .def(
+          "show_part",
+          [](Obstacles& obstacles, std::uint32_t part) {
+            change(obstacles, [&](DynamicObstacles& overlay) { overlay.show_part(part); });
+          },
+          py::arg("part"))
+      .def_property_readonly("hidden_parts",
+                             [](const Obstacles& o) {
+                               std::shared_lock shared(*o.lock);
+                               return o.overlay->hidden_parts();
+                             })
+      .def_property_readonly(
+          "parts",
+          [](const Obstacles& o) {
+            std::shared_lock shared(*o.lock);
+            std::vector<std::pair<DynamicPartId, std::string>> parts;
+            for (const auto& part : o.overlay->parts()) parts.emplace_back(part.id, part.name);
+            std::sort(parts.begin(), parts.end());
+            return parts;
+          },
+          "(id, name) of every inserted part, by id.")
+      .def("__len__",
+           [](const Obstacles& o) {
+             std::shared_lock shared(*o.lock);
+             return o.overlay->size();
+           })
+      .def(
+          "save",
+          [](Obstacles& obstacles, const std::filesystem::path& path) {
+            change(obstacles, [&](DynamicObstacles& overlay) { overlay.save(path); });
+          },
+          py::arg("path"),
+          "Writes the overlay as text (coordinates exactly), for `fly --obstacles`.")
+      .def_static(
+          "load",
+          [](const Index& index, const std::filesystem::path& path, double cell_size) {
+            py::gil_scoped_release unlocked;
+            return obstacles_of(DynamicObstacles::load(index.index, path, cell_size));
+          },
+          py::arg("index"), py::arg("path"), py::kw_only(), py::arg("cell_size") = 0.0);
+}
+
+}  // namespace tetrapage::python
