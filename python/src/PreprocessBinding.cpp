@@ -26,12 +26,23 @@ struct PreprocessArguments {
   bool interiors = false, accept_undecided = false;
 };
 
+// A whole number in [1, limit].
+std::uint64_t count_of(py::handle value, const char* what, std::uint64_t limit) {
+  if (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value)) {
+    const auto count = value.cast<long long>();
+    if (count >= 1 && std::uint64_t(count) <= limit) return std::uint64_t(count);
+  }
+  throw InputError(std::string(what) + ": " + py::repr(value).cast<std::string>() +
+                   " is not a whole number from 1 to " + std::to_string(limit));
+}
+
 PreprocessOptions options_of(const PreprocessArguments& a) {
   PreprocessOptions options;
   options.memory_bytes = memory_bytes(a.memory, options.memory_bytes);
-  if (!a.threads.is_none()) options.threads = a.threads.cast<unsigned>();
+  if (!a.threads.is_none()) options.threads = unsigned(count_of(a.threads, "threads", 4096));
   if (!a.region_triangles.is_none())
-    options.region_triangles = a.region_triangles.cast<std::size_t>();
+    options.region_triangles =
+        count_of(a.region_triangles, "region_triangles", std::uint64_t(1) << 32);
   options.shard = parse_shard_choice(a.shard);
   options.precision = parse_stored_precision(a.precision);
   options.compression = parse_chunk_compression(a.compression);

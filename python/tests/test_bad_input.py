@@ -117,7 +117,9 @@ def test_bad_preprocess_leaves_nothing(tmp_path):
     for keywords, exception in [({"shard": "octree"}, tetrapage.InputError),
                                 ({"precision": "half"}, tetrapage.InputError),
                                 ({"progress": 5}, tetrapage.InputError),
-                                ({"deflection": "-1"}, tetrapage.InputError)]:
+                                ({"deflection": "-1"}, tetrapage.InputError),
+                                ({"threads": -1}, tetrapage.InputError),
+                                ({"region_triangles": 2.5}, tetrapage.InputError)]:
         with pytest.raises(exception):
             tetrapage.preprocess(source, output, **keywords)
     with pytest.raises(tetrapage.IoError):
