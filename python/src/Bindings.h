@@ -109,4 +109,12 @@ namespace tetrapage::python {
 /// @throw InputError for anything else, or an overlay on another index.
 void set_object_obstacles(Object& object, py::handle obstacles);
 
+/// The overlay of an Obstacles and its lock, or nulls for None.
+/// @throw InputError for anything else.
+struct HeldOverlay {
+  std::shared_ptr<const DynamicObstacles> overlay;
+  std::shared_ptr<std::shared_mutex> lock;
+};
+HeldOverlay overlay_of(py::handle obstacles);
+
 }  // namespace tetrapage::python

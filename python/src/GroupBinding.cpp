@@ -125,13 +125,7 @@ index (or none: object/object questions only). Object/object answers are always 
       .def(
           "set_obstacles",
           [](Group& group, py::handle value) {
-            std::shared_ptr<const DynamicObstacles> overlay;
-            std::shared_ptr<std::shared_mutex> lock;
-            if (!value.is_none()) {
-              const Obstacles& obstacles = value.cast<const Obstacles&>();
-              overlay = obstacles.overlay;
-              lock = obstacles.lock;
-            }
+            auto [overlay, lock] = overlay_of(value);
             {
               py::gil_scoped_release unlocked;
               std::lock_guard busy(*group.busy);

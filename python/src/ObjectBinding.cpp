@@ -110,7 +110,13 @@ void run_step(Object& object, Step&& step) {
 // A bad pose in a batch is named by its row.
 template <class Query>
 void for_each_pose(const PoseBatch& batch, const char* what, Query&& query) {
+  constexpr std::size_t kPosesBetweenSignalChecks = 1 << 14;  // a few milliseconds
   for (std::size_t k = 0; k < batch.poses.size(); ++k) {
+    if (k % kPosesBetweenSignalChecks == kPosesBetweenSignalChecks - 1) {
+      // Ctrl-C stops a long batch (the GIL is taken only for the check).
+      py::gil_scoped_acquire locked;
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+    }
     try {
       query(k, batch.poses[k]);
     } catch (const InputError& error) {

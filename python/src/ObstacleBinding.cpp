@@ -24,18 +24,27 @@ Obstacles obstacles_of(DynamicObstacles overlay) {
   return obstacles;
 }
 
+// A read shares the overlay, the GIL released first: a thread that holds the overlay in a step
+// may need the GIL (to check for Ctrl-C) before it lets go.
+template <class Read>
+auto read(const Obstacles& obstacles, Read&& look) {
+  py::gil_scoped_release unlocked;
+  std::shared_lock shared(*obstacles.lock);
+  return look(static_cast<const DynamicObstacles&>(*obstacles.overlay));
+}
+
 }  // namespace
 
+HeldOverlay overlay_of(py::handle value) {
+  if (value.is_none()) return {};
+  if (!py::isinstance<Obstacles>(value))
+    throw InputError("obstacles: a tetrapage.Obstacles or None is expected");
+  const Obstacles& obstacles = value.cast<const Obstacles&>();
+  return {obstacles.overlay, obstacles.lock};
+}
+
 void set_object_obstacles(Object& object, py::handle value) {
-  std::shared_ptr<const DynamicObstacles> overlay;
-  std::shared_ptr<std::shared_mutex> lock;
-  if (!value.is_none()) {
-    if (!py::isinstance<Obstacles>(value))
-      throw InputError("obstacles: a tetrapage.Obstacles or None is expected");
-    const Obstacles& obstacles = value.cast<const Obstacles&>();
-    overlay = obstacles.overlay;
-    lock = obstacles.lock;
-  }
+  auto [overlay, lock] = overlay_of(value);
   {
     py::gil_scoped_release unlocked;
     std::lock_guard busy(*object.busy);
@@ -92,30 +101,30 @@ threads and hold them off while they run.)")
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.show_part(part); });
           },
           py::arg("part"))
-      .def_property_readonly("hidden_parts",
-                             [](const Obstacles& o) {
-                               std::shared_lock shared(*o.lock);
-                               return o.overlay->hidden_parts();
-                             })
+      .def_property_readonly(
+          "hidden_parts",
+          [](const Obstacles& o) {
+            return read(o, [](const DynamicObstacles& overlay) { return overlay.hidden_parts(); });
+          })
       .def_property_readonly(
           "parts",
           [](const Obstacles& o) {
-            std::shared_lock shared(*o.lock);
-            std::vector<std::pair<DynamicPartId, std::string>> parts;
-            for (const auto& part : o.overlay->parts()) parts.emplace_back(part.id, part.name);
-            std::sort(parts.begin(), parts.end());
-            return parts;
+            return read(o, [](const DynamicObstacles& overlay) {
+              std::vector<std::pair<DynamicPartId, std::string>> parts;
+              for (const auto& part : overlay.parts()) parts.emplace_back(part.id, part.name);
+              std::sort(parts.begin(), parts.end());
+              return parts;
+            });
           },
           "(id, name) of every inserted part, by id.")
       .def("__len__",
            [](const Obstacles& o) {
-             std::shared_lock shared(*o.lock);
-             return o.overlay->size();
+             return read(o, [](const DynamicObstacles& overlay) { return overlay.size(); });
            })
       .def(
           "save",
-          [](Obstacles& obstacles, const std::filesystem::path& path) {
-            change(obstacles, [&](DynamicObstacles& overlay) { overlay.save(path); });
+          [](const Obstacles& obstacles, const std::filesystem::path& path) {
+            read(obstacles, [&](const DynamicObstacles& overlay) { overlay.save(path); });
           },
           py::arg("path"),
           "Writes the overlay as text (coordinates exactly), for `fly --obstacles`.")
