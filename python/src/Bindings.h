@@ -105,10 +105,6 @@ py::dict counters_dict(const StepCounters& counters);
 
 namespace tetrapage::python {
 
-/// Gives `object` the overlay `obstacles` (an Obstacles, or None for none).
-/// @throw InputError for anything else, or an overlay on another index.
-void set_object_obstacles(Object& object, py::handle obstacles);
-
 /// The overlay of an Obstacles and its lock, or nulls for None.
 /// @throw InputError for anything else.
 struct HeldOverlay {
@@ -116,5 +112,20 @@ struct HeldOverlay {
   std::shared_ptr<std::shared_mutex> lock;
 };
 HeldOverlay overlay_of(py::handle obstacles);
+
+/// Gives `holder` (a wrapper with busy, obstacles_lock and obstacles, as Object) the overlay
+/// `value` (an Obstacles, or None for none), set on its C++ `runtime` between its steps.
+/// @throw InputError for anything else, or an overlay on another index.
+template <class Holder, class Runtime>
+void hold_obstacles(Holder& holder, Runtime& runtime, py::handle value) {
+  auto [overlay, lock] = overlay_of(value);
+  {
+    py::gil_scoped_release unlocked;
+    std::lock_guard busy(*holder.busy);
+    runtime.set_obstacles(overlay);
+    holder.obstacles_lock = lock;
+  }
+  holder.obstacles = py::reinterpret_borrow<py::object>(value);
+}
 
 }  // namespace tetrapage::python

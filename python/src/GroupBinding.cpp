@@ -124,16 +124,7 @@ index (or none: object/object questions only). Object/object answers are always 
            "queries on TBB's threads. Returns a GroupAnswer.")
       .def(
           "set_obstacles",
-          [](Group& group, py::handle value) {
-            auto [overlay, lock] = overlay_of(value);
-            {
-              py::gil_scoped_release unlocked;
-              std::lock_guard busy(*group.busy);
-              group.group->set_obstacles(overlay);
-              group.obstacles_lock = lock;
-            }
-            group.obstacles = py::reinterpret_borrow<py::object>(value);
-          },
+          [](Group& group, py::handle value) { hold_obstacles(group, *group.group, value); },
           py::arg("obstacles"), "Obstacles merged into every object's environment query, or None.")
       .def("__len__", [](const Group& g) { return g.group->size(); });
 }

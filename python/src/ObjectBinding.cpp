@@ -480,7 +480,8 @@ the current pose: the poses are consecutive steps).)")
           },
           py::arg("pose"), "The object's world box at `pose`, (2, 3).")
       .def_property(
-          "obstacles", [](const Object& o) { return o.obstacles; }, &set_object_obstacles,
+          "obstacles", [](const Object& o) { return o.obstacles; },
+          [](Object& o, py::handle value) { hold_obstacles(o, *o.flying, value); },
           "The tetrapage.Obstacles merged into every query, or None.")
       .def_property_readonly("triangles",
                              [](const Object& o) { return o.flying->object().triangle_count(); })

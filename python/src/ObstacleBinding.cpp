@@ -43,17 +43,6 @@ HeldOverlay overlay_of(py::handle value) {
   return {obstacles.overlay, obstacles.lock};
 }
 
-void set_object_obstacles(Object& object, py::handle value) {
-  auto [overlay, lock] = overlay_of(value);
-  {
-    py::gil_scoped_release unlocked;
-    std::lock_guard busy(*object.busy);
-    object.flying->set_obstacles(overlay);
-    object.obstacles_lock = lock;
-  }
-  object.obstacles = py::reinterpret_borrow<py::object>(value);
-}
-
 void bind_obstacles(py::module_& module) {
   py::class_<Obstacles>(module, "Obstacles", R"(Obstacles that change between steps, merged into the
 queries of every object that holds them (FlyingObject.obstacles = ...): parts inserted, moved
