@@ -316,9 +316,9 @@ void add_fly_command(CLI::App& app) {
   command->add_option("--path", args->paths, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz); one per --object, in order")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(
+      command, args->memory,
+      "Budget of the decoded shards held in memory; one above the index's shards costs no more");
   command->add_option("--accuracy", args->accuracy,
                       "exact, double_eps, float_eps (optionally :EPSILON) or clearance:D")
       ->capture_default_str();

@@ -18,7 +18,7 @@ namespace {
 
 struct FlightArguments {
   std::filesystem::path environment, index, object, output, answers, report;
-  std::string memory = "1G";
+  std::string memory;  // add_memory_option sets the default
   FlightOptions options;
 };
 
@@ -143,11 +143,7 @@ void add_generate_flight_command(CLI::App& generate) {
                       "Instead of --env: an index (.tpi), collisions decided by tetrapage's exact runtime "
                       "(for models too large for the in-core oracle, ~150 B a triangle)")
       ->check(CLI::ExistingFile);
-  command
-      ->add_option("--memory", args->memory,
-                   "Shard budget of the runtime with --index (bytes; K, M, G)")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(command, args->memory, "With --index: the runtime's budget of decoded shards");
   command->add_option("--object", args->object, "Flying object mesh (its own frame, model units)")
       ->required()
       ->check(CLI::ExistingFile);

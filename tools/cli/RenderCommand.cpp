@@ -18,7 +18,7 @@ struct RenderArguments {
   std::filesystem::path index, output, path, object, report;
   std::string colour = "kind";
   std::string size = "1200x800";
-  std::string memory = "64M";
+  std::string memory;  // add_memory_option sets the default
   double azimuth = 35, elevation = 30, zoom = 1;
   std::uint64_t max_triangles = 20'000'000;
 };
@@ -47,7 +47,7 @@ void run_render(const RenderArguments& args) {
   if (replay && (poses.empty() || args.object.empty()))
     throw InputError("--color page-ins needs the flight (--path) and the object (--object) to replay");
   CollisionIndexOptions index_options;
-  index_options.memory_budget_bytes = replay ? parse_byte_size(args.memory) : std::uint64_t(256) << 20;
+  index_options.memory_budget_bytes = parse_byte_size(args.memory);
   index_options.prefetch = replay;  // as `fly` runs the flight
   const auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   nlohmann::json flight = nlohmann::json::object();
@@ -112,9 +112,9 @@ void add_render_command(CLI::App& app) {
       ->check(CLI::IsMember({"kind", "regions", "page-ins"}))
       ->capture_default_str();
   command->add_option("--object", args->object, "Flying object (for --color page-ins)")->check(CLI::ExistingFile);
-  command->add_option("--memory", args->memory, "Shard budget of the replay (for --color page-ins)")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(
+      command, args->memory,
+      "Budget of the decoded shards (the replay's for --color page-ins: a smaller one pages more)");
   command->add_option("--size", args->size, "Image size WIDTHxHEIGHT (each side 1 to 16384 pixels)")
       ->capture_default_str()
       ->check(image_size_check());
