@@ -1,6 +1,8 @@
 // `tetrapage render`: a PNG of an index, regions coloured by shard kind, region or page-ins
 // of a flight, with the flight's path drawn.
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 
 #include "Commands.h"
@@ -14,6 +16,36 @@
 namespace tetrapage::cli {
 namespace {
 
+// The image formats render writes, by the output's extension (any case).
+struct ImageFormat {
+  const char* extension;
+  const char* name;
+  void (*write)(const std::filesystem::path&, const RgbImage&);
+};
+constexpr ImageFormat kImageFormats[] = {{".png", "PNG", write_png}};
+
+// "PNG (.png)", for the help and the refusal.
+std::string written_formats() {
+  std::string list;
+  for (const ImageFormat& format : kImageFormats)
+    list += std::string(list.empty() ? "" : ", ") + format.name + " (" + format.extension + ")";
+  return list;
+}
+
+// The format `output` names, or an InputError naming the path and the formats render writes:
+// a picture is written in the format its name promises, never in another under that name.
+const ImageFormat& image_format(const std::filesystem::path& output) {
+  std::string extension = output.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  for (const ImageFormat& format : kImageFormats)
+    if (extension == format.extension) return format;
+  throw InputError("render: cannot write '" + output.string() + "': " +
+                   (extension.empty() ? std::string("it has no extension")
+                                      : "unknown extension '" + extension + "'") +
+                   "; render writes " + written_formats());
+}
+
 struct RenderArguments {
   std::filesystem::path index, output, path, object, report;
   std::string colour = "kind";
@@ -25,6 +57,7 @@ struct RenderArguments {
 
 void run_render(const RenderArguments& args) {
   // Before the work: a picture that cannot be written is known now, not after the render.
+  const ImageFormat& format = image_format(args.output);
   check_outputs_writable({args.output, args.report}, {args.index, args.path, args.object});
   RenderOptions options;
   if (std::sscanf(args.size.c_str(), "%zux%zu", &options.width, &options.height) != 2)
@@ -73,7 +106,7 @@ void run_render(const RenderArguments& args) {
   }
   RenderSummary summary;
   const RgbImage image = render_model(*index, options, summary);
-  write_png(args.output, image);
+  format.write(args.output, image);
   std::printf("%s: %zux%zu, %llu triangles drawn%s from %llu shards, %.1f %% of pixels on the model, %.2f s\n",
               args.output.string().c_str(), image.width, image.height, (unsigned long long)summary.triangles_drawn,
               summary.stride > 1 ? (" (every " + std::to_string(summary.stride) + "th)").c_str() : "",
@@ -105,7 +138,10 @@ void add_render_command(CLI::App& app) {
       "(--color page-ins replays --path with --object under --memory; grey: never), with the\n"
       "flight's path drawn in magenta (faint where hidden; start green, end red).");
   command->add_option("index", args->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
-  command->add_option("-o,--output", args->output, "PNG to write")->required();
+  command
+      ->add_option("-o,--output", args->output,
+                   "Image to write, in the format its extension names: " + written_formats())
+      ->required();
   command->add_option("--path", args->path, "Pose file of a flight to draw (CSV tx,ty,tz,qw,qx,qy,qz)")
       ->check(CLI::ExistingFile);
   command->add_option("--color", args->colour, "kind, regions or page-ins")
