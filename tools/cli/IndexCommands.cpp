@@ -221,9 +221,9 @@ void run_inspect(const InspectArguments& args) {
                           {"rtree_shards", kinds[1]},
                           {"shard_stored_bytes", stored},
                           {"shard_decoded_bytes", decoded},
-                          {"max_rounding_distance", header.max_rounding_distance},
                           {"components", interiors.json},
                           {"model", part_json}};
+    if (header.precision == "float") report["max_rounding_distance"] = header.max_rounding_distance;
     if (stabbing) {
       report["stabbing_segments"] = stabbing->segments;
       report["stabbing_number_walk"] = stabbing->walk;

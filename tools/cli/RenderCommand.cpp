@@ -83,7 +83,7 @@ void run_render(const RenderArguments& args) {
   index_options.memory_budget_bytes = parse_byte_size(args.memory);
   index_options.prefetch = replay;  // as `fly` runs the flight
   const auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
-  nlohmann::json flight = nlohmann::json::object();
+  nlohmann::json flight;  // the replay's figures (--color page-ins)
   if (replay) {
     FlyingObject object(index, read_mesh(args.object));
     Progress progress("replaying the flight", poses.size());
@@ -98,9 +98,13 @@ void run_render(const RenderArguments& args) {
     const auto counters = index->cache().counters();
     std::uint64_t touched = 0;
     for (const auto n : options.page_ins) touched += n > 0;
-    flight = {{"poses", poses.size()},         {"collisions", collisions},
-              {"budget", args.memory},         {"page_ins", counters.page_ins},
-              {"shards_paged_in", touched},    {"bytes_read", counters.bytes_loaded}};
+    flight = {{"poses", poses.size()},
+              {"collisions", collisions},
+              {"budget", args.memory},
+              {"budget_bytes", index_options.memory_budget_bytes},
+              {"page_ins", counters.page_ins},
+              {"shards_paged_in", touched},
+              {"bytes_read", counters.bytes_loaded}};
     std::fprintf(stderr, "flight: %zu poses, %llu page-ins of %llu shards under %s\n", poses.size(),
                  (unsigned long long)counters.page_ins, (unsigned long long)touched, args.memory.c_str());
   }
@@ -112,19 +116,21 @@ void run_render(const RenderArguments& args) {
               summary.stride > 1 ? (" (every " + std::to_string(summary.stride) + "th)").c_str() : "",
               (unsigned long long)summary.shards, 100.0 * double(summary.pixels_hit) / double(image.width * image.height),
               summary.seconds);
-  if (!args.report.empty())
-    write_report(args.report, {{"command", "render"},
-                               {"index", args.index.string()},
-                               {"output", args.output.string()},
-                               {"colour", args.colour},
-                               {"width", image.width},
-                               {"height", image.height},
-                               {"shards", summary.shards},
-                               {"triangles_drawn", summary.triangles_drawn},
-                               {"stride", summary.stride},
-                               {"pixels_hit", summary.pixels_hit},
-                               {"seconds", summary.seconds},
-                               {"flight", flight}});
+  if (!args.report.empty()) {
+    nlohmann::json report{{"command", "render"},
+                          {"index", args.index.string()},
+                          {"output", args.output.string()},
+                          {"colour", args.colour},
+                          {"width", image.width},
+                          {"height", image.height},
+                          {"shards", summary.shards},
+                          {"triangles_drawn", summary.triangles_drawn},
+                          {"stride", summary.stride},
+                          {"pixels_hit", summary.pixels_hit},
+                          {"seconds", summary.seconds}};
+    if (replay) report["flight"] = flight;
+    write_report(args.report, report);
+  }
 }
 
 }  // namespace
