@@ -43,4 +43,11 @@ std::string format_byte_size(std::uint64_t bytes) {
   return text;
 }
 
+std::string byte_size_text(std::uint64_t bytes) {
+  static const char suffixes[] = {'k', 'M', 'G', 'T'};
+  int unit = -1;
+  while (unit < 3 && bytes != 0 && bytes % 1024 == 0) bytes /= 1024, ++unit;
+  return unit < 0 ? std::to_string(bytes) : std::to_string(bytes) + suffixes[unit];
+}
+
 }  // namespace tetrapage

@@ -170,8 +170,13 @@ std::string PreprocessSummary::to_json() const {
   j["files_read"] = files_read;
   j["parts"] = parts;
   j["length_unit"] = length_unit;
-  j["tessellation_deflection"] = tessellation_deflection;
-  j["skipped_parts"] = skipped_parts;
+  // Keys about a feature the run did not use are left out, not written as zeros: tessellation
+  // (STEP or IGES input), rounding (float storage), shards in floats (not under double), and
+  // the interiors' figures (stored).
+  if (tessellation_deflection > 0 || !skipped_parts.empty()) {
+    j["tessellation_deflection"] = tessellation_deflection;
+    j["skipped_parts"] = skipped_parts;
+  }
   j["triangles_read"] = triangles_read;
   j["degenerate_dropped"] = degenerate_dropped;
   j["region_triangles"] = region_triangles;
@@ -188,15 +193,17 @@ std::string PreprocessSummary::to_json() const {
   j["bytes_per_triangle"] = triangles_read ? double(bytes_written) / double(triangles_read) : 0.0;
   j["precision"] = precision;
   j["compression"] = compression;
-  j["max_rounding_distance"] = max_rounding_distance;
-  j["float_shards"] = float_shards;
+  if (precision == "float") j["max_rounding_distance"] = max_rounding_distance;
+  if (precision != "double") j["float_shards"] = float_shards;
   j["query_extent"] = query_extent;
   j["memory_budget_bytes"] = memory_budget_bytes;
   j["components"] = components;
   j["closed_components"] = closed_components;
   j["interiors"] = interiors;
-  j["interior_tets"] = interior_tets;
-  j["interior_undecided"] = interior_undecided;
+  if (interiors.starts_with("stored")) {
+    j["interior_tets"] = interior_tets;
+    j["interior_undecided"] = interior_undecided;
+  }
   j["buckets"] = buckets;
   j["spilled"] = spilled;
   j["stale_temporaries_removed"] = stale_temporaries_removed;

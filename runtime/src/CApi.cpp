@@ -17,6 +17,7 @@
 #include <utility>
 
 #include "CApiSupport.h"
+#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/runtime/CollisionIndex.h"
@@ -24,6 +25,11 @@
 #include "tetrapage/runtime/geometry/Accuracy.h"
 
 using namespace tetrapage::capi;
+
+// A C header cannot read the C++ constant: the macro restates it, and this keeps them equal.
+static_assert(
+    TETRAPAGE_DEFAULT_BUDGET_BYTES == tetrapage::kDefaultMemoryBudget,
+    "tetrapage.h's TETRAPAGE_DEFAULT_BUDGET_BYTES must equal ByteSize.h's kDefaultMemoryBudget");
 
 namespace {
 

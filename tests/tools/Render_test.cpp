@@ -1,17 +1,21 @@
 // tetrapage render: the PNG encoding round-trips (and a corrupted file is refused), and the
 // picture of a box seen face-on covers exactly the square that perspective projection predicts
-// (an analytic oracle), with the flight path drawn over it; bad requests are clear errors.
+// (an analytic oracle), with the flight path drawn over it; bad requests are clear errors, and
+// the file written is in the format its extension names (or none is written).
 
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
 
 #include "BoxSoup.h"
+#include "RunCli.h"
+#include "TestFiles.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
@@ -127,6 +131,44 @@ TEST(Render, BadRequestsAreClearErrors) {
                               (folder.path / "x.png").string() + " --color page-ins 2>/dev/null";
   EXPECT_NE(std::system(command.c_str()), 0);
   EXPECT_FALSE(fs::exists(folder.path / "x.png"));
+}
+
+// The picture's format follows its extension: a .png file (any case) starts with PNG's
+// signature and decodes; any other extension, or none, is refused before the work with one line
+// naming the path and what render writes, and leaves no file (nor the report).
+TEST(Render, WritesTheFormatItsExtensionNamesOrRefuses) {
+  Folder folder;
+  TriangleSoup soup;
+  test::add_box(soup, {0, 0, 0}, {1, 1, 1});
+  write_mesh(folder.path / "box.ply", soup);
+  preprocess({folder.path / "box.ply"}, folder.path / "box.tpi", PreprocessOptions{});
+  const std::string render = "render box.tpi --size 40x30 --report r.json -o ";
+  const unsigned char png_signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  for (const char* name : {"view.png", "VIEW.PNG"}) {
+    const test::CliResult run = test::run_cli_in(folder.path, render + name);
+    ASSERT_EQ(run.status, 0) << name << ": " << run.err;
+    const std::string bytes = test::file_bytes(folder.path / name);
+    ASSERT_GE(bytes.size(), 8u) << name;
+    EXPECT_EQ(std::memcmp(bytes.data(), png_signature, 8), 0)
+        << name << " does not start with PNG's signature";
+    const RgbImage image = read_png(folder.path / name);
+    EXPECT_EQ(image.width, 40u);
+    EXPECT_EQ(image.height, 30u);
+    fs::remove(folder.path / "r.json");
+  }
+  for (const char* name : {"view.jpg", "view", "view.ppm", "view.png.bak", "view.svg"}) {
+    const test::CliResult run = test::run_cli_in(folder.path, render + name);
+    EXPECT_EQ(run.status, 1) << name;
+    EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << "one line: " << run.err;
+    EXPECT_NE(run.err.find(std::string("'") + name + "'"), std::string::npos)
+        << "names the path: " << run.err;
+    EXPECT_NE(run.err.find("PNG (.png)"), std::string::npos)
+        << "names the formats written: " << run.err;
+    EXPECT_FALSE(fs::exists(folder.path / name)) << name;
+    EXPECT_FALSE(fs::exists(folder.path / "r.json")) << name;
+    for (const auto& entry : fs::directory_iterator(folder.path))
+      EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
 }
 
 }  // namespace

@@ -14,6 +14,10 @@ namespace tetrapage::cli {
 /// A CLI11 check that an option is a byte size (parse_byte_size: "64M", "1G", "1048576"), so
 /// that a bad value is a command-line mistake (exit 2) found before any work.
 CLI::Validator byte_size_check();
+/// Adds `--memory SIZE` to `command`, defaulting to kDefaultMemoryBudget (ByteSize.h) in
+/// `memory`: `purpose` says what it bounds, and the help adds the default and how sizes are
+/// written, so that every command states both the same way.
+CLI::Option* add_memory_option(CLI::App* command, std::string& memory, const std::string& purpose);
 /// A CLI11 check that a whole number lies in [lowest, highest], with a message that names the
 /// range as written (CLI11's own prints the type's limits).
 CLI::Validator whole_number_check(long long lowest, long long highest);

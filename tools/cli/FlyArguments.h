@@ -23,7 +23,7 @@ struct FlyArguments {
   std::string object_unit;
   double object_scale = 1.0;
   TessellationArguments tessellation;
-  std::string memory = "256M";
+  std::string memory;  // add_memory_option sets the default
   std::string accuracy = "exact";
   std::string query = "collide";
   double max_distance = std::numeric_limits<double>::infinity();

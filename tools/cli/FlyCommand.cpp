@@ -125,12 +125,18 @@ class QueryStep {
                     (unsigned long long)impacts_[2], double(iterations_) / double(std::max<std::size_t>(1, steps)));
     return text;
   }
+  /// Whether each step runs the collision query, whose result, contacts and counters the
+  /// summary adds up (distance and toi answer through their own results).
+  bool collision_query() const {
+    return query_ == FlyQuery::collide || query_ == FlyQuery::contacts;
+  }
+  /// The report's figures of distance and toi (null for the collision queries, which have none).
   nlohmann::json report() const {
     if (query_ == FlyQuery::distance)
       return {{"touching", separations_[0]}, {"apart", separations_[1]}, {"farther", separations_[2]}};
     if (query_ == FlyQuery::time_of_impact)
       return {{"hits", impacts_[1]}, {"none", impacts_[0]}, {"unresolved", impacts_[2]}, {"distance_queries", iterations_}};
-    return nlohmann::json::object();
+    return nullptr;
   }
 
  private:
@@ -217,10 +223,16 @@ void run_fly(const FlyArguments& args) {
   const double lookups = double(cache.hits + cache.misses);
   const double hit_rate = lookups > 0 ? double(cache.hits) / lookups : 1.0;
   const double steps = std::max<double>(1, double(poses.size()));
-  std::printf("fly (%s, %s, %s): %zu steps, %llu collisions (%llu by containment: one body inside the other)%s\n",
-              fly_query_name(step.query()), args.accuracy.c_str(), args.no_prefetch ? "no prefetch" : "prefetch", poses.size(),
-              (unsigned long long)collisions, (unsigned long long)containments,
-              index->has_interiors() ? "" : "; the index has no interiors: objects inside obstacles go unseen");
+  const std::string by_containment =
+      step.collision_query()
+          ? " (" + std::to_string(containments) + " by containment: one body inside the other)"
+          : "";
+  std::printf("fly (%s, %s, %s): %zu steps, %llu collisions%s%s\n", fly_query_name(step.query()),
+              args.accuracy.c_str(), args.no_prefetch ? "no prefetch" : "prefetch", poses.size(),
+              (unsigned long long)collisions, by_containment.c_str(),
+              index->has_interiors()
+                  ? ""
+                  : "; the index has no interiors: objects inside obstacles go unseen");
   std::printf("%s\n", storage_statement(index->header()).c_str());
   std::printf("%.0f steps/s, latency p50 %.1f us, p95 %.1f us, p99 %.1f us, max %.1f us; open to first answer %.1f ms\n",
               steps_per_second, latency.p50_us, latency.p95_us, latency.p99_us, latency.max_us,
@@ -230,9 +242,11 @@ void run_fly(const FlyArguments& args) {
               format_byte_size(cache.peak_resident_bytes).c_str(), format_byte_size(index_options.memory_budget_bytes).c_str(),
               format_byte_size(index->total_shard_bytes()).c_str(), (unsigned long long)cache.page_ins,
               format_byte_size(cache.bytes_loaded).c_str(), hit_rate, cache.page_in_p50_us, cache.page_in_p99_us);
-  std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; peak RSS %s\n",
-              double(tets_visited) / steps, double(shards_touched) / steps, double(candidates) / steps,
-              double(triangle_tests) / steps, format_byte_size(peak_resident_bytes()).c_str());
+  if (step.collision_query())
+    std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; ",
+                double(tets_visited) / steps, double(shards_touched) / steps,
+                double(candidates) / steps, double(triangle_tests) / steps);
+  std::printf("peak RSS %s\n", format_byte_size(peak_resident_bytes()).c_str());
   if (const std::string summary = step.summary(poses.size()); !summary.empty()) std::printf("%s\n", summary.c_str());
   if (step.query() == FlyQuery::collide && !args.answers.empty()) write_answers(args.answers, answers);
   step.commit();
@@ -240,48 +254,63 @@ void run_fly(const FlyArguments& args) {
     contact_file->commit();
     std::printf("contacts: %llu rows written to %s\n", (unsigned long long)contact_file->rows(), args.contacts.c_str());
   }
-  if (!args.report.empty())
-    write_report(args.report, {{"command", "fly"},
-                               {"index", args.index.string()},
-                               {"accuracy", args.accuracy},
-                               {"query", fly_query_name(step.query())},
-                               {"query_answers", step.report()},
-                               {"prefetch", !args.no_prefetch},
-                               {"prefetch_ahead", !args.no_prefetch && args.prefetch_ahead},
-                               {"shard_arena", !args.no_shard_arena},
-                               {"spin_before_sleep_us", args.spin_before_sleep_us},
-                               {"preloaded", args.preload},
-                               {"preload_seconds", preload_seconds},
-                               {"steps", poses.size()},
-                               {"collisions", collisions},
-                               {"containments", containments},
-                               {"index_has_interiors", index->has_interiors()},
-                               {"precision", index->header().precision},
-                               {"max_rounding_distance", index->header().max_rounding_distance},
-                               {"answers_exact_for", index->header().precision == "float" ? "rounded model" : "input"},
-                               {"contacts", contacts},
-                               {"contact_rows_written", contact_file ? contact_file->rows() : 0},
-                               {"steps_outside_model", outside},
-                               {"steps_per_second", steps_per_second},
-                               {"latency_us", latency.to_json()},
-                               {"open_to_first_answer_ms", first_answer_seconds * 1e3},
-                               {"budget_bytes", index_options.memory_budget_bytes},
-                               {"index_shard_bytes", index->total_shard_bytes()},
-                               {"peak_resident_shard_bytes", cache.peak_resident_bytes},
-                               {"peak_rss_bytes", peak_resident_bytes()},
-                               {"page_ins", cache.page_ins},
-                               {"bytes_read", cache.bytes_loaded},
-                               {"bytes_read_per_step", double(cache.bytes_loaded) / steps},
-                               {"cache_hit_rate", hit_rate},
-                               {"prefetch_loads", cache.prefetch_loads},
-                               {"prefetch_hits", cache.prefetch_hits},
-                               {"page_in_latency_us", {{"p50", cache.page_in_p50_us}, {"p99", cache.page_in_p99_us},
-                                                       {"max", cache.page_in_max_us}}},
-                               {"per_step", {{"tets_visited", double(tets_visited) / steps},
-                                             {"shards_touched", double(shards_touched) / steps},
-                                             {"candidates", double(candidates) / steps},
-                                             {"triangle_tests", double(triangle_tests) / steps}}},
-                               {"disagreements", check.disagreements()}});
+  if (!args.report.empty()) {
+    // Keys about a feature the run did not use are left out, not written as zeros.
+    nlohmann::json report{
+        {"command", "fly"},
+        {"index", args.index.string()},
+        {"accuracy", args.accuracy},
+        {"query", fly_query_name(step.query())},
+        {"prefetch", !args.no_prefetch},
+        {"shard_arena", !args.no_shard_arena},
+        {"spin_before_sleep_us", args.spin_before_sleep_us},
+        {"preloaded", args.preload},
+        {"steps", poses.size()},
+        {"collisions", collisions},
+        {"index_has_interiors", index->has_interiors()},
+        {"precision", index->header().precision},
+        {"answers_exact_for", index->header().precision == "float" ? "rounded model" : "input"},
+        {"steps_per_second", steps_per_second},
+        {"latency_us", latency.to_json()},
+        {"open_to_first_answer_ms", first_answer_seconds * 1e3},
+        {"budget_bytes", index_options.memory_budget_bytes},
+        {"index_shard_bytes", index->total_shard_bytes()},
+        {"peak_resident_shard_bytes", cache.peak_resident_bytes},
+        {"peak_rss_bytes", peak_resident_bytes()},
+        {"page_ins", cache.page_ins},
+        {"bytes_read", cache.bytes_loaded},
+        {"bytes_read_per_step", double(cache.bytes_loaded) / steps},
+        {"cache_hit_rate", hit_rate},
+        {"page_in_latency_us",
+         {{"p50", cache.page_in_p50_us},
+          {"p99", cache.page_in_p99_us},
+          {"max", cache.page_in_max_us}}}};
+    if (index->header().precision == "float")
+      report["max_rounding_distance"] = index->header().max_rounding_distance;
+    if (!args.no_prefetch) {
+      report["prefetch_ahead"] = args.prefetch_ahead;
+      report["prefetch_loads"] = cache.prefetch_loads;
+      report["prefetch_hits"] = cache.prefetch_hits;
+    }
+    if (args.preload) report["preload_seconds"] = preload_seconds;
+    if (step.collision_query()) {
+      report["containments"] = containments;
+      report["contacts"] = contacts;
+      report["steps_outside_model"] = outside;
+      report["per_step"] = {{"tets_visited", double(tets_visited) / steps},
+                            {"shards_touched", double(shards_touched) / steps},
+                            {"candidates", double(candidates) / steps},
+                            {"triangle_tests", double(triangle_tests) / steps}};
+    } else {
+      report["query_answers"] = step.report();
+    }
+    if (contact_file) report["contact_rows_written"] = contact_file->rows();
+    if (const auto& obstacles = object.obstacles())
+      report["obstacles"] = {{"dynamic_parts", obstacles->size()},
+                             {"hidden_index_parts", obstacles->hidden_parts().size()}};
+    if (check.checking()) report["disagreements"] = check.disagreements();
+    write_report(args.report, report);
+  }
   check.finish();
 }
 
@@ -316,9 +345,9 @@ void add_fly_command(CLI::App& app) {
   command->add_option("--path", args->paths, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz); one per --object, in order")
       ->required()
       ->check(CLI::ExistingFile);
-  command->add_option("--memory", args->memory, "Budget for resident shards (e.g. 64M, 1G)")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(
+      command, args->memory,
+      "Budget of the decoded shards held in memory; one above the index's shards costs no more");
   command->add_option("--accuracy", args->accuracy,
                       "exact, double_eps, float_eps (optionally :EPSILON) or clearance:D")
       ->capture_default_str();

@@ -18,7 +18,7 @@ namespace {
 
 struct FlightArguments {
   std::filesystem::path environment, index, object, output, answers, report;
-  std::string memory = "1G";
+  std::string memory;  // add_memory_option sets the default
   FlightOptions options;
 };
 
@@ -98,27 +98,33 @@ void run_generate_flight(const FlightArguments& args) {
       oracle ? environment.triangle_count() : std::size_t(0), read_seconds, build_seconds,
       object.triangle_count(), fly_seconds, args.output.c_str());
   if (!args.report.empty()) {
-    write_report(args.report, {{"command", "generate flight"},
-                               {"environment", args.environment.string()},
-                               {"index", args.index.string()},
-                               {"judge", oracle ? "reference oracle" : "runtime"},
-                               {"object", args.object.string()},
-                               {"seed", args.options.seed},
-                               {"steps", flight.poses.size()},
-                               {"displacement", flight.displacement},
-                               {"displacement_default", !args.options.displacement},
-                               {"max_rotation", args.options.max_rotation},
-                               {"collisions", flight.collisions},
-                               {"boundary_reversals", flight.boundary_reversals},
-                               {"start_attempts", flight.start_attempts},
-                               {"steps_per_second", steps_per_second},
-                               {"latency_us", latency.to_json()},
-                               {"environment_triangles", environment.triangle_count()},
-                               {"object_triangles", object.triangle_count()},
-                               {"read_seconds", read_seconds},
-                               {"build_seconds", build_seconds},
-                               {"flight_seconds", fly_seconds},
-                               {"peak_rss_bytes", peak_resident_bytes()}});
+    nlohmann::json report{{"command", "generate flight"},
+                          {"judge", oracle ? "reference oracle" : "runtime"},
+                          {"object", args.object.string()},
+                          {"seed", args.options.seed},
+                          {"steps", flight.poses.size()},
+                          {"displacement", flight.displacement},
+                          {"displacement_default", !args.options.displacement},
+                          {"max_rotation", args.options.max_rotation},
+                          {"collisions", flight.collisions},
+                          {"boundary_reversals", flight.boundary_reversals},
+                          {"start_attempts", flight.start_attempts},
+                          {"steps_per_second", steps_per_second},
+                          {"latency_us", latency.to_json()},
+                          {"object_triangles", object.triangle_count()},
+                          {"read_seconds", read_seconds},
+                          {"build_seconds", build_seconds},
+                          {"flight_seconds", fly_seconds},
+                          {"peak_rss_bytes", peak_resident_bytes()}};
+    // The oracle reads the environment; the runtime pages the index under --memory.
+    if (oracle) {
+      report["environment"] = args.environment.string();
+      report["environment_triangles"] = environment.triangle_count();
+    } else {
+      report["index"] = args.index.string();
+      report["budget_bytes"] = parse_byte_size(args.memory);
+    }
+    write_report(args.report, report);
   }
 }
 
@@ -143,11 +149,7 @@ void add_generate_flight_command(CLI::App& generate) {
                       "Instead of --env: an index (.tpi), collisions decided by tetrapage's exact runtime "
                       "(for models too large for the in-core oracle, ~150 B a triangle)")
       ->check(CLI::ExistingFile);
-  command
-      ->add_option("--memory", args->memory,
-                   "Shard budget of the runtime with --index (bytes; K, M, G)")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(command, args->memory, "With --index: the runtime's budget of decoded shards");
   command->add_option("--object", args->object, "Flying object mesh (its own frame, model units)")
       ->required()
       ->check(CLI::ExistingFile);

@@ -38,7 +38,7 @@ struct PreprocessArguments {
   std::vector<std::filesystem::path> inputs;
   std::filesystem::path output;
   std::size_t region_triangles = PreprocessOptions{}.region_triangles;
-  std::string memory = "1G";
+  std::string memory;  // add_memory_option sets the default
   unsigned threads = 0;
   std::string shard = "auto";
   std::string precision = "exact";
@@ -221,9 +221,9 @@ void run_inspect(const InspectArguments& args) {
                           {"rtree_shards", kinds[1]},
                           {"shard_stored_bytes", stored},
                           {"shard_decoded_bytes", decoded},
-                          {"max_rounding_distance", header.max_rounding_distance},
                           {"components", interiors.json},
                           {"model", part_json}};
+    if (header.precision == "float") report["max_rounding_distance"] = header.max_rounding_distance;
     if (stabbing) {
       report["stabbing_segments"] = stabbing->segments;
       report["stabbing_number_walk"] = stabbing->walk;
@@ -399,13 +399,12 @@ void add_index_commands(CLI::App& app) {
                       "when larger, so that the coarse mesh stays near 100k tets")
       ->capture_default_str()
       ->check(whole_number_check(0, 1ll << 30));
-  command->add_option("--memory", pre->memory,
-                      "Working-memory budget of the stages' data (e.g. 512M, 4G, at least 16M): larger models\n"
-                      "spill to disk next to the output. It bounds what the stages hold; the process itself\n"
-                      "(about 22 MiB) and each input file's soup while it is read come on top, and the summary\n"
-                      "says by how much the peak exceeded the budget")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(
+      command, pre->memory,
+      "Working-memory budget of the stages' data, at least 16M: larger models spill to disk\n"
+      "next to the output. It bounds what the stages hold; the process itself (about 22 MiB)\n"
+      "and each input file's soup while it is read come on top, and the summary says by how\n"
+      "much the peak exceeded the budget");
   command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")->capture_default_str();
   command->add_option("--shard", pre->shard, "Shard kind: auto (measured cost model), grid or rtree")
       ->capture_default_str()

@@ -24,6 +24,19 @@ CLI::Validator byte_size_check() {
       "SIZE", "byte size");
 }
 
+CLI::Option* add_memory_option(CLI::App* command, std::string& memory, const std::string& purpose) {
+  memory = byte_size_text(kDefaultMemoryBudget);
+  // A purpose written in lines (as preprocess's help is) gets the sizes on a line of their own.
+  const char* separator = purpose.find('\n') == std::string::npos ? ". " : ".\n";
+  return command
+      ->add_option("--memory", memory,
+                   purpose + separator +
+                       "Sizes as 512M or 4G: k, M, G, T are KiB, MiB, GiB, TiB (powers of 1024; "
+                       "kB, MB, GB, TB too); no suffix: bytes")
+      ->capture_default_str()
+      ->check(byte_size_check());
+}
+
 CLI::Validator whole_number_check(long long lowest, long long highest) {
   const std::string range = "a whole number from " + std::to_string(lowest) + " to " + std::to_string(highest);
   return CLI::Validator(

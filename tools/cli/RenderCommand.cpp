@@ -1,6 +1,8 @@
 // `tetrapage render`: a PNG of an index, regions coloured by shard kind, region or page-ins
 // of a flight, with the flight's path drawn.
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 
 #include "Commands.h"
@@ -14,17 +16,48 @@
 namespace tetrapage::cli {
 namespace {
 
+// The image formats render writes, by the output's extension (any case).
+struct ImageFormat {
+  const char* extension;
+  const char* name;
+  void (*write)(const std::filesystem::path&, const RgbImage&);
+};
+constexpr ImageFormat kImageFormats[] = {{".png", "PNG", write_png}};
+
+// "PNG (.png)", for the help and the refusal.
+std::string written_formats() {
+  std::string list;
+  for (const ImageFormat& format : kImageFormats)
+    list += std::string(list.empty() ? "" : ", ") + format.name + " (" + format.extension + ")";
+  return list;
+}
+
+// The format `output` names, or an InputError naming the path and the formats render writes:
+// a picture is written in the format its name promises, never in another under that name.
+const ImageFormat& image_format(const std::filesystem::path& output) {
+  std::string extension = output.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  for (const ImageFormat& format : kImageFormats)
+    if (extension == format.extension) return format;
+  throw InputError("render: cannot write '" + output.string() + "': " +
+                   (extension.empty() ? std::string("it has no extension")
+                                      : "unknown extension '" + extension + "'") +
+                   "; render writes " + written_formats());
+}
+
 struct RenderArguments {
   std::filesystem::path index, output, path, object, report;
   std::string colour = "kind";
   std::string size = "1200x800";
-  std::string memory = "64M";
+  std::string memory;  // add_memory_option sets the default
   double azimuth = 35, elevation = 30, zoom = 1;
   std::uint64_t max_triangles = 20'000'000;
 };
 
 void run_render(const RenderArguments& args) {
   // Before the work: a picture that cannot be written is known now, not after the render.
+  const ImageFormat& format = image_format(args.output);
   check_outputs_writable({args.output, args.report}, {args.index, args.path, args.object});
   RenderOptions options;
   if (std::sscanf(args.size.c_str(), "%zux%zu", &options.width, &options.height) != 2)
@@ -47,10 +80,10 @@ void run_render(const RenderArguments& args) {
   if (replay && (poses.empty() || args.object.empty()))
     throw InputError("--color page-ins needs the flight (--path) and the object (--object) to replay");
   CollisionIndexOptions index_options;
-  index_options.memory_budget_bytes = replay ? parse_byte_size(args.memory) : std::uint64_t(256) << 20;
+  index_options.memory_budget_bytes = parse_byte_size(args.memory);
   index_options.prefetch = replay;  // as `fly` runs the flight
   const auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
-  nlohmann::json flight = nlohmann::json::object();
+  nlohmann::json flight;  // the replay's figures (--color page-ins)
   if (replay) {
     FlyingObject object(index, read_mesh(args.object));
     Progress progress("replaying the flight", poses.size());
@@ -65,33 +98,39 @@ void run_render(const RenderArguments& args) {
     const auto counters = index->cache().counters();
     std::uint64_t touched = 0;
     for (const auto n : options.page_ins) touched += n > 0;
-    flight = {{"poses", poses.size()},         {"collisions", collisions},
-              {"budget", args.memory},         {"page_ins", counters.page_ins},
-              {"shards_paged_in", touched},    {"bytes_read", counters.bytes_loaded}};
+    flight = {{"poses", poses.size()},
+              {"collisions", collisions},
+              {"budget", args.memory},
+              {"budget_bytes", index_options.memory_budget_bytes},
+              {"page_ins", counters.page_ins},
+              {"shards_paged_in", touched},
+              {"bytes_read", counters.bytes_loaded}};
     std::fprintf(stderr, "flight: %zu poses, %llu page-ins of %llu shards under %s\n", poses.size(),
                  (unsigned long long)counters.page_ins, (unsigned long long)touched, args.memory.c_str());
   }
   RenderSummary summary;
   const RgbImage image = render_model(*index, options, summary);
-  write_png(args.output, image);
+  format.write(args.output, image);
   std::printf("%s: %zux%zu, %llu triangles drawn%s from %llu shards, %.1f %% of pixels on the model, %.2f s\n",
               args.output.string().c_str(), image.width, image.height, (unsigned long long)summary.triangles_drawn,
               summary.stride > 1 ? (" (every " + std::to_string(summary.stride) + "th)").c_str() : "",
               (unsigned long long)summary.shards, 100.0 * double(summary.pixels_hit) / double(image.width * image.height),
               summary.seconds);
-  if (!args.report.empty())
-    write_report(args.report, {{"command", "render"},
-                               {"index", args.index.string()},
-                               {"output", args.output.string()},
-                               {"colour", args.colour},
-                               {"width", image.width},
-                               {"height", image.height},
-                               {"shards", summary.shards},
-                               {"triangles_drawn", summary.triangles_drawn},
-                               {"stride", summary.stride},
-                               {"pixels_hit", summary.pixels_hit},
-                               {"seconds", summary.seconds},
-                               {"flight", flight}});
+  if (!args.report.empty()) {
+    nlohmann::json report{{"command", "render"},
+                          {"index", args.index.string()},
+                          {"output", args.output.string()},
+                          {"colour", args.colour},
+                          {"width", image.width},
+                          {"height", image.height},
+                          {"shards", summary.shards},
+                          {"triangles_drawn", summary.triangles_drawn},
+                          {"stride", summary.stride},
+                          {"pixels_hit", summary.pixels_hit},
+                          {"seconds", summary.seconds}};
+    if (replay) report["flight"] = flight;
+    write_report(args.report, report);
+  }
 }
 
 }  // namespace
@@ -105,16 +144,19 @@ void add_render_command(CLI::App& app) {
       "(--color page-ins replays --path with --object under --memory; grey: never), with the\n"
       "flight's path drawn in magenta (faint where hidden; start green, end red).");
   command->add_option("index", args->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
-  command->add_option("-o,--output", args->output, "PNG to write")->required();
+  command
+      ->add_option("-o,--output", args->output,
+                   "Image to write, in the format its extension names: " + written_formats())
+      ->required();
   command->add_option("--path", args->path, "Pose file of a flight to draw (CSV tx,ty,tz,qw,qx,qy,qz)")
       ->check(CLI::ExistingFile);
   command->add_option("--color", args->colour, "kind, regions or page-ins")
       ->check(CLI::IsMember({"kind", "regions", "page-ins"}))
       ->capture_default_str();
   command->add_option("--object", args->object, "Flying object (for --color page-ins)")->check(CLI::ExistingFile);
-  command->add_option("--memory", args->memory, "Shard budget of the replay (for --color page-ins)")
-      ->capture_default_str()
-      ->check(byte_size_check());
+  add_memory_option(
+      command, args->memory,
+      "Budget of the decoded shards (the replay's for --color page-ins: a smaller one pages more)");
   command->add_option("--size", args->size, "Image size WIDTHxHEIGHT (each side 1 to 16384 pixels)")
       ->capture_default_str()
       ->check(image_size_check());

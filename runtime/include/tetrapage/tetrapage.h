@@ -87,8 +87,9 @@ const char* tetrapage_status_string(tetrapage_status status);
 
 typedef struct tetrapage_index tetrapage_index;
 
-/* The budget the C++ API uses by default: 256 MiB of decoded shards. */
-#define TETRAPAGE_DEFAULT_BUDGET_BYTES ((uint64_t)256 << 20)
+/* The budget the C++ API and the command line use by default: 1 GiB of decoded shards (an
+   index whose shards are smaller never holds more than they need). */
+#define TETRAPAGE_DEFAULT_BUDGET_BYTES ((uint64_t)1 << 30)
 
 /* Opens an index file written by `tetrapage preprocess`, with a budget in bytes for the
    decoded shards held in memory (must be positive; a background thread prefetches the shards

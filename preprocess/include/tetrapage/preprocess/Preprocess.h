@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/Progress.h"
@@ -37,8 +38,9 @@ struct PreprocessOptions {
   /// Target triangles per region (the leaf size of the adaptive split of centroids); 0: auto,
   /// auto_region_triangles(triangles read).
   std::size_t region_triangles = 0;
-  /// Working-memory budget in bytes (the ingest's largest part file comes on top).
-  std::uint64_t memory_bytes = std::uint64_t(1) << 30;
+  /// Working-memory budget in bytes (the ingest's largest part file comes on top;
+  /// kDefaultMemoryBudget, ByteSize.h).
+  std::uint64_t memory_bytes = kDefaultMemoryBudget;
   /// Worker threads; 0: all cores.
   unsigned threads = 0;
   ShardChoice shard = ShardChoice::automatic;

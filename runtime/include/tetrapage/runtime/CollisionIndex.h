@@ -13,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/IndexParts.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/TetMesh.h"
@@ -25,8 +26,9 @@
 namespace tetrapage {
 
 struct CollisionIndexOptions {
-  /// The byte budget of decoded shards held in memory (never exceeded).
-  std::uint64_t memory_budget_bytes = std::uint64_t(256) << 20;
+  /// The byte budget of decoded shards held in memory (never exceeded; kDefaultMemoryBudget,
+  /// ByteSize.h).
+  std::uint64_t memory_budget_bytes = kDefaultMemoryBudget;
   /// Load the shards the motion is heading for in the background.
   bool prefetch = true;
   /// With prefetch, also hint the shards of the next region along the motion when an object

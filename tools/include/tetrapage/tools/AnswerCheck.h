@@ -17,6 +17,8 @@ class AnswerCheck {
 
   /// Counts a disagreement at `step` (the first ten are printed on stderr).
   void record(std::size_t step, bool answer);
+  /// Whether there are answers to compare with (a report states disagreements only then).
+  bool checking() const { return !path_.empty(); }
   std::uint64_t disagreements() const { return disagreements_; }
 
   /// Prints the count on stdout (when checking).

@@ -1,0 +1,21 @@
+// The program around a ```cpp block of docs/USAGE.md marked <!-- fragment -->: the block runs
+// in main() with `index` (a std::shared_ptr<const tetrapage::CollisionIndex> open on model.tpi)
+// in scope and the runtime's headers included. UsageBlocks.cmake puts the block where the
+// marker line below stands.
+#include <cstdio>
+#include <memory>
+#include <vector>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/runtime/DynamicObstacles.h"
+#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/ObjectGroup.h"
+
+int main() {
+  const auto index = std::make_shared<const tetrapage::CollisionIndex>("model.tpi");
+  {
+@USAGE_BLOCK@
+  }
+  return 0;
+}
