@@ -84,7 +84,7 @@ void bind_index(py::module_& module) {
 
   py::class_<Index>(module, "Index", R"(An index opened for queries. Shards are paged in on demand
 within `memory` (bytes, or a size such as "256M": k, M, G, T are powers of 1024; None: the
-library's default); the budget is never exceeded. Any number of objects, each used from its own
+shared default, tetrapage.DEFAULT_MEMORY (1 GiB)); the budget is never exceeded. Any number of objects, each used from its own
 thread, may share one Index.)")
       .def(py::init(&open_index), py::arg("path"), py::kw_only(), py::arg("memory") = py::none(),
            py::arg("prefetch") = true,

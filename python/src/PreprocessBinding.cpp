@@ -112,7 +112,7 @@ void bind_preprocess(py::module_& module) {
 
 inputs: a path or a list of paths. output: the index (.tpi); nothing is left there on failure.
 memory: the working-memory budget, bytes or a size ("1G"; k, M, G, T are powers of 1024);
-  None: the library's default. threads: None uses every core.
+  None: the shared default, tetrapage.DEFAULT_MEMORY (1 GiB). threads: None uses every core.
 region_triangles: triangles per region (None: automatic). shard: "auto", "grid", "rtree".
 precision: "exact" (answers exact for the input), "double", "float" (rounded: exact for the
   rounded model only). compression: "lz4" or "none". interiors: store which regions lie inside

@@ -28,6 +28,8 @@ def test_the_summary_and_the_inspection_describe_the_model(cube_index):
     assert index.memory == 64 << 20 and index.has_interiors
     assert index.precision == "exact" and info["precision"] == "exact"
     assert index.shard_bytes.sum() == index.total_shard_bytes > 0
+    # The default budget is every command's.
+    assert tetrapage.Index(cube_index).memory == tetrapage.DEFAULT_MEMORY == 1 << 30
 
 
 def test_contacts_name_the_part_and_where_the_triangles_meet(cube_index):
