@@ -37,6 +37,7 @@ install(TARGETS tetrapage_formats tetrapage_runtime tetrapage_warnings
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/formats/include/ ${PROJECT_SOURCE_DIR}/runtime/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
+install(FILES ${TETRAPAGE_VERSION_HEADER} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tetrapage)
 install(TARGETS tetrapage RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
 install(EXPORT tetrapageTargets
@@ -62,7 +63,7 @@ if(TETRAPAGE_BUILD_TESTS AND NOT TEST capi_example)
             -P ${capi_tests_source}/CApiExample.cmake)
   set_tests_properties(capi_example_index PROPERTIES FIXTURES_SETUP capi_index TIMEOUT 300)
   add_test(NAME capi_example
-    COMMAND ${CMAKE_COMMAND} -DSTEP=run -DWORK=${capi_work}
+    COMMAND ${CMAKE_COMMAND} -DSTEP=run -DWORK=${capi_work} -DVERSION=${PROJECT_VERSION}
             -DEXAMPLES=$<TARGET_FILE:tetrapage_example_c>,$<TARGET_FILE:tetrapage_example_cpp>
             -P ${capi_tests_source}/CApiExample.cmake)
   set_tests_properties(capi_example PROPERTIES FIXTURES_REQUIRED capi_index TIMEOUT 300)

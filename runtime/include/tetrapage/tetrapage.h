@@ -45,9 +45,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tetrapage/version.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Version                                                                                     */
+
+/* The library's version, "MAJOR.MINOR.PATCH": TETRAPAGE_VERSION_STRING of the release it was
+   built from, which a program compares with the TETRAPAGE_VERSION_STRING it was compiled
+   with (tetrapage/version.h) to detect a mismatched shared library. Never null. */
+const char* tetrapage_version(void);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Status codes and messages                                                                   */
