@@ -1,5 +1,6 @@
 # The examples of the C and C++ APIs, and what `cmake --install` puts in a prefix so that
-# another project can `find_package(tetrapage)` and link tetrapage::runtime.
+# another project can link tetrapage with `find_package(tetrapage)`: tetrapage::c, the C API in
+# libtetrapage.so; tetrapage::runtime, the C++ API.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -7,8 +8,9 @@ include(CMakePackageConfigHelpers)
 add_executable(tetrapage_example_c ${PROJECT_SOURCE_DIR}/runtime/examples/example.c)
 set_target_properties(tetrapage_example_c PROPERTIES C_STANDARD 11 C_STANDARD_REQUIRED ON
                                                      C_EXTENSIONS OFF)
-# The runtime is C++: linking it makes CMake use the C++ driver, which brings the C++ runtime.
-target_link_libraries(tetrapage_example_c PRIVATE tetrapage::runtime m)
+# The shared C library, as a C program outside the tree links it: with the C driver, naming
+# neither the C++ runtime nor tetrapage's dependencies (m: the example's own cos and sin).
+target_link_libraries(tetrapage_example_c PRIVATE tetrapage::c m)
 # tetrapage::warnings holds C++-only flags; the C example gets the C subset.
 target_compile_options(tetrapage_example_c PRIVATE -Wall -Wextra -Wpedantic -Wshadow
                        $<$<BOOL:${TETRAPAGE_WERROR}>:-Werror>)
@@ -20,7 +22,9 @@ target_link_libraries(tetrapage_example_cpp PRIVATE tetrapage::runtime tetrapage
 set(TETRAPAGE_INSTALL_CMAKEDIR "${CMAKE_INSTALL_LIBDIR}/cmake/tetrapage" CACHE STRING
     "Where the package configuration files go, relative to the install prefix")
 
-# Consumers see tetrapage::formats and tetrapage::runtime, the names the build tree uses.
+# Consumers see tetrapage::c, tetrapage::formats and tetrapage::runtime, the names the build
+# tree uses.
+set_target_properties(tetrapage_c PROPERTIES EXPORT_NAME c)
 set_target_properties(tetrapage_formats PROPERTIES EXPORT_NAME formats)
 set_target_properties(tetrapage_runtime PROPERTIES EXPORT_NAME runtime)
 # Static libraries carry their private links as $<LINK_ONLY:...> entries, so the export needs
@@ -34,6 +38,12 @@ install(TARGETS tetrapage_formats tetrapage_runtime tetrapage_warnings
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+# The shared C library has its own export set: it needs none of the packages the static
+# libraries need, so that a project in C alone finds it without C++ or those packages.
+install(TARGETS tetrapage_c
+        EXPORT tetrapageCTargets
+        LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
+        INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/formats/include/ ${PROJECT_SOURCE_DIR}/runtime/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
@@ -41,6 +51,9 @@ install(FILES ${TETRAPAGE_VERSION_HEADER} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR
 install(TARGETS tetrapage RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 
 install(EXPORT tetrapageTargets
+        NAMESPACE tetrapage::
+        DESTINATION ${TETRAPAGE_INSTALL_CMAKEDIR})
+install(EXPORT tetrapageCTargets
         NAMESPACE tetrapage::
         DESTINATION ${TETRAPAGE_INSTALL_CMAKEDIR})
 configure_package_config_file(${PROJECT_SOURCE_DIR}/cmake/tetrapageConfig.cmake.in
