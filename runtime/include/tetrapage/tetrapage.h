@@ -188,7 +188,8 @@ tetrapage_status tetrapage_object_destroy(tetrapage_object* object);
 /* ------------------------------------------------------------------------------------------ */
 /* Queries                                                                                     */
 
-/* How collisions are decided (see docs/USAGE.md, "Accuracy"). */
+/* How collisions are decided (docs/USAGE.md, "Index and fly": `--accuracy`; what each mode
+   costs and misses: docs/BENCHMARKS.md, "Speed against accuracy"). */
 typedef enum tetrapage_accuracy {
   /* Exact signs on the stored coordinates; touching counts. `parameter` is ignored. */
   TETRAPAGE_ACCURACY_EXACT = 0,
