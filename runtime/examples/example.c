@@ -4,8 +4,9 @@
  *
  * Opens an index, loads a flying object, and queries a few poses: those of a pose file
  * (CSV `tx,ty,tz,qw,qx,qy,qz`), or by default five points along the diagonal of the model's
- * box. Prints one line per pose (`pose K: collides` or `pose K: free`) followed by up to five of
- * its contacts, then a summary. Exits 1 with the library's message on any error.
+ * box. Prints the library's version (`tetrapage 0.1.0`), one line per pose (`pose K: collides`
+ * or `pose K: free`) followed by up to five of its contacts, then a summary. Exits 1 with the
+ * library's message on any error.
  */
 #include <math.h>
 #include <stdio.h>
@@ -91,6 +92,11 @@ int main(int argc, char** argv) {
     fprintf(stderr, "error: %s\n", tetrapage_last_error());
     return 2;
   }
+  /* A shared library may come from another release than the headers this was compiled with. */
+  printf("tetrapage %s\n", tetrapage_version());
+  if (strcmp(tetrapage_version(), TETRAPAGE_VERSION_STRING) != 0)
+    fprintf(stderr, "warning: compiled with tetrapage %s, running with %s\n",
+            TETRAPAGE_VERSION_STRING, tetrapage_version());
   if (tetrapage_open(argv[1], TETRAPAGE_DEFAULT_BUDGET_BYTES, &index) != TETRAPAGE_OK ||
       tetrapage_object_create_from_file(index, argv[2], &object) != TETRAPAGE_OK) {
     fprintf(stderr, "error: %s\n", tetrapage_last_error());

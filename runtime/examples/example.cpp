@@ -3,8 +3,9 @@
 //   tetrapage_example_cpp INDEX.tpi OBJECT.ply [POSES.csv [ACCURACY]]
 //
 // Opens an index, loads a flying object, and queries a few poses: those of a pose file, or by
-// default five points along the diagonal of the model's box. Prints one line per pose
-// (`pose K: collides` or `pose K: free`) and up to five of its contacts, then a summary.
+// default five points along the diagonal of the model's box. Prints the version it was built
+// with (`tetrapage 0.1.0`), one line per pose (`pose K: collides` or `pose K: free`) and up to
+// five of its contacts, then a summary.
 
 #include <cmath>
 #include <cstdio>
@@ -18,12 +19,14 @@
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
+#include "tetrapage/version.h"
 
 int main(int argc, char** argv) {
   if (argc < 3 || argc > 5) {
     std::cerr << "usage: " << argv[0] << " INDEX.tpi OBJECT.ply [POSES.csv [ACCURACY]]\n";
     return 2;
   }
+  std::printf("tetrapage %s\n", TETRAPAGE_VERSION_STRING);
   try {
     tetrapage::CollisionIndexOptions index_options;
     index_options.memory_budget_bytes = std::uint64_t(256) << 20;

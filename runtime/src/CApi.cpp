@@ -57,6 +57,8 @@ tetrapage::geometry::Accuracy to_accuracy(int accuracy, double parameter) {
 
 extern "C" {
 
+const char* tetrapage_version(void) { return TETRAPAGE_VERSION_STRING; }
+
 const char* tetrapage_last_error(void) { return last_error_message.c_str(); }
 
 const char* tetrapage_status_string(tetrapage_status status) {

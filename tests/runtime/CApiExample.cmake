@@ -4,6 +4,8 @@
 #               with the oracle's answers, and the index (the fixture of the other tests).
 #   STEP=run:   -DEXAMPLES=a,b -DWORK=folder    runs each example on the flight and requires its
 #               answers to equal the oracle's; also the default poses and a missing index.
+#               -DVERSION=x.y.z: each example's first line must be `tetrapage x.y.z`, with no
+#               warning that the library and the headers differ.
 
 include(${CMAKE_CURRENT_LIST_DIR}/../../cmake/RunChecked.cmake)
 
@@ -47,6 +49,12 @@ foreach(example IN LISTS examples)
                   RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT result EQUAL 0)
     message(FATAL_ERROR "${example} failed (${result}):\n${err}")
+  endif()
+  if(DEFINED VERSION)
+    string(REPLACE "." "\\." version_pattern "${VERSION}")
+    if(NOT out MATCHES "^tetrapage ${version_pattern}\n" OR err MATCHES "compiled with")
+      message(FATAL_ERROR "${example} does not begin with `tetrapage ${VERSION}`:\n${out}\n${err}")
+    endif()
   endif()
   string(REGEX MATCHALL "pose [0-9]+: (collides|free)" answers "${out}")
   list(LENGTH answers answer_count)

@@ -204,6 +204,18 @@ class CApiTest : public ::testing::Test {
   tetrapage_index* index_ = nullptr;
 };
 
+// The library reports the version its headers carry, and the macros agree with each other.
+TEST(CApiVersion, LibraryVersionIsTheHeaders) {
+  ASSERT_NE(tetrapage_version(), nullptr);
+  EXPECT_STREQ(tetrapage_version(), TETRAPAGE_VERSION_STRING);
+  EXPECT_EQ(std::to_string(TETRAPAGE_VERSION_MAJOR) + "." +
+                std::to_string(TETRAPAGE_VERSION_MINOR) + "." +
+                std::to_string(TETRAPAGE_VERSION_PATCH),
+            TETRAPAGE_VERSION_STRING);
+  EXPECT_EQ(TETRAPAGE_VERSION, TETRAPAGE_VERSION_MAJOR * 10000 + TETRAPAGE_VERSION_MINOR * 100 +
+                                   TETRAPAGE_VERSION_PATCH);
+}
+
 TEST_F(CApiTest, StatusStringsAreDistinctAndNeverNull) {
   std::set<std::string> names;
   for (int s = TETRAPAGE_OK; s <= TETRAPAGE_ERROR_STALE_HANDLE; ++s) {

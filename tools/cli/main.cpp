@@ -8,7 +8,9 @@
 
 #include "Commands.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/TemporaryFiles.h"
+#include "tetrapage/version.h"
 
 namespace {
 
@@ -36,6 +38,10 @@ int main(int argc, char** argv) {
       "and (as the pipeline grows) preprocesses assemblies into an index and flies through it."};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Show help for every subcommand");
+  // The index format beside the release: indexes open only in a build of the same format.
+  app.set_version_flag("--version", std::string("tetrapage ") + TETRAPAGE_VERSION_STRING +
+                                        " (index format " +
+                                        std::to_string(tetrapage::kIndexVersion) + ")");
 
   auto* generate = app.add_subcommand(
       "generate", "Generate the study's environments, flying objects and billiard flights");
@@ -58,6 +64,8 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     std::fprintf(stderr, "tetrapage: %s (see --help)\n", e.what());

@@ -45,9 +45,19 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "tetrapage/version.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
+
+/* ------------------------------------------------------------------------------------------ */
+/* Version                                                                                     */
+
+/* The library's version, "MAJOR.MINOR.PATCH": TETRAPAGE_VERSION_STRING of the release it was
+   built from, which a program compares with the TETRAPAGE_VERSION_STRING it was compiled
+   with (tetrapage/version.h) to detect a mismatched shared library. Never null. */
+const char* tetrapage_version(void);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Status codes and messages                                                                   */
@@ -179,7 +189,8 @@ tetrapage_status tetrapage_object_destroy(tetrapage_object* object);
 /* ------------------------------------------------------------------------------------------ */
 /* Queries                                                                                     */
 
-/* How collisions are decided (see docs/USAGE.md, "Accuracy"). */
+/* How collisions are decided (docs/USAGE.md, "Index and fly": `--accuracy`; what each mode
+   costs and misses: docs/BENCHMARKS.md, "Speed against accuracy"). */
 typedef enum tetrapage_accuracy {
   /* Exact signs on the stored coordinates; touching counts. `parameter` is ignored. */
   TETRAPAGE_ACCURACY_EXACT = 0,
