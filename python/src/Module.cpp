@@ -2,11 +2,12 @@
 
 #include "Bindings.h"
 #include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/version.h"
 
 PYBIND11_MODULE(_tetrapage, module) {
   using namespace tetrapage::python;
   module.doc() = "tetrapage: exact collision detection in huge CAD models, paged from disk.";
-  module.attr("__version__") = TETRAPAGE_PYTHON_VERSION;
+  module.attr("__version__") = TETRAPAGE_VERSION_STRING;
   // What memory=None means for Index and preprocess, as for every --memory.
   module.attr("DEFAULT_MEMORY") = tetrapage::kDefaultMemoryBudget;
   bind_errors(module);

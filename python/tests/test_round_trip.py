@@ -123,3 +123,8 @@ def test_meshes_round_trip_through_files(tmp_path):
     poses = np.array([pose(0.1, 1e-9, -3e9), [0, 0, 0, 0.5, 0.5, 0.5, 0.5]])
     tetrapage.write_poses(tmp_path / "p.csv", poses)
     np.testing.assert_array_equal(tetrapage.read_poses(tmp_path / "p.csv"), poses)
+
+
+def test_the_version_is_the_commands(tmp_path):
+    from conftest import run_cli
+    assert run_cli("--version").split()[1] == tetrapage.__version__
