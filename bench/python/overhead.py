@@ -1,6 +1,7 @@
 """The Python module's cost per call against the C++ API's, on the same index, object and flight
 (docs/BENCHMARKS.md, "From Python"). The index is preloaded in both; each pass starts a new
-object; the median pass of --repeat is reported, with the spread (min-max) over the passes.
+object (built before the clock starts); the median pass of --repeat is reported, with the
+spread (min-max) over the passes.
 
     PYTHONPATH=build/python python3 bench/python/overhead.py INDEX OBJECT FLIGHT \\
         --cpp build/bench/tetrapage_bench_query_loop [--repeat 5]
@@ -25,11 +26,13 @@ import numpy as np
 import tetrapage
 
 
-def passes(repeat, run):
+def passes(repeat, run, prepare=lambda: None):
+    """Seconds of each of `repeat` calls of run(prepare()), prepare() not timed."""
     times = []
     for _ in range(repeat):
+        prepared = prepare()
         start = time.perf_counter()
-        run()
+        run(prepared)
         times.append(time.perf_counter() - start)
     return times
 
@@ -62,43 +65,42 @@ def main():
     poses = tetrapage.read_poses(args.flight)
     rows = list(poses)  # one (7,) array per pose, as a caller's loop would hold them
 
-    def batch():
-        index.object(mesh).collides(poses)
+    def new_object():
+        return index.object(mesh)
 
-    def single():
-        obj = index.object(mesh)
+    def batch(obj):
+        obj.collides(poses)
+
+    def single(obj):
         for pose in rows:
             obj.collides(pose)
 
-    def single_query():
-        obj = index.object(mesh)
+    def single_query(obj):
         for pose in rows:
             obj.query(pose, mode="all_contacts")
 
     parts = np.array_split(poses, args.threads)  # each thread flies a stretch of the flight
+    pool = ThreadPoolExecutor(max_workers=args.threads)
+    list(pool.map(lambda part: None, parts))  # the threads started before the clock
 
-    def threads():
-        with ThreadPoolExecutor(max_workers=args.threads) as pool:
-            list(pool.map(lambda part: index.object(mesh).collides(part), parts))
+    def threads(objects):
+        list(pool.map(lambda job: job[0].collides(job[1]), zip(objects, parts)))
 
-    # A pass includes building the object (its BVH): time that alone to take it out.
-    build = statistics.median(passes(args.repeat, lambda: index.object(mesh)))
     per_pose = 1e6 / len(poses)
-    print(f"C++: {cpp_line}; object built in {1e3 * build:.2f} ms (taken out of each pass)")
+    print(f"C++: {cpp_line}")
     print()
     print("| way of asking | us per pose (median) | spread over passes | C++ us per pose | overhead us per call | ratio |")
     print("|---|---:|---:|---:|---:|---:|")
     for name, run, reference in [(f"batch of {len(poses)}: collides(poses)", batch, "collides"),
                                  ("single pose: collides(pose)", single, "collides"),
                                  ("single pose: query(pose, all_contacts)", single_query, "query")]:
-        times = [max(t - build, 0.0) * per_pose for t in passes(args.repeat, run)]
+        times = [t * per_pose for t in passes(args.repeat, run, new_object)]
         middle = statistics.median(times)
         calls = 1 if name.startswith("batch") else len(poses)
         overhead = (middle - cpp[reference]) * len(poses) / calls
         print(f"| {name} | {middle:.3f} | {min(times):.3f}-{max(times):.3f} | {cpp[reference]:.3f} | "
               f"{overhead:.3f} | {middle / cpp[reference]:.2f} |")
-    # Each thread builds its object at once: the wall time of one build is taken out.
-    times = [max(t - build, 0.0) * per_pose for t in passes(args.repeat, threads)]
+    times = [t * per_pose for t in passes(args.repeat, threads, lambda: [new_object() for _ in parts])]
     middle = statistics.median(times)
     print(f"| {args.threads} threads, one object each: collides(a stretch of the flight) | "
           f"{middle:.3f} | {min(times):.3f}-{max(times):.3f} | {cpp['collides']:.3f} | - | "
