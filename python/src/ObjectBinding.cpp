@@ -44,13 +44,17 @@ struct DistanceRecord {
   std::uint32_t dynamic_part;
 };
 
+// The step's counters and box become Python objects only when asked for: a caller stepping
+// one pose per call pays for the contacts alone.
 struct QueryAnswer {
   bool collides = false;
-  std::string containment;
+  Containment containment = Containment::none;
   std::uint32_t containing_part = 0;
   std::uint32_t containing_dynamic_part = 0;
   bool outside_model = false;
-  py::object contacts, counters, world_box;
+  py::object contacts;
+  StepCounters counters;
+  geometry::Box world_box;
 };
 
 struct DistanceAnswer {
@@ -163,13 +167,13 @@ void contact_records(FlyingObject& flying, const QueryResult& result, bool geome
 QueryAnswer answer_of(const QueryResult& result, py::array contacts) {
   QueryAnswer answer;
   answer.collides = result.collides;
-  answer.containment = containment_name(result.containment);
+  answer.containment = result.containment;
   answer.containing_part = result.containing_part;
   answer.containing_dynamic_part = result.containing_dynamic_part;
   answer.outside_model = result.outside_model;
   answer.contacts = std::move(contacts);
-  answer.counters = counters_dict(result.counters);
-  answer.world_box = box_array(result.world_box.lo, result.world_box.hi);
+  answer.counters = result.counters;
+  answer.world_box = result.world_box;
   return answer;
 }
 
@@ -263,13 +267,17 @@ contacts: structured array, one row per contact (first_hit: at most one): part, 
   share, NaN without geometry), points (6, 3), environment_normal, object_normal.
 counters: what the step did (dict). world_box: (2, 3).)")
       .def_readonly("collides", &QueryAnswer::collides)
-      .def_readonly("containment", &QueryAnswer::containment)
+      .def_property_readonly("containment",
+                             [](const QueryAnswer& a) { return containment_name(a.containment); })
       .def_readonly("containing_part", &QueryAnswer::containing_part)
       .def_readonly("containing_dynamic_part", &QueryAnswer::containing_dynamic_part)
       .def_readonly("outside_model", &QueryAnswer::outside_model)
       .def_readonly("contacts", &QueryAnswer::contacts)
-      .def_readonly("counters", &QueryAnswer::counters)
-      .def_readonly("world_box", &QueryAnswer::world_box)
+      .def_property_readonly("counters",
+                             [](const QueryAnswer& a) { return counters_dict(a.counters); })
+      .def_property_readonly(
+          "world_box",
+          [](const QueryAnswer& a) { return box_array(a.world_box.lo, a.world_box.hi); })
       .def("__bool__", [](const QueryAnswer& a) { return a.collides; })
       .def("__repr__", [](const QueryAnswer& a) {
         return std::string("<tetrapage.QueryAnswer ") + (a.collides ? "collides" : "free") + ", " +
@@ -476,7 +484,7 @@ the current pose: the poses are consecutive steps).)")
             const Pose pose = pose_from_array(pose_value, "pose");
             geometry::Box box;
             run_step(object, [&](FlyingObject& flying) { box = flying.world_box(pose); });
-            return box_array({box.lo[0], box.lo[1], box.lo[2]}, {box.hi[0], box.hi[1], box.hi[2]});
+            return box_array(box.lo, box.hi);
           },
           py::arg("pose"), "The object's world box at `pose`, (2, 3).")
       .def_property(
