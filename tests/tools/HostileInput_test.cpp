@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "RunCli.h"
 #include "tetrapage/formats/MeshWriter.h"
 #include "tetrapage/formats/Pose.h"
 #include "tetrapage/tools/TetrasGenerator.h"
@@ -24,10 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int status = -1;  ///< exit status; 128 + N when ended by signal N; -1 otherwise
-  std::string out, err;
-};
+using CliRun = test::CliResult;
 
 std::string read_file(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -36,25 +34,11 @@ std::string read_file(const fs::path& path) {
   return text.str();
 }
 
-// Runs `tetrapage ARGUMENTS` in `folder` under a 60 s timeout (a hang fails, it never blocks
-// the suite).
+// Under a 60 s timeout: a hang fails, it never blocks the suite.
 CliRun run(const fs::path& folder, const std::string& arguments) {
-  const fs::path err = folder / "stderr.txt";
-  const std::string command = "cd '" + folder.string() + "' && timeout 60 " + std::string(TETRAPAGE_CLI) + " " +
-                              arguments + " 2>'" + err.string() + "'";
-  CliRun result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return result;
-  char buffer[4096];
-  while (std::size_t n = fread(buffer, 1, sizeof buffer, pipe)) result.out.append(buffer, n);
-  const int status = pclose(pipe);
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  result.err = read_file(err);
-  fs::remove(err);
-  return result;
+  return test::run_cli_in(folder, arguments, 60);
 }
 
-// A refusal: non-zero (not the timeout's 124), one line on stderr naming `what`.
 void expect_refused(const CliRun& r, const std::string& what, int status = 1) {
   EXPECT_EQ(r.status, status) << r.err;
   ASSERT_FALSE(r.err.empty());
@@ -67,7 +51,8 @@ std::vector<std::string> leftovers(const fs::path& folder) {
   std::vector<std::string> found;
   for (const auto& entry : fs::directory_iterator(folder)) {
     const std::string name = entry.path().filename().string();
-    if (name.find(".tmp") != std::string::npos || name.find(".tetrapage-spill") != std::string::npos)
+    if (name.find(".tmp") != std::string::npos ||
+        name.find(".tetrapage-spill") != std::string::npos)
       found.push_back(name);
   }
   return found;
@@ -76,8 +61,9 @@ std::vector<std::string> leftovers(const fs::path& folder) {
 class HostileInput : public ::testing::Test {
  protected:
   void SetUp() override {
-    folder_ = fs::path(TETRAPAGE_TEST_TMP) / ("hostile-" + std::to_string(::getpid()) + "-" +
-                                              ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    folder_ = fs::path(TETRAPAGE_TEST_TMP) /
+              ("hostile-" + std::to_string(::getpid()) + "-" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::remove_all(folder_);
     fs::create_directories(folder_);
   }
@@ -110,9 +96,13 @@ TEST_F(HostileInput, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
   ASSERT_EQ(run(folder_, "generate object --triangles 4 -o object.ply").status, 0);
   write_poses(folder_ / "flight.csv", std::vector<Pose>(3));
   const std::string poses = read_file(folder_ / "flight.csv");
-  expect_refused(run(folder_, "fly model.tpi --object object.ply --path flight.csv --answers flight.csv"), "flight.csv");
-  expect_refused(run(folder_, "fly model.tpi --object object.ply --path flight.csv --answers a.csv --report a.csv"),
-                 "twice");
+  expect_refused(
+      run(folder_, "fly model.tpi --object object.ply --path flight.csv --answers flight.csv"),
+      "flight.csv");
+  expect_refused(
+      run(folder_,
+          "fly model.tpi --object object.ply --path flight.csv --answers a.csv --report a.csv"),
+      "twice");
   EXPECT_EQ(read_file(folder_ / "flight.csv"), poses);
   EXPECT_TRUE(leftovers(folder_).empty());
 }
@@ -151,7 +141,8 @@ TEST_F(HostileInput, FifosAsInputsFailAtOnce) {
   expect_refused(run(folder_, "fly model.tpi --object in.ply --path flight.csv"), "FIFO");
   expect_refused(run(folder_, "fly model.tpi --object object.ply --path in.csv"), "FIFO");
   expect_refused(run(folder_, "preprocess in.ply -o x.tpi"), "FIFO");
-  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(50)) << "nothing may wait on a FIFO";
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(50))
+      << "nothing may wait on a FIFO";
   EXPECT_FALSE(fs::exists(folder_ / "x.tpi"));
 }
 
@@ -159,7 +150,8 @@ TEST_F(HostileInput, BadOptionValuesAreCommandLineMistakes) {
   make_model("model.ply", 400);
   expect_refused(run(folder_, "preprocess model.ply -o x.tpi --memory 12Q"), "12Q", 2);
   expect_refused(run(folder_, "preprocess model.ply -o x.tpi --memory -5M"), "-5M", 2);
-  expect_refused(run(folder_, "preprocess model.ply -o x.tpi --region-triangles -1"), "from 0 to", 2);
+  expect_refused(run(folder_, "preprocess model.ply -o x.tpi --region-triangles -1"), "from 0 to",
+                 2);
   ASSERT_EQ(run(folder_, "preprocess model.ply -o model.tpi").status, 0);
   expect_refused(run(folder_, "render model.tpi -o view.png --size -5x3"), "-5x3", 2);
   expect_refused(run(folder_, "render model.tpi -o view.png --size 0x3"), "0x3", 2);
@@ -169,7 +161,8 @@ TEST_F(HostileInput, BadOptionValuesAreCommandLineMistakes) {
 
 // Coordinates whose placement or box would overflow are named, not taken for "no tet reachable".
 TEST_F(HostileInput, CoordinatesThatWouldOverflowAreNamed) {
-  std::ofstream(folder_ / "huge.obj") << "v 0 0 0\nv 1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\nf 1 2 3\nf 1 3 4\nf 1 2 4\nf 2 3 4\n";
+  std::ofstream(folder_ / "huge.obj")
+      << "v 0 0 0\nv 1e308 0 0\nv 0 1e308 0\nv 0 0 1e308\nf 1 2 3\nf 1 3 4\nf 1 2 4\nf 2 3 4\n";
   expect_refused(run(folder_, "preprocess huge.obj -o huge.tpi"), "1e+308");
   EXPECT_FALSE(fs::exists(folder_ / "huge.tpi"));
   make_model("model.ply", 400);
@@ -191,8 +184,8 @@ TEST_F(HostileInput, InterruptedAndKilledRunsLeaveNothingBehind) {
       ::chdir(folder_.c_str());
       ::freopen("/dev/null", "w", stderr);
       ::freopen("/dev/null", "w", stdout);
-      ::execl(TETRAPAGE_CLI, TETRAPAGE_CLI, "preprocess", "model.ply", "-o", "out.tpi", "--memory", "16M",
-              "--threads", "1", static_cast<char*>(nullptr));
+      ::execl(TETRAPAGE_CLI, TETRAPAGE_CLI, "preprocess", "model.ply", "-o", "out.tpi", "--memory",
+              "16M", "--threads", "1", static_cast<char*>(nullptr));
       ::_exit(127);
     }
     // Wait for the temporary index to appear (the run is then writing), then interrupt.
@@ -209,13 +202,15 @@ TEST_F(HostileInput, InterruptedAndKilledRunsLeaveNothingBehind) {
     EXPECT_FALSE(fs::exists(folder_ / "out.tpi"));
     const auto left = leftovers(folder_);
     if (signal_number == SIGKILL) {
-      EXPECT_EQ(left, std::vector<std::string>{temporary.filename().string()}) << "only the index's temporary";
+      EXPECT_EQ(left, std::vector<std::string>{temporary.filename().string()})
+          << "only the index's temporary";
       const CliRun again = run(folder_, "preprocess model.ply -o out.tpi --memory 16M");
       EXPECT_EQ(again.status, 0) << again.err;
       EXPECT_NE(again.out.find("removed 1 temporary"), std::string::npos) << again.out;
       EXPECT_TRUE(leftovers(folder_).empty());
     } else {
-      EXPECT_TRUE(left.empty()) << "signal " << signal_number << ": " << (left.empty() ? "" : left[0]);
+      EXPECT_TRUE(left.empty()) << "signal " << signal_number << ": "
+                                << (left.empty() ? "" : left[0]);
     }
   }
 }

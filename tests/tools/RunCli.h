@@ -30,11 +30,16 @@ struct CliResult {
 };
 
 /// Runs `tetrapage ARGUMENTS` in `folder` (relative paths are read there); stderr goes through
-/// `folder`/stderr.txt, removed afterwards.
-inline CliResult run_cli_in(const std::filesystem::path& folder, const std::string& arguments) {
+/// `folder`/stderr.txt, removed afterwards. With a timeout, a run still going after that many
+/// seconds is ended (status 124: a hang fails a test, it never blocks the suite).
+inline CliResult run_cli_in(const std::filesystem::path& folder, const std::string& arguments,
+                            int timeout_seconds = 0) {
   const std::filesystem::path err = folder / "stderr.txt";
-  const std::string command = "cd '" + folder.string() + "' && " + std::string(TETRAPAGE_CLI) +
-                              " " + arguments + " 2>'" + err.string() + "'";
+  const std::string limit =
+      timeout_seconds > 0 ? "timeout " + std::to_string(timeout_seconds) + " " : "";
+  const std::string command = "cd '" + folder.string() + "' && " + limit +
+                              std::string(TETRAPAGE_CLI) + " " + arguments + " 2>'" + err.string() +
+                              "'";
   CliResult result;
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
