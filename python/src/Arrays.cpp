@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "Bindings.h"
@@ -26,14 +27,18 @@ std::string dtype_text(const py::array& array) {
   return py::str(array.dtype()).cast<std::string>();
 }
 
-// Any array-like as an array; a value numpy cannot read as numbers is an InputError.
+}  // namespace
+
+// Any array-like as an array; a value numpy cannot read as numbers is an InputError. ensure()
+// does not throw: it returns a null array (the numpy error cleared) for what numpy refuses, such
+// as a ragged list, and a null array must never reach dtype() or ndim().
 py::array as_array(py::handle value, std::string_view what) {
-  try {
-    return py::array::ensure(value);
-  } catch (const py::error_already_set&) {
-  }
-  throw InputError(std::string(what) + ": not an array of numbers");
+  py::array array = py::array::ensure(value);
+  if (!array) throw InputError(std::string(what) + ": not an array of numbers");
+  return array;
 }
+
+namespace {
 
 // The array as C-ordered float64, refusing what is not real numbers (bool, complex, text, objects).
 py::array_t<double, py::array::c_style> real_array(py::handle value, std::string_view what) {
@@ -209,9 +214,14 @@ std::uint64_t memory_bytes(py::handle value, std::uint64_t default_bytes) {
   if (value.is_none()) return default_bytes;
   if (py::isinstance<py::str>(value)) return parse_byte_size(value.cast<std::string>());
   if (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value)) {
-    const auto bytes = value.cast<long long>();
-    if (bytes <= 0) throw InputError("memory: " + std::to_string(bytes) + " bytes is not a budget");
-    return std::uint64_t(bytes);
+    // Compared as Python ints: cast<long long>() of 2**63 would raise a RuntimeError that names
+    // nothing.
+    if (value.cast<py::int_>() <= py::int_(0))
+      throw InputError("memory: " + py::repr(value).cast<std::string>() + " bytes is not a budget");
+    if (value.cast<py::int_>() > py::int_(std::numeric_limits<std::uint64_t>::max()))
+      throw InputError("memory: " + py::repr(value).cast<std::string>() +
+                       " bytes is beyond 2**64 - 1");
+    return value.cast<std::uint64_t>();
   }
   throw InputError(
       "memory: give a byte count or a size such as \"256M\" (k, M, G, T: powers of 1024)");

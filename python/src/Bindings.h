@@ -51,6 +51,9 @@ struct PoseBatch {
 /// @throw InputError naming `what` for a wrong dtype or shape, a matrix that is not a rigid
 ///        motion (rotation block not orthonormal with determinant +1, last row not 0 0 0 1).
 PoseBatch poses_from_array(py::handle value, std::string_view what);
+/// Any array-like as a numpy array.
+/// @throw InputError naming `what` for what numpy cannot read as an array (a ragged list).
+py::array as_array(py::handle value, std::string_view what);
 /// Exactly one pose.
 Pose pose_from_array(py::handle value, std::string_view what);
 /// A soup of one part from (N,3) vertices (floating or integer) and (M,3) integer triangles.
@@ -77,6 +80,29 @@ void bind_obstacles(py::module_& module);
 }  // namespace tetrapage::python
 
 namespace tetrapage::python {
+
+/// The locks of one step, taken with the GIL released: its holder's (one thread at a time) and
+/// its overlay's, shared (no change meanwhile). A step's Ctrl-C check runs Python signal handlers
+/// on the step's thread with them held: a handler that steps the same holder or changes the
+/// overlay gets an InputError rather than waiting forever for its own thread, and one that steps
+/// another holder of the overlay uses the shared lock its thread already holds.
+class StepLocks {
+ public:
+  /// @throw InputError if this thread's steps hold `busy`.
+  StepLocks(std::mutex& busy, const std::shared_ptr<std::shared_mutex>& overlay);
+  ~StepLocks();
+  StepLocks(const StepLocks&) = delete;
+  StepLocks& operator=(const StepLocks&) = delete;
+
+  /// Whether a step of this thread holds `lock`.
+  static bool held(const void* lock);
+  /// @throw InputError naming `what` if a step of this thread holds `lock`.
+  static void refuse_held(const void* lock, const std::string& what);
+
+ private:
+  std::unique_lock<std::mutex> busy_;
+  std::shared_lock<std::shared_mutex> overlay_;
+};
 
 /// A flying object as Python holds it: used by one thread at a time (a second thread waits), with
 /// the overlay it reads, if any.
@@ -119,6 +145,7 @@ HeldOverlay overlay_of(py::handle obstacles);
 template <class Holder, class Runtime>
 void hold_obstacles(Holder& holder, Runtime& runtime, py::handle value) {
   auto [overlay, lock] = overlay_of(value);
+  StepLocks::refuse_held(holder.busy.get(), "obstacles");
   {
     py::gil_scoped_release unlocked;
     std::lock_guard busy(*holder.busy);

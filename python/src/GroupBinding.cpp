@@ -40,11 +40,13 @@ Group make_group(py::handle objects, py::handle index) {
       throw InputError("index: a tetrapage.Index or None is expected");
     environment = index.cast<const Index&>().index;
   }
+  // Made with the GIL held: its `obstacles` takes a reference to None, and drops it if the
+  // group's construction throws.
+  Group group;
   py::gil_scoped_release unlocked;
   std::vector<std::shared_ptr<const ObjectModel>> models;
   for (TriangleSoup& soup : soups)
     models.push_back(std::make_shared<const ObjectModel>(std::move(soup)));
-  Group group;
   group.group = std::make_unique<ObjectGroup>(environment, std::move(models));
   return group;
 }
@@ -63,9 +65,7 @@ GroupAnswer step(Group& group, py::handle poses, bool environment, bool pairs,
   GroupResult result;
   {
     py::gil_scoped_release unlocked;
-    std::lock_guard busy(*group.busy);
-    std::shared_lock<std::shared_mutex> overlay;
-    if (group.obstacles_lock) overlay = std::shared_lock(*group.obstacles_lock);
+    const StepLocks locks(*group.busy, group.obstacles_lock);
     group.group->step(batch.poses, options, result);
   }
   GroupAnswer answer;

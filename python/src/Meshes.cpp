@@ -3,6 +3,8 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <limits>
+
 #include "Bindings.h"
 #include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/MeshReader.h"
@@ -36,21 +38,44 @@ Mesh mesh_of_arrays(py::handle vertices, py::handle triangles, py::handle part_o
     if (!part_names.empty()) mesh.soup.part_names = {part_names.front()};
     return mesh;
   }
+  const py::array parts_any = as_array(part_of, "part_of");
+  const char kind = parts_any.dtype().kind();
+  // An empty list reads as float64: no id in it to be fractional.
+  if (kind != 'i' && kind != 'u' && parts_any.size() != 0)
+    throw InputError("part_of: dtype " + py::str(parts_any.dtype()).cast<std::string>() +
+                     " is not an integer type (part ids)");
+  // Ids are compared as uint64: a uint64 id beyond int64's range must not wrap to a negative one.
   const auto parts =
-      py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(part_of);
-  if (!parts || parts.ndim() != 1 || std::size_t(parts.shape(0)) != mesh.soup.triangles.size())
+      py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(parts_any);
+  if (parts.ndim() != 1 || std::size_t(parts.shape(0)) != mesh.soup.triangles.size())
     throw InputError("part_of: one integer per triangle is expected (" +
                      std::to_string(mesh.soup.triangles.size()) + ")");
-  std::int64_t largest = -1;
+  // Part ids are uint32 in the soup (a larger one would be truncated to another part's id).
+  std::uint64_t parts_needed = 0;  // the largest id + 1
   for (py::ssize_t t = 0; t < parts.shape(0); ++t) {
-    if (parts.at(t) < 0) throw InputError("part_of[" + std::to_string(t) + "] is negative");
-    largest = std::max(largest, parts.at(t));
+    const std::uint64_t id = parts.at(t);
+    if (kind == 'i' && std::int64_t(id) < 0)
+      throw InputError("part_of[" + std::to_string(t) + "] is negative");
+    if (id > std::numeric_limits<std::uint32_t>::max())
+      throw InputError("part_of[" + std::to_string(t) + "] = " + std::to_string(id) +
+                       " is beyond the largest part id " +
+                       std::to_string(std::numeric_limits<std::uint32_t>::max()));
+    parts_needed = std::max(parts_needed, id + 1);
   }
-  if (part_names.empty())
-    for (std::int64_t p = 0; p <= largest; ++p) part_names.push_back("part " + std::to_string(p));
-  if (std::int64_t(part_names.size()) <= largest)
+  if (part_names.empty()) {
+    // One made-up name per id up to the largest: without this bound an id of 2**31 would make
+    // two billion names (a hang, then an allocation failure).
+    if (parts_needed > mesh.soup.triangles.size())
+      throw InputError("part_of: part id " + std::to_string(parts_needed - 1) +
+                       " is not below the triangle count " +
+                       std::to_string(mesh.soup.triangles.size()) +
+                       " (give part_names to number parts beyond it)");
+    for (std::uint64_t p = 0; p < parts_needed; ++p)
+      part_names.push_back("part " + std::to_string(p));
+  }
+  if (part_names.size() < parts_needed)
     throw InputError("part_names: " + std::to_string(part_names.size()) +
-                     " names for part ids up to " + std::to_string(largest));
+                     " names for part ids up to " + std::to_string(parts_needed - 1));
   mesh.soup.part_names = std::move(part_names);
   mesh.soup.part_of.assign(parts.data(), parts.data() + parts.shape(0));
   return mesh;

@@ -3,6 +3,7 @@
 
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -105,11 +106,12 @@ const char* impact_name(Impact impact) {
 template <class Step>
 void run_step(Object& object, Step&& step) {
   py::gil_scoped_release unlocked;
-  std::lock_guard busy(*object.busy);
-  std::shared_lock<std::shared_mutex> overlay;
-  if (object.obstacles_lock) overlay = std::shared_lock(*object.obstacles_lock);
+  const StepLocks locks(*object.busy, object.obstacles_lock);
   step(*object.flying);
 }
+
+// The locks this thread's steps hold, innermost last (steps nest only through signal handlers).
+thread_local std::vector<const void*> locks_of_this_thread;
 
 // A bad pose in a batch is named by its row.
 template <class Query>
@@ -210,6 +212,19 @@ QueryAnswer query(Object& object, py::handle pose_value, const std::string& mode
   return answer_of(result, py::array_t<ContactRecord>(py::ssize_t(records.size()), records.data()));
 }
 
+// Whether the answer holds closest points: not when farther, nor for a containment (touching,
+// yet nothing measured: the C++ points are then zeros, which read as a point at the origin).
+bool has_points(const DistanceResult& r) {
+  return r.environment_triangle != DistanceResult::kNoTriangle ||
+         (r.separation == Separation::touching && r.containment == Containment::none);
+}
+
+// The point, or NaNs when the answer holds none.
+py::array_t<double> point_or_nan(const DistanceResult& r, const geometry::Point& point) {
+  const double nan[3] = {kNaN, kNaN, kNaN};
+  return double_array(has_points(r) ? point.data() : nan, {3});
+}
+
 DistanceRecord record_of(const DistanceResult& r) {
   DistanceRecord record{};
   record.separation = std::uint8_t(r.separation);
@@ -218,9 +233,8 @@ DistanceRecord record_of(const DistanceResult& r) {
   record.upper_bound = r.upper_bound;
   const bool measured = r.environment_triangle != DistanceResult::kNoTriangle;
   for (int a = 0; a < 3; ++a) {
-    record.on_environment[a] =
-        measured || r.separation == Separation::touching ? r.on_environment[a] : kNaN;
-    record.on_object[a] = measured || r.separation == Separation::touching ? r.on_object[a] : kNaN;
+    record.on_environment[a] = has_points(r) ? r.on_environment[a] : kNaN;
+    record.on_object[a] = has_points(r) ? r.on_object[a] : kNaN;
   }
   record.environment_triangle = measured ? std::int64_t(r.environment_triangle) : -1;
   record.environment_part = r.environment_part;
@@ -297,10 +311,12 @@ distance lies in [lower_bound, upper_bound] (certified); separation is "touching
                              [](const DistanceAnswer& a) { return a.result.upper_bound; })
       .def_property_readonly(
           "on_environment",
-          [](const DistanceAnswer& a) { return double_array(a.result.on_environment.data(), {3}); })
+          [](const DistanceAnswer& a) { return point_or_nan(a.result, a.result.on_environment); },
+          "The closest point on the environment; NaN when farther or for a containment.")
       .def_property_readonly(
           "on_object",
-          [](const DistanceAnswer& a) { return double_array(a.result.on_object.data(), {3}); })
+          [](const DistanceAnswer& a) { return point_or_nan(a.result, a.result.on_object); },
+          "The closest point on the object; NaN when farther or for a containment.")
       .def_property_readonly("environment_triangle",
                              [](const DistanceAnswer& a) {
                                return optional_triangle(
@@ -361,6 +377,33 @@ or "unresolved" (max_iterations ran out: free up to free_until).)")
 }
 
 }  // namespace
+
+StepLocks::StepLocks(std::mutex& busy, const std::shared_ptr<std::shared_mutex>& overlay) {
+  refuse_held(&busy, "this object");
+  busy_ = std::unique_lock(busy);
+  locks_of_this_thread.push_back(&busy);
+  if (overlay && !held(overlay.get())) {
+    overlay_ = std::shared_lock(*overlay);
+    locks_of_this_thread.push_back(overlay.get());
+  }
+}
+
+StepLocks::~StepLocks() {
+  locks_of_this_thread.pop_back();
+  if (overlay_.owns_lock()) locks_of_this_thread.pop_back();
+}
+
+bool StepLocks::held(const void* lock) {
+  return std::find(locks_of_this_thread.begin(), locks_of_this_thread.end(), lock) !=
+         locks_of_this_thread.end();
+}
+
+void StepLocks::refuse_held(const void* lock, const std::string& what) {
+  if (held(lock))
+    throw InputError(what +
+                     ": a query in progress on this thread holds it (a signal handler ran "
+                     "during that query); use it after the query returns");
+}
 
 QueryOptions query_options(const std::string& mode, const std::string& accuracy,
                            const std::string& shape, const std::string& motion) {

@@ -13,6 +13,7 @@ namespace {
 // A change takes the overlay exclusively: no step of an object holding it runs meanwhile.
 template <class Change>
 auto change(Obstacles& obstacles, Change&& apply) {
+  StepLocks::refuse_held(obstacles.lock.get(), "obstacles");
   py::gil_scoped_release unlocked;
   std::unique_lock exclusive(*obstacles.lock);
   return apply(*obstacles.overlay);
@@ -29,7 +30,9 @@ Obstacles obstacles_of(DynamicObstacles overlay) {
 template <class Read>
 auto read(const Obstacles& obstacles, Read&& look) {
   py::gil_scoped_release unlocked;
-  std::shared_lock shared(*obstacles.lock);
+  // A step of this thread (which ran a signal handler) may already share it.
+  std::shared_lock shared(*obstacles.lock, std::defer_lock);
+  if (!StepLocks::held(obstacles.lock.get())) shared.lock();
   return look(static_cast<const DynamicObstacles&>(*obstacles.overlay));
 }
 

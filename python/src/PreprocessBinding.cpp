@@ -12,11 +12,24 @@ namespace tetrapage::python {
 
 namespace {
 
+// `value` as a T, or an InputError naming the argument (pybind11's cast_error names neither it
+// nor the type given).
+template <class T>
+T cast_argument(py::handle value, const char* what, const char* expected) {
+  try {
+    return value.cast<T>();
+  } catch (const py::cast_error&) {
+    throw InputError(std::string(what) + ": " + py::repr(value).cast<std::string>() + " is not " +
+                     expected);
+  }
+}
+
 std::vector<std::filesystem::path> input_paths(py::handle inputs) {
   if (py::isinstance<py::str>(inputs) || py::hasattr(inputs, "__fspath__"))
-    return {inputs.cast<std::filesystem::path>()};
+    return {cast_argument<std::filesystem::path>(inputs, "inputs", "a path")};
   std::vector<std::filesystem::path> paths;
-  for (py::handle input : inputs) paths.push_back(input.cast<std::filesystem::path>());
+  for (py::handle input : inputs)
+    paths.push_back(cast_argument<std::filesystem::path>(input, "inputs", "a path"));
   return paths;
 }
 
@@ -26,12 +39,12 @@ struct PreprocessArguments {
   bool interiors = false, accept_undecided = false;
 };
 
-// A whole number in [1, limit].
+// A whole number in [1, limit] (compared as Python ints: cast<long long>() of 2**70 would raise
+// a RuntimeError that names nothing).
 std::uint64_t count_of(py::handle value, const char* what, std::uint64_t limit) {
-  if (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value)) {
-    const auto count = value.cast<long long>();
-    if (count >= 1 && std::uint64_t(count) <= limit) return std::uint64_t(count);
-  }
+  if (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value) &&
+      value.cast<py::int_>() >= py::int_(1) && value.cast<py::int_>() <= py::int_(limit))
+    return value.cast<std::uint64_t>();
   throw InputError(std::string(what) + ": " + py::repr(value).cast<std::string>() +
                    " is not a whole number from 1 to " + std::to_string(limit));
 }
@@ -46,10 +59,13 @@ PreprocessOptions options_of(const PreprocessArguments& a) {
   options.shard = parse_shard_choice(a.shard);
   options.precision = parse_stored_precision(a.precision);
   options.compression = parse_chunk_compression(a.compression);
-  if (!a.query_extent.is_none()) options.query_extent = a.query_extent.cast<double>();
-  if (!a.length_unit.is_none()) options.length_unit = a.length_unit.cast<std::string>();
+  if (!a.query_extent.is_none())
+    options.query_extent = cast_argument<double>(a.query_extent, "query_extent", "a length");
+  if (!a.length_unit.is_none())
+    options.length_unit = cast_argument<std::string>(a.length_unit, "length_unit", "a unit text");
   if (!a.spill_folder.is_none())
-    options.spill_folder = a.spill_folder.cast<std::filesystem::path>();
+    options.spill_folder =
+        cast_argument<std::filesystem::path>(a.spill_folder, "spill_folder", "a path");
   set_deflection(options.tessellation, a.deflection, "deflection");
   options.interiors = a.interiors;
   options.accept_undecided = a.accept_undecided;

@@ -8,9 +8,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <string>
 #include <map>
 #include <numbers>
+#include <string>
 
 #include "ConvexHull.h"
 #include "tetrapage/formats/Error.h"
@@ -93,16 +93,19 @@ bool zero_area(const TriangleSoup& soup, std::size_t t) {
   const auto& c = soup.vertices[soup.triangles[t][2]];
   for (int u = 0; u < 3; ++u) {
     const int v = (u + 1) % 3;
-    if (geometry::orient2d_cgal(a[u], a[v], b[u], b[v], c[u], c[v]) != geometry::Sign::zero) return false;
+    if (geometry::orient2d_cgal(a[u], a[v], b[u], b[v], c[u], c[v]) != geometry::Sign::zero)
+      return false;
   }
   return true;
 }
 
-// What the BVH does not check but placing needs: coordinates whose placement cannot overflow,
-// and some triangle with an area (a wholly degenerate object has no hull, normal or inside,
-// and its queries would fail later on NaN points).
-void check_placeable(const TriangleSoup& soup) {
-  if (const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup); beyond.found) {
+// Coordinates whose placement cannot overflow. Checked before the BVH is built: its boxes and
+// centroids overflow too for coordinates near DBL_MAX (an infinite centroid put a triangle in
+// bin INT_MIN: a crash).
+TriangleSoup within_coordinate_limit(TriangleSoup soup) {
+  // An infinite one is left to the BVH, which names every non-finite coordinate alike.
+  if (const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup);
+      beyond.found && std::isfinite(beyond.value)) {
     char text[200];
     std::snprintf(text, sizeof text,
                   "object: vertex %zu has coordinate %c = %g, beyond %g in magnitude: placing it "
@@ -110,15 +113,24 @@ void check_placeable(const TriangleSoup& soup) {
                   beyond.vertex, "xyz"[beyond.axis], beyond.value, kMaxCoordinateMagnitude);
     throw InputError(text);
   }
+  return soup;
+}
+
+// What the BVH does not check but placing needs: some triangle with an area (a wholly
+// degenerate object has no hull, normal or inside, and its queries would fail later on NaN
+// points).
+void check_placeable(const TriangleSoup& soup) {
   for (std::size_t t = 0; t < soup.triangle_count(); ++t)
     if (!zero_area(soup, t)) return;
-  throw InputError("object: all " + std::to_string(soup.triangle_count()) +
-                   " triangles have zero area (collinear or repeated corners): the object is degenerate");
+  throw InputError(
+      "object: all " + std::to_string(soup.triangle_count()) +
+      " triangles have zero area (collinear or repeated corners): the object is degenerate");
 }
 
 }  // namespace
 
-ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mesh) {
+ObjectModel::ObjectModel(TriangleSoup object)
+    : mesh(within_coordinate_limit(std::move(object))), bvh(mesh) {
   check_placeable(mesh);  // after the BVH, which checked the indices and finiteness
   for (const auto& v : mesh.vertices) {
     radius = std::max(radius, std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]));
@@ -128,13 +140,16 @@ ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mes
     double farthest = 0;
     for (int a = 0; a < 3; ++a) ball_centre[a] = 0.5 * (box.lo[a] + box.hi[a]);
     for (const auto& v : mesh.vertices) {
-      const double dx = v[0] - ball_centre[0], dy = v[1] - ball_centre[1], dz = v[2] - ball_centre[2];
+      const double dx = v[0] - ball_centre[0], dy = v[1] - ball_centre[1],
+                   dz = v[2] - ball_centre[2];
       farthest = std::max(farthest, dx * dx + dy * dy + dz * dz);
     }
     // Up by far more than the roundings of the squares and the root.
     ball_radius = std::sqrt(farthest) * (1 + 0x1p-40);
-    const double ball_volume = 4.0 / 3.0 * std::numbers::pi * ball_radius * ball_radius * ball_radius;
-    const double box_volume = (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
+    const double ball_volume =
+        4.0 / 3.0 * std::numbers::pi * ball_radius * ball_radius * ball_radius;
+    const double box_volume =
+        (box.hi[0] - box.lo[0]) * (box.hi[1] - box.lo[1]) * (box.hi[2] - box.lo[2]);
     ball_prunes = ball_volume < 0.7 * box_volume;
   }
   // The interior grid and the hull are independent: build them side by side (opening an
@@ -142,7 +157,8 @@ ObjectModel::ObjectModel(TriangleSoup object) : mesh(std::move(object)), bvh(mes
   tbb::parallel_invoke(
       [&] {
         const SurfaceComponents components = find_surface_components(mesh);
-        std::vector<std::uint32_t> closed_index(components.components.size(), ClosedComponentOf::kOpen);
+        std::vector<std::uint32_t> closed_index(components.components.size(),
+                                                ClosedComponentOf::kOpen);
         for (std::size_t c = 0; c < components.components.size(); ++c) {
           const SurfaceComponent& component = components.components[c];
           component_vertices.push_back(mesh.triangles[component.first_triangle][0]);

@@ -485,6 +485,17 @@ TEST(FlyingObject, BadObjectsPosesAndBudgetsAreRejectedUpFront) {
   expect_input_error([&] { FlyingObject(index, huge); }, {"vertex 1", "-1e+308", "overflow"});
   huge.vertices[1][2] = 1e300;  // the bound itself is accepted
   EXPECT_NO_THROW(FlyingObject(index, huge));
+  // A cube with corners at 0 and 1e308: its BVH's box sums overflowed, and the build crashed
+  // before the coordinates were checked.
+  TriangleSoup far_cube;
+  far_cube.part_names = {"object"};
+  for (double x : {0.0, 1e308})
+    for (double y : {0.0, 1e308})
+      for (double z : {0.0, 1e308}) far_cube.vertices.push_back({x, y, z});
+  far_cube.triangles = {{0, 1, 3}, {0, 3, 2}, {4, 6, 7}, {4, 7, 5}, {0, 4, 5}, {0, 5, 1},
+                        {2, 3, 7}, {2, 7, 6}, {0, 2, 6}, {0, 6, 4}, {1, 5, 7}, {1, 7, 3}};
+  far_cube.part_of.assign(far_cube.triangles.size(), 0);
+  expect_input_error([&] { FlyingObject(index, far_cube); }, {"1e+308", "overflow"});
 
   FlyingObject object(index, world.object);
   Pose far = world.flight.poses.front();
