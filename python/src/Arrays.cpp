@@ -210,6 +210,16 @@ py::array_t<double> box_array(const Vec3& lo, const Vec3& hi) {
   return double_array(values, {2, 3});
 }
 
+std::uint64_t whole_number(py::handle value, const char* what, std::uint64_t lowest,
+                           std::uint64_t highest) {
+  if (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value) &&
+      value.cast<py::int_>() >= py::int_(lowest) && value.cast<py::int_>() <= py::int_(highest))
+    return value.cast<std::uint64_t>();
+  throw InputError(std::string(what) + ": " + py::repr(value).cast<std::string>() +
+                   " is not a whole number from " + std::to_string(lowest) + " to " +
+                   std::to_string(highest));
+}
+
 std::uint64_t memory_bytes(py::handle value, std::uint64_t default_bytes) {
   if (value.is_none()) return default_bytes;
   if (py::isinstance<py::str>(value)) return parse_byte_size(value.cast<std::string>());

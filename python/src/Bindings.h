@@ -66,6 +66,10 @@ TriangleSoup soup_from_mesh_like(py::handle value, std::string_view what);
 py::array_t<double> double_array(const double* values, std::vector<py::ssize_t> shape);
 /// A (2,3) array: the box's lo and hi rows.
 py::array_t<double> box_array(const Vec3& lo, const Vec3& hi);
+/// A Python int in [lowest, highest] (compared as Python ints, so 2**70 or -1 is named, not cast).
+/// @throw InputError naming `what` and the value otherwise (a bool or a float too).
+std::uint64_t whole_number(py::handle value, const char* what, std::uint64_t lowest,
+                           std::uint64_t highest);
 /// A memory budget: None (the library's default), a byte count, or a size text ("256M").
 std::uint64_t memory_bytes(py::handle value, std::uint64_t default_bytes);
 

@@ -35,6 +35,9 @@ Mesh mesh_of_arrays(py::handle vertices, py::handle triangles, py::handle part_o
                     std::vector<std::string> part_names) {
   Mesh mesh{soup_from_arrays(vertices, triangles), {}};
   if (part_of.is_none()) {
+    if (part_names.size() > 1)
+      throw InputError("part_names: " + std::to_string(part_names.size()) +
+                       " names, but without part_of every triangle is in one part");
     if (!part_names.empty()) mesh.soup.part_names = {part_names.front()};
     return mesh;
   }
@@ -121,9 +124,11 @@ void bind_meshes(py::module_& module) {
           "bounds",
           [](const Mesh& m) {
             const BoundingBox box = m.soup.bounds();
-            return box_array(box.lo, box.hi);
+            if (!box.empty()) return box_array(box.lo, box.hi);
+            const double nan = std::numeric_limits<double>::quiet_NaN();
+            return box_array({nan, nan, nan}, {nan, nan, nan});
           },
-          "(2, 3): the lowest and highest corner of the vertices' box.")
+          "(2, 3): the lowest and highest corner of the vertices' box (NaN without vertices).")
       .def("__len__", [](const Mesh& m) { return m.soup.triangles.size(); })
       .def("__repr__", [](const Mesh& m) {
         return "<tetrapage.Mesh " + std::to_string(m.soup.triangles.size()) + " triangles, " +

@@ -506,7 +506,9 @@ the current pose: the poses are consecutive steps).)")
       .def(
           "time_of_impact",
           [](Object& object, py::handle start, py::handle end, double tolerance,
-             std::uint32_t max_iterations) {
+             py::handle max_iterations_value) {
+            const auto max_iterations =
+                std::uint32_t(whole_number(max_iterations_value, "max_iterations", 1, 0xffffffffu));
             const Pose from = pose_from_array(start, "start");
             const Pose to = pose_from_array(end, "end");
             ImpactAnswer answer;

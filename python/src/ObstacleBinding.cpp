@@ -70,26 +70,30 @@ threads and hold them off while they run.)")
           "the `dynamic_part` of its contacts.")
       .def(
           "move",
-          [](Obstacles& obstacles, DynamicPartId id, py::handle pose_value) {
+          [](Obstacles& obstacles, py::handle id_value, py::handle pose_value) {
+            const auto id = DynamicPartId(whole_number(id_value, "id", 0, 0xffffffffu));
             const Pose pose = pose_from_array(pose_value, "pose");
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.move(id, pose); });
           },
           py::arg("id"), py::arg("pose"))
       .def(
           "remove",
-          [](Obstacles& obstacles, DynamicPartId id) {
+          [](Obstacles& obstacles, py::handle id_value) {
+            const auto id = DynamicPartId(whole_number(id_value, "id", 0, 0xffffffffu));
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.remove(id); });
           },
           py::arg("id"))
       .def(
           "hide_part",
-          [](Obstacles& obstacles, std::uint32_t part) {
+          [](Obstacles& obstacles, py::handle part_value) {
+            const auto part = std::uint32_t(whole_number(part_value, "part", 0, 0xffffffffu));
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.hide_part(part); });
           },
           py::arg("part"), "Hides a part of the index (its id in Index.parts) from every answer.")
       .def(
           "show_part",
-          [](Obstacles& obstacles, std::uint32_t part) {
+          [](Obstacles& obstacles, py::handle part_value) {
+            const auto part = std::uint32_t(whole_number(part_value, "part", 0, 0xffffffffu));
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.show_part(part); });
           },
           py::arg("part"))

@@ -5,6 +5,8 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
+
 #include "Bindings.h"
 #include "tetrapage/preprocess/Preprocess.h"
 
@@ -39,28 +41,23 @@ struct PreprocessArguments {
   bool interiors = false, accept_undecided = false;
 };
 
-// A whole number in [1, limit] (compared as Python ints: cast<long long>() of 2**70 would raise
-// a RuntimeError that names nothing).
-std::uint64_t count_of(py::handle value, const char* what, std::uint64_t limit) {
-  if (py::isinstance<py::int_>(value) && !py::isinstance<py::bool_>(value) &&
-      value.cast<py::int_>() >= py::int_(1) && value.cast<py::int_>() <= py::int_(limit))
-    return value.cast<std::uint64_t>();
-  throw InputError(std::string(what) + ": " + py::repr(value).cast<std::string>() +
-                   " is not a whole number from 1 to " + std::to_string(limit));
-}
-
 PreprocessOptions options_of(const PreprocessArguments& a) {
   PreprocessOptions options;
   options.memory_bytes = memory_bytes(a.memory, options.memory_bytes);
-  if (!a.threads.is_none()) options.threads = unsigned(count_of(a.threads, "threads", 4096));
+  if (!a.threads.is_none()) options.threads = unsigned(whole_number(a.threads, "threads", 1, 4096));
   if (!a.region_triangles.is_none())
     options.region_triangles =
-        count_of(a.region_triangles, "region_triangles", std::uint64_t(1) << 32);
+        whole_number(a.region_triangles, "region_triangles", 1, std::uint64_t(1) << 32);
   options.shard = parse_shard_choice(a.shard);
   options.precision = parse_stored_precision(a.precision);
   options.compression = parse_chunk_compression(a.compression);
-  if (!a.query_extent.is_none())
+  if (!a.query_extent.is_none()) {
     options.query_extent = cast_argument<double>(a.query_extent, "query_extent", "a length");
+    // 0 is the option struct's "automatic": a caller means that with None.
+    if (!(options.query_extent > 0) || !std::isfinite(options.query_extent))
+      throw InputError("query_extent: " + std::to_string(options.query_extent) +
+                       " is not a positive length (None: 5 % of the model's largest side)");
+  }
   if (!a.length_unit.is_none())
     options.length_unit = cast_argument<std::string>(a.length_unit, "length_unit", "a unit text");
   if (!a.spill_folder.is_none())

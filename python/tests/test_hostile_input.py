@@ -197,3 +197,28 @@ def test_a_signal_handler_may_use_other_objects_and_read_the_obstacles(cube_inde
     """
     returncode, stderr = run_isolated(code, cube_index, timeout=30)
     assert returncode == 0, stderr
+
+
+def test_ids_and_counts_out_of_range_are_named(cube_index):
+    obstacles = tetrapage.Obstacles(tetrapage.Index(cube_index))
+    for call, message in [(lambda: obstacles.move(-1, [0, 0, 0, 1, 0, 0, 0]), "id: -1"),
+                          (lambda: obstacles.remove(2**40), "id: 1099511627776"),
+                          (lambda: obstacles.hide_part(2**40), "part: 1099511627776"),
+                          (lambda: obstacles.show_part(1.5), "part: 1.5")]:
+        with pytest.raises(tetrapage.InputError) as raised:
+            call()
+        assert message in str(raised.value)
+    obj = tetrapage.Index(cube_index).object(np.eye(3), [[0, 1, 2]])
+    with pytest.raises(tetrapage.InputError, match="max_iterations: 0"):
+        obj.time_of_impact([5, 5, 5, 1, 0, 0, 0], [6, 5, 5, 1, 0, 0, 0], max_iterations=0)
+
+
+def test_names_without_ids_and_an_empty_mesh(tmp_path):
+    with pytest.raises(tetrapage.InputError, match="part_names: 2 names"):
+        tetrapage.Mesh(np.eye(3), [[0, 1, 2]], part_names=["a", "b"])
+    assert np.isnan(tetrapage.Mesh(np.zeros((0, 3)), np.zeros((0, 3), dtype=int)).bounds).all()
+    source = tmp_path / "t.obj"
+    tetrapage.write_mesh(source, (np.eye(3), [[0, 1, 2]]))
+    for extent in (0.0, -1.0, float("nan")):
+        with pytest.raises(tetrapage.InputError, match="query_extent"):
+            tetrapage.preprocess(source, tmp_path / "t.tpi", query_extent=extent)
