@@ -117,7 +117,18 @@ struct Object {
   py::object obstacles = py::none();                  ///< the Obstacles it holds, or None
 };
 
-/// An object of `mesh` (a Mesh or a (vertices, triangles) pair) flying through `index`.
+/// An object's model, immutable: shared by any number of objects, obstacles and threads.
+struct Model {
+  std::shared_ptr<const ObjectModel> model;
+};
+
+/// A Model's own model, or one built (the GIL released) from a Mesh, a (vertices, triangles)
+/// pair, or `mesh` as vertices with `triangles`.
+/// @throw InputError naming `what` for anything else, and what ObjectModel throws.
+std::shared_ptr<const ObjectModel> model_of(py::handle mesh, py::handle triangles,
+                                            std::string_view what);
+
+/// An object of `mesh` (a Model, a Mesh or a (vertices, triangles) pair) flying through `index`.
 Object make_object(const Index& index, py::handle mesh, py::handle triangles);
 
 /// Query options from their names, as keyword arguments give them.

@@ -32,8 +32,8 @@ struct GroupAnswer {
 };
 
 Group make_group(py::handle objects, py::handle index) {
-  std::vector<TriangleSoup> soups;
-  for (py::handle object : objects) soups.push_back(soup_from_mesh_like(object, "objects"));
+  std::vector<std::shared_ptr<const ObjectModel>> models;
+  for (py::handle object : objects) models.push_back(model_of(object, py::none(), "objects"));
   std::shared_ptr<const CollisionIndex> environment;
   if (!index.is_none()) {
     if (!py::isinstance<Index>(index))
@@ -44,9 +44,6 @@ Group make_group(py::handle objects, py::handle index) {
   // group's construction throws.
   Group group;
   py::gil_scoped_release unlocked;
-  std::vector<std::shared_ptr<const ObjectModel>> models;
-  for (TriangleSoup& soup : soups)
-    models.push_back(std::make_shared<const ObjectModel>(std::move(soup)));
   group.group = std::make_unique<ObjectGroup>(environment, std::move(models));
   return group;
 }
@@ -115,7 +112,7 @@ world_boxes: (N, 2, 3).)")
   py::class_<Group>(module, "ObjectGroup", R"(Several rigid objects moving together through one
 index (or none: object/object questions only). Object/object answers are always exact.)")
       .def(py::init(&make_group), py::arg("objects"), py::arg("index") = py::none(),
-           "objects: a list of Mesh or (vertices, triangles) pairs.")
+           "objects: a list of Model, Mesh or (vertices, triangles) pairs.")
       .def("step", &step, py::arg("poses"), py::kw_only(), py::arg("environment") = true,
            py::arg("pairs") = true, py::arg("pair_mode") = "first_hit",
            py::arg("containment") = true, py::arg("parallel") = false,

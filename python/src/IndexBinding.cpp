@@ -121,9 +121,10 @@ thread, may share one Index.)")
           "Whether containment (an object inside a closed part) is answered.")
       .def(
           "object", &make_object, py::arg("mesh"), py::arg("triangles") = py::none(),
-          R"(A FlyingObject: object(mesh) with a tetrapage.Mesh, or object(vertices, triangles) with
-an (N, 3) float array and an (M, 3) integer array, in the index's coordinates. Building it (its
-BVH and hull) takes tens of milliseconds for 10,000 triangles and releases the GIL.)")
+          R"(A FlyingObject: object(model) with a tetrapage.Model (immediate), object(mesh) with a
+tetrapage.Mesh, or object(vertices, triangles) with an (N, 3) float array and an (M, 3) integer
+array, in the index's coordinates. Building a model (its BVH and hull) takes tens of milliseconds
+for 10,000 triangles and releases the GIL: threads flying one shape share one Model.)")
       .def("inspect", &inspect, "What `tetrapage inspect` shows, as a dict.")
       .def(
           "preload",

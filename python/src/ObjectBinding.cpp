@@ -455,17 +455,45 @@ py::dict counters_dict(const StepCounters& c) {
   return d;
 }
 
-Object make_object(const Index& index, py::handle mesh, py::handle triangles) {
+std::shared_ptr<const ObjectModel> model_of(py::handle mesh, py::handle triangles,
+                                            std::string_view what) {
+  if (triangles.is_none() && py::isinstance<Model>(mesh)) return mesh.cast<const Model&>().model;
   TriangleSoup soup =
-      triangles.is_none() ? soup_from_mesh_like(mesh, "object") : soup_from_arrays(mesh, triangles);
+      triangles.is_none() ? soup_from_mesh_like(mesh, what) : soup_from_arrays(mesh, triangles);
+  py::gil_scoped_release unlocked;  // the BVH and the hull: tens of milliseconds
+  return std::make_shared<const ObjectModel>(std::move(soup));
+}
+
+Object make_object(const Index& index, py::handle mesh, py::handle triangles) {
+  const std::shared_ptr<const ObjectModel> model = model_of(mesh, triangles, "object");
   Object object;
-  py::gil_scoped_release unlocked;  // the model's BVH and hull: tens of milliseconds
-  object.flying = std::make_unique<FlyingObject>(index.index, std::move(soup));
+  object.flying = std::make_unique<FlyingObject>(index.index, model);
   return object;
 }
 
 void bind_objects(py::module_& module) {
   bind_answers(module);
+  py::class_<Model>(module, "Model",
+                    R"(An object's model (its triangles, BVH, hull and, when closed, its
+interior), built once and shared: Index.object(model) makes a flying object of it at once, on any
+thread; Obstacles.insert(model, pose) and ObjectGroup take it too.)")
+      .def(py::init([](py::handle mesh, py::handle triangles) {
+             return Model{model_of(mesh, triangles, "mesh")};
+           }),
+           py::arg("mesh"), py::arg("triangles") = py::none(),
+           "Model(mesh) with a tetrapage.Mesh, or Model(vertices, triangles).")
+      .def_property_readonly("triangles",
+                             [](const Model& m) { return m.model->mesh.triangle_count(); })
+      .def_property_readonly(
+          "closed", [](const Model& m) { return m.model->closed; },
+          "Some component is closed (obstacles inside it are reported).")
+      .def_property_readonly(
+          "bounds", [](const Model& m) { return box_array(m.model->box.lo, m.model->box.hi); },
+          "(2, 3): its box in its own frame.")
+      .def("__repr__", [](const Model& m) {
+        return "<tetrapage.Model " + std::to_string(m.model->mesh.triangle_count()) + " triangles" +
+               (m.model->closed ? ", closed>" : ">");
+      });
   py::class_<Object>(module, "FlyingObject", R"(A rigid object flying through an Index (made by
 Index.object). Poses are (7,) or (K, 7) arrays of tx, ty, tz, qw, qx, qy, qz (a unit quaternion,
 as in pose files) or (4, 4) / (K, 4, 4) rigid matrices. Queries release the GIL; one object is

@@ -59,14 +59,16 @@ threads and hold them off while they run.)")
       .def(
           "insert",
           [](Obstacles& obstacles, py::handle mesh, py::handle pose_value, std::string name) {
-            TriangleSoup soup = soup_from_mesh_like(mesh, "mesh");
             const Pose pose = pose_from_array(pose_value, "pose");
+            // Built before the overlay is taken: steps wait only for the insertion.
+            std::shared_ptr<const ObjectModel> model = model_of(mesh, py::none(), "mesh");
             return change(obstacles, [&](DynamicObstacles& overlay) {
-              return overlay.insert(std::move(soup), pose, std::move(name));
+              return overlay.insert(std::move(model), pose, std::move(name));
             });
           },
           py::arg("mesh"), py::arg("pose"), py::arg("name") = "",
-          "Adds a part (a Mesh or a (vertices, triangles) pair) at `pose`; returns its id (> 0), "
+          "Adds a part (a Model, shared at no cost; a Mesh or a (vertices, triangles) pair) at "
+          "`pose`; returns its id (> 0), "
           "the `dynamic_part` of its contacts.")
       .def(
           "move",

@@ -64,3 +64,23 @@ def test_obstacles_inserted_moved_hidden_saved(cube_index, tmp_path):
     assert obj.collides(free) and loaded.parts == [(block, "block")]
     obj.obstacles = None
     assert not obj.collides(free) and obj.obstacles is None
+
+
+def test_a_model_is_shared_by_objects_obstacles_and_groups(cube_index):
+    index = tetrapage.Index(cube_index)
+    model = tetrapage.Model(*corner_tetrahedron())
+    assert model.triangles == 4 and model.closed
+    np.testing.assert_array_equal(model.bounds, [[0, 0, 0], [0.125, 0.125, 0.125]])
+    poses = np.array([pose(1.0 + gap, 0.5, 0.5) for gap in (0.25, 0.0, -0.5)])
+    from_model = index.object(model).collides(poses)
+    np.testing.assert_array_equal(from_model, index.object(*corner_tetrahedron()).collides(poses))
+    np.testing.assert_array_equal(from_model, [False, True, True])
+    # One model inserted many times: each copy is its own part.
+    obstacles = tetrapage.Obstacles(index)
+    ids = [obstacles.insert(model, pose(3.0 + k, 0.0, 0.0)) for k in range(5)]
+    assert len(set(ids)) == 5 and len(obstacles) == 5
+    flying = index.object(model)
+    flying.obstacles = obstacles
+    assert flying.collides(pose(5.0625, 0.0, 0.0)) and not flying.collides(pose(5.5, 0.0, 0.0))
+    group = tetrapage.ObjectGroup([model, model])
+    assert len(group.step(np.array([pose(0, 0, 0), pose(0.125, 0, 0)])).pairs) == 1

@@ -12,7 +12,7 @@ from conftest import corner_tetrahedron, cube, pose
 
 def test_threads_share_an_index(demo):
     index = tetrapage.Index(demo / "scene.tpi", memory="8M")
-    mesh = tetrapage.read_mesh(demo / "object.ply")
+    mesh = tetrapage.Model(tetrapage.read_mesh(demo / "object.ply"))  # shared by the threads
     poses = tetrapage.read_poses(demo / "flight.csv")
     expected = index.object(mesh).collides(poses)
     assert expected.any()
