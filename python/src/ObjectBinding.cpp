@@ -31,6 +31,17 @@ struct ContactRecord {
   double object_normal[3];
 };
 
+// One row of FlyingObject.times_of_impact.
+struct ImpactRecord {
+  std::uint8_t impact;  // 0 none, 1 hit, 2 unresolved
+  double free_until;
+  double contact_at;
+  std::int64_t environment_triangle;  // -1: no contact found
+  std::uint32_t environment_part;
+  std::int64_t object_triangle;
+  std::uint32_t iterations;
+};
+
 // One row of FlyingObject.distances.
 struct DistanceRecord {
   std::uint8_t separation;  // 0 touching, 1 apart, 2 farther
@@ -256,6 +267,29 @@ py::array distances(Object& object, py::handle poses, double max_distance) {
   return py::array_t<DistanceRecord>(py::ssize_t(records.size()), records.data());
 }
 
+// As `tetrapage fly --query toi`: row 0 the first pose alone, row k the motion from pose k - 1.
+py::array times_of_impact(Object& object, py::handle poses, double tolerance,
+                          py::handle max_iterations_value) {
+  const ImpactOptions options{
+      tolerance,
+      std::uint32_t(whole_number(max_iterations_value, "max_iterations", 1, 0xffffffffu))};
+  const PoseBatch batch = poses_from_array(poses, "poses");
+  std::vector<ImpactRecord> records(batch.poses.size());
+  run_step(object, [&](FlyingObject& flying) {
+    for_each_pose(batch, "poses", [&](std::size_t k, const Pose& pose) {
+      const ImpactResult r = flying.time_of_impact(batch.poses[k == 0 ? 0 : k - 1], pose, options);
+      records[k] = {std::uint8_t(r.impact),
+                    r.free_until,
+                    r.contact_at,
+                    r.has_contact ? std::int64_t(r.environment_triangle) : -1,
+                    r.environment_part,
+                    r.has_contact ? std::int64_t(r.object_triangle) : -1,
+                    r.iterations};
+    });
+  });
+  return py::array_t<ImpactRecord>(py::ssize_t(records.size()), records.data());
+}
+
 py::object optional_triangle(bool present, std::uint64_t id) {
   return present ? py::object(py::int_(id)) : py::object(py::none());
 }
@@ -272,6 +306,12 @@ void bind_answers(py::module_& module) {
   module.attr("FARTHER") = std::uint8_t(Separation::farther);
   module.attr("contact_dtype") = py::dtype::of<ContactRecord>();
   module.attr("distance_dtype") = py::dtype::of<DistanceRecord>();
+  PYBIND11_NUMPY_DTYPE(ImpactRecord, impact, free_until, contact_at, environment_triangle,
+                       environment_part, object_triangle, iterations);
+  module.attr("IMPACT_NONE") = std::uint8_t(Impact::none);
+  module.attr("IMPACT_HIT") = std::uint8_t(Impact::hit);
+  module.attr("IMPACT_UNRESOLVED") = std::uint8_t(Impact::unresolved);
+  module.attr("impact_dtype") = py::dtype::of<ImpactRecord>();
 
   py::class_<QueryAnswer>(module, "QueryAnswer", R"(One collision query's answer.
 collides: surfaces touch, or one body holds the other (containment).
@@ -531,6 +571,12 @@ the current pose: the poses are consecutive steps).)")
            "distance() over (K, 7) or (K, 4, 4) poses: a structured array "
            "(tetrapage.distance_dtype; "
            "separation is TOUCHING, APART or FARTHER).")
+      .def(
+          "times_of_impact", &times_of_impact, py::arg("poses"), py::kw_only(),
+          py::arg("tolerance") = 1e-4, py::arg("max_iterations") = 10000,
+          "time_of_impact() along (K, 7) or (K, 4, 4) poses, as `tetrapage fly --query toi`: row 0 "
+          "the first pose alone, row k the motion from pose k - 1 to pose k. A structured array "
+          "(tetrapage.impact_dtype; impact is IMPACT_NONE, IMPACT_HIT or IMPACT_UNRESOLVED).")
       .def(
           "time_of_impact",
           [](Object& object, py::handle start, py::handle end, double tolerance,

@@ -31,7 +31,7 @@ def read_csv(path):
 def demo(tmp_path_factory):
     """The demo's workload, scaled down: a generated scene (real CGAL meshes), an object, a
     billiard flight with the reference oracle's answers, the index, and `tetrapage fly`'s own
-    answers: collisions, distances and every contact."""
+    answers: collisions, distances, every contact and the times of impact."""
     folder = tmp_path_factory.mktemp("demo")
     scene, obj, flight = folder / "scene.ply", folder / "object.ply", folder / "flight.csv"
     run_cli("generate", "scene", "--triangles", 40000, "--seed", 1, "-o", scene)
@@ -45,6 +45,8 @@ def demo(tmp_path_factory):
             "--answers", folder / "distance.csv")
     run_cli("fly", index, "--object", obj, "--path", flight, "--query", "contacts",
             "--answers", folder / "contacts.csv")
+    run_cli("fly", index, "--object", obj, "--path", flight, "--query", "toi",
+            "--answers", folder / "toi.csv")
     return folder
 
 

@@ -95,3 +95,19 @@ def test_contacts_equal_fly(demo):
             assert np.all(np.isfinite(contacts["point"]))
             assert set(answer.counters) >= {"candidates", "triangle_tests", "shard_misses"}
     assert found and found == expected
+
+
+def test_times_of_impact_equal_fly(demo):
+    _, obj = open_demo(demo)
+    poses = tetrapage.read_poses(demo / "flight.csv")
+    records = obj.times_of_impact(poses)
+    rows = read_csv(demo / "toi.csv")
+    assert len(rows) == len(poses) == len(records)
+    names = {"none": tetrapage.IMPACT_NONE, "hit": tetrapage.IMPACT_HIT,
+             "unresolved": tetrapage.IMPACT_UNRESOLVED}
+    np.testing.assert_array_equal(records["impact"], [names[row["impact"]] for row in rows])
+    assert (records["impact"] == tetrapage.IMPACT_HIT).any()
+    np.testing.assert_array_equal(records["free_until"], [float(row["free_until"]) for row in rows])
+    np.testing.assert_array_equal(records["contact_at"], [float(row["contact_at"]) for row in rows])
+    hits = records["impact"] == tetrapage.IMPACT_HIT
+    assert np.all(records["contact_at"][hits] - records["free_until"][hits] <= 1e-4)
