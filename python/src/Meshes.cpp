@@ -3,10 +3,12 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <limits>
 
 #include "Bindings.h"
 #include "tetrapage/formats/CadReader.h"
+#include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/MeshWriter.h"
 
@@ -84,6 +86,31 @@ Mesh mesh_of_arrays(py::handle vertices, py::handle triangles, py::handle part_o
   return mesh;
 }
 
+Mesh scaled(const Mesh& mesh, double factor) {
+  if (!(factor > 0) || !std::isfinite(factor))
+    throw InputError("scaled: the factor " + std::to_string(factor) + " is not a positive number");
+  Mesh copy = mesh;
+  for (Vec3& vertex : copy.soup.vertices)
+    for (double& c : vertex) c *= factor;
+  copy.length_unit.clear();
+  return copy;
+}
+
+Mesh in_unit(const Mesh& mesh, const std::string& unit, py::handle from_unit) {
+  std::string from = mesh.length_unit;
+  if (!from_unit.is_none()) {
+    const std::string given = from_unit.cast<std::string>();
+    metres_per_unit(given);  // an unknown unit is an InputError naming it
+    if (!from.empty() && from != given)
+      throw InputError("in_unit: from_unit " + given + ", but the mesh states " + from);
+    from = given;
+  }
+  if (from.empty()) throw InputError("in_unit: the mesh states no unit: give from_unit");
+  Mesh copy = scaled(mesh, metres_per_unit(from) / metres_per_unit(unit));
+  copy.length_unit = unit;
+  return copy;
+}
+
 }  // namespace
 
 void bind_meshes(py::module_& module) {
@@ -129,6 +156,12 @@ void bind_meshes(py::module_& module) {
             return box_array({nan, nan, nan}, {nan, nan, nan});
           },
           "(2, 3): the lowest and highest corner of the vertices' box (NaN without vertices).")
+      .def("scaled", &scaled, py::arg("factor"),
+           "A copy with every coordinate times `factor` (positive); its unit is then unstated.")
+      .def("in_unit", &in_unit, py::arg("unit"), py::arg("from_unit") = py::none(),
+           "A copy in `unit` (\"mm\", \"m\", \"in\", ...), converted from the mesh's own "
+           "length_unit, or from `from_unit` for a mesh that states none. For an object in an "
+           "index's unit: mesh.in_unit(index.length_unit).")
       .def("__len__", [](const Mesh& m) { return m.soup.triangles.size(); })
       .def("__repr__", [](const Mesh& m) {
         return "<tetrapage.Mesh " + std::to_string(m.soup.triangles.size()) + " triangles, " +

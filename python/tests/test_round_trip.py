@@ -128,3 +128,23 @@ def test_meshes_round_trip_through_files(tmp_path):
 def test_the_version_is_the_commands(tmp_path):
     from conftest import run_cli
     assert run_cli("--version").split()[1] == tetrapage.__version__
+
+
+def test_meshes_convert_between_units(tmp_path):
+    vertices, triangles = corner_tetrahedron(1.0)
+    mesh = tetrapage.Mesh(vertices, triangles)
+    assert mesh.length_unit == ""
+    in_mm = mesh.in_unit("mm", from_unit="m")
+    assert in_mm.length_unit == "mm"
+    np.testing.assert_array_equal(in_mm.vertices, vertices * 1000)
+    np.testing.assert_array_equal(in_mm.in_unit("m").vertices, vertices)
+    np.testing.assert_allclose(in_mm.in_unit("in").vertices, vertices / 0.0254, rtol=1e-15)
+    with pytest.raises(tetrapage.InputError, match="states no unit"):
+        mesh.in_unit("mm")
+    with pytest.raises(tetrapage.InputError, match="furlong"):
+        mesh.in_unit("mm", from_unit="furlong")
+    with pytest.raises(tetrapage.InputError, match="but the mesh states mm"):
+        in_mm.in_unit("m", from_unit="in")
+    np.testing.assert_array_equal(mesh.scaled(0.5).vertices, vertices * 0.5)
+    with pytest.raises(tetrapage.InputError):
+        mesh.scaled(-1.0)
