@@ -35,6 +35,22 @@ def run_isolated(code, cube_index, timeout=60):
     return done.returncode, done.stderr
 
 
+def expect_refused_isolated(statement, message, cube_index, timeout=60):
+    """Runs `statement` as run_isolated does: it must raise an InputError naming `message`, and
+    neither crash nor hang."""
+    code = f"""
+        try:
+            {statement}
+        except tetrapage.InputError as error:
+            assert {message!r} in str(error), error
+            print("refused")
+        else:
+            raise SystemExit("accepted")
+        """
+    returncode, stderr = run_isolated(code, cube_index, timeout)
+    assert returncode == 0, stderr
+
+
 @pytest.mark.parametrize("code", [
     # numpy refuses a ragged list: py::array::ensure returned a null array, read as an array.
     "index.object(vertices * 0.1, triangles).collides([[1, 2], [3]])",
@@ -45,29 +61,15 @@ def run_isolated(code, cube_index, timeout=60):
     "tetrapage.write_poses('unused.csv', [[1, 2], [3]])",
 ])
 def test_ragged_lists_are_input_errors(cube_index, code):
-    code = f"""
-        try:
-            {code}
-        except tetrapage.InputError as error:
-            assert "not an array of numbers" in str(error), error
-            print("refused")
-        """
-    returncode, stderr = run_isolated(code, cube_index)
-    assert returncode == 0, stderr
+    expect_refused_isolated(code, "not an array of numbers", cube_index)
 
 
 @pytest.mark.parametrize("part_id", [2**31, 2**40, 2**64 - 1])
 def test_huge_part_ids_are_refused_without_making_names(cube_index, part_id):
     # Unnamed part ids got a made-up name each up to the largest: 2**40 names.
-    code = f"""
-        try:
-            tetrapage.Mesh(vertices, triangles, part_of=np.full(12, {part_id}, dtype=np.uint64))
-        except tetrapage.InputError as error:
-            assert "part" in str(error), error
-            print("refused")
-        """
-    returncode, stderr = run_isolated(code, cube_index, timeout=30)
-    assert returncode == 0, stderr
+    expect_refused_isolated(
+        f"tetrapage.Mesh(vertices, triangles, part_of=np.full(12, {part_id}, dtype=np.uint64))",
+        "part", cube_index, timeout=30)
 
 
 def test_part_ids_and_names(cube_index):
@@ -92,15 +94,7 @@ def test_part_ids_and_names(cube_index):
 ])
 def test_coordinates_near_the_largest_double_are_refused(cube_index, make):
     # Finite but beyond 1e300: the object's BVH overflowed (and crashed) before the check ran.
-    code = f"""
-        try:
-            {make}
-        except tetrapage.InputError as error:
-            assert "beyond 1e+300" in str(error), error
-            print("refused")
-        """
-    returncode, stderr = run_isolated(code, cube_index)
-    assert returncode == 0, stderr
+    expect_refused_isolated(make, "beyond 1e+300", cube_index)
 
 
 @pytest.mark.parametrize("keyword, value, message", [
