@@ -116,7 +116,7 @@ void bind_preprocess(py::module_& module) {
       py::arg("inputs"), py::arg("output"), py::kw_only(), py::arg("memory") = py::none(),
       py::arg("threads") = py::none(), py::arg("region_triangles") = py::none(),
       py::arg("shard") = "auto", py::arg("precision") = "exact", py::arg("compression") = "lz4",
-      py::arg("interiors") = false, py::arg("accept_undecided") = false,
+      py::arg("interiors") = true, py::arg("accept_undecided") = false,
       py::arg("length_unit") = py::none(), py::arg("deflection") = "0.1%",
       py::arg("query_extent") = py::none(), py::arg("spill_folder") = py::none(),
       py::arg("progress") = py::none(),
@@ -129,7 +129,8 @@ memory: the working-memory budget, bytes or a size ("1G"; k, M, G, T are powers 
 region_triangles: triangles per region (None: automatic). shard: "auto", "grid", "rtree".
 precision: "exact" (answers exact for the input), "double", "float" (rounded: exact for the
   rounded model only). compression: "lz4" or "none". interiors: store which regions lie inside
-  closed parts (for containment answers). length_unit: the unit of plain meshes ("mm", "m").
+  closed parts (containment answers; default True, as the CLI). length_unit: the unit of plain
+  meshes ("mm", "m").
 deflection: STEP/IGES tessellation ("0.1%" of each shape's diagonal, or a length in mm).
 progress: a callable(stage, done, total), called from the pipeline's threads at most 10 times
   a second per stage; or True for bars on stderr. What it raises stops the run (Ctrl-C too).

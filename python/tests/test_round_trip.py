@@ -55,11 +55,12 @@ def test_containment_needs_the_interiors(cube_index, tmp_path):
     answer = index.object(*corner_tetrahedron()).query(inside)
     assert answer.collides and answer.containment == "object_inside_obstacle"
     assert answer.containing_part == 0 and len(answer.contacts) == 0
-    # Without the interiors only touching surfaces count.
+    # Without the interiors (stored by default, as `preprocess --interiors on`) only touching
+    # surfaces count.
     vertices, triangles = cube()
     source = tmp_path / "cube.off"
     tetrapage.write_mesh(source, (vertices, triangles))
-    tetrapage.preprocess(source, tmp_path / "surface.tpi")
+    tetrapage.preprocess(source, tmp_path / "surface.tpi", interiors=False)
     surface_only = tetrapage.Index(tmp_path / "surface.tpi")
     assert not surface_only.object(*corner_tetrahedron()).collides(inside)
 
