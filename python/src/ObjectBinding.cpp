@@ -54,6 +54,9 @@ struct DistanceRecord {
   std::uint32_t environment_part;
   std::int64_t object_triangle;
   std::uint32_t dynamic_part;
+  std::uint8_t containment;  // touching without contact: Containment (0 none, 1 object inside, 2
+                             // obstacle inside)
+  std::uint32_t containing_part;
 };
 
 // The step's counters and box become Python objects only when asked for: a caller stepping
@@ -251,6 +254,8 @@ DistanceRecord record_of(const DistanceResult& r) {
   record.environment_part = r.environment_part;
   record.object_triangle = measured ? std::int64_t(r.object_triangle) : -1;
   record.dynamic_part = r.dynamic_part;
+  record.containment = std::uint8_t(r.containment);
+  record.containing_part = r.containing_part;
   return record;
 }
 
@@ -300,7 +305,9 @@ void bind_answers(py::module_& module) {
                        object_normal);
   PYBIND11_NUMPY_DTYPE(DistanceRecord, separation, distance, lower_bound, upper_bound,
                        on_environment, on_object, environment_triangle, environment_part,
-                       object_triangle, dynamic_part);
+                       object_triangle, dynamic_part, containment, containing_part);
+  module.attr("OBJECT_INSIDE_OBSTACLE") = std::uint8_t(Containment::object_inside_obstacle);
+  module.attr("OBSTACLE_INSIDE_OBJECT") = std::uint8_t(Containment::obstacle_inside_object);
   module.attr("TOUCHING") = std::uint8_t(Separation::touching);
   module.attr("APART") = std::uint8_t(Separation::apart);
   module.attr("FARTHER") = std::uint8_t(Separation::farther);

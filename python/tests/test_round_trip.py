@@ -55,6 +55,9 @@ def test_containment_needs_the_interiors(cube_index, tmp_path):
     answer = index.object(*corner_tetrahedron()).query(inside)
     assert answer.collides and answer.containment == "object_inside_obstacle"
     assert answer.containing_part == 0 and len(answer.contacts) == 0
+    far_and_inside = index.object(*corner_tetrahedron()).distances(np.array([pose(1.25, 0.5, 0.5), inside]))
+    np.testing.assert_array_equal(far_and_inside["containment"], [0, tetrapage.OBJECT_INSIDE_OBSTACLE])
+    assert far_and_inside["separation"][1] == tetrapage.TOUCHING and far_and_inside["containing_part"][1] == 0
     # Without the interiors (stored by default, as `preprocess --interiors on`) only touching
     # surfaces count.
     vertices, triangles = cube()
