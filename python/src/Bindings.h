@@ -136,9 +136,6 @@ Object make_object(const Index& index, py::handle mesh, py::handle triangles);
 QueryOptions query_options(const std::string& mode, const std::string& accuracy,
                            const std::string& shape, const std::string& motion);
 
-/// "none", "object_inside_obstacle", "obstacle_inside_object".
-std::string containment_name(Containment containment);
-
 /// One python-side dict of a step's counters.
 py::dict counters_dict(const StepCounters& counters);
 

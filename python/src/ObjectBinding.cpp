@@ -91,30 +91,6 @@ Enum parse_name(const std::string& text, std::initializer_list<std::pair<const c
   throw InputError(std::string(what) + " '" + text + "' is not one of " + known);
 }
 
-const char* separation_name(Separation separation) {
-  switch (separation) {
-    case Separation::touching:
-      return "touching";
-    case Separation::apart:
-      return "apart";
-    case Separation::farther:
-      return "farther";
-  }
-  return "?";
-}
-
-const char* impact_name(Impact impact) {
-  switch (impact) {
-    case Impact::none:
-      return "none";
-    case Impact::hit:
-      return "hit";
-    case Impact::unresolved:
-      return "unresolved";
-  }
-  return "?";
-}
-
 // Runs `step` on the object's FlyingObject with the GIL released, this object's lock held (one
 // thread at a time) and its overlay's shared (no change during a step).
 template <class Step>
@@ -226,17 +202,10 @@ QueryAnswer query(Object& object, py::handle pose_value, const std::string& mode
   return answer_of(result, py::array_t<ContactRecord>(py::ssize_t(records.size()), records.data()));
 }
 
-// Whether the answer holds closest points: not when farther, nor for a containment (touching,
-// yet nothing measured: the C++ points are then zeros, which read as a point at the origin).
-bool has_points(const DistanceResult& r) {
-  return r.environment_triangle != DistanceResult::kNoTriangle ||
-         (r.separation == Separation::touching && r.containment == Containment::none);
-}
-
 // The point, or NaNs when the answer holds none.
 py::array_t<double> point_or_nan(const DistanceResult& r, const geometry::Point& point) {
   const double nan[3] = {kNaN, kNaN, kNaN};
-  return double_array(has_points(r) ? point.data() : nan, {3});
+  return double_array(has_closest_points(r) ? point.data() : nan, {3});
 }
 
 DistanceRecord record_of(const DistanceResult& r) {
@@ -247,8 +216,8 @@ DistanceRecord record_of(const DistanceResult& r) {
   record.upper_bound = r.upper_bound;
   const bool measured = r.environment_triangle != DistanceResult::kNoTriangle;
   for (int a = 0; a < 3; ++a) {
-    record.on_environment[a] = has_points(r) ? r.on_environment[a] : kNaN;
-    record.on_object[a] = has_points(r) ? r.on_object[a] : kNaN;
+    record.on_environment[a] = has_closest_points(r) ? r.on_environment[a] : kNaN;
+    record.on_object[a] = has_closest_points(r) ? r.on_object[a] : kNaN;
   }
   record.environment_triangle = measured ? std::int64_t(r.environment_triangle) : -1;
   record.environment_part = r.environment_part;
@@ -329,7 +298,7 @@ contacts: structured array, one row per contact (first_hit: at most one): part, 
 counters: what the step did (dict). world_box: (2, 3).)")
       .def_readonly("collides", &QueryAnswer::collides)
       .def_property_readonly("containment",
-                             [](const QueryAnswer& a) { return containment_name(a.containment); })
+                             [](const QueryAnswer& a) { return to_string(a.containment); })
       .def_readonly("containing_part", &QueryAnswer::containing_part)
       .def_readonly("containing_dynamic_part", &QueryAnswer::containing_dynamic_part)
       .def_readonly("outside_model", &QueryAnswer::outside_model)
@@ -348,9 +317,8 @@ counters: what the step did (dict). world_box: (2, 3).)")
   py::class_<DistanceAnswer>(module, "DistanceAnswer", R"(One distance query's answer: the true
 distance lies in [lower_bound, upper_bound] (certified); separation is "touching" (distance 0),
 "apart", or "farther" (than max_distance: distance is then the certified lower bound).)")
-      .def_property_readonly(
-          "separation",
-          [](const DistanceAnswer& a) { return separation_name(a.result.separation); })
+      .def_property_readonly("separation",
+                             [](const DistanceAnswer& a) { return to_string(a.result.separation); })
       .def_property_readonly("distance", [](const DistanceAnswer& a) { return a.result.distance; })
       .def_property_readonly("lower_bound",
                              [](const DistanceAnswer& a) { return a.result.lower_bound; })
@@ -381,8 +349,7 @@ distance lies in [lower_bound, upper_bound] (certified); separation is "touching
       .def_property_readonly("dynamic_part",
                              [](const DistanceAnswer& a) { return a.result.dynamic_part; })
       .def_property_readonly(
-          "containment",
-          [](const DistanceAnswer& a) { return containment_name(a.result.containment); })
+          "containment", [](const DistanceAnswer& a) { return to_string(a.result.containment); })
       .def_property_readonly("containing_part",
                              [](const DistanceAnswer& a) { return a.result.containing_part; })
       .def_property_readonly("candidates",
@@ -390,15 +357,15 @@ distance lies in [lower_bound, upper_bound] (certified); separation is "touching
       .def_property_readonly("pair_tests",
                              [](const DistanceAnswer& a) { return a.result.pair_tests; })
       .def("__repr__", [](const DistanceAnswer& a) {
-        return std::string("<tetrapage.DistanceAnswer ") + separation_name(a.result.separation) +
-               " " + std::to_string(a.result.distance) + ">";
+        return std::string("<tetrapage.DistanceAnswer ") + to_string(a.result.separation) + " " +
+               std::to_string(a.result.distance) + ">";
       });
 
   py::class_<ImpactAnswer>(module, "ImpactAnswer", R"(One time-of-impact answer over the motion's
 time [0, 1]: impact "none" (certified free), "hit" (first contact in (free_until, contact_at]),
 or "unresolved" (max_iterations ran out: free up to free_until).)")
       .def_property_readonly("impact",
-                             [](const ImpactAnswer& a) { return impact_name(a.result.impact); })
+                             [](const ImpactAnswer& a) { return to_string(a.result.impact); })
       .def_property_readonly("free_until",
                              [](const ImpactAnswer& a) { return a.result.free_until; })
       .def_property_readonly("contact_at",
@@ -418,7 +385,7 @@ or "unresolved" (max_iterations ran out: free up to free_until).)")
       .def_property_readonly("iterations",
                              [](const ImpactAnswer& a) { return a.result.iterations; })
       .def("__repr__", [](const ImpactAnswer& a) {
-        return std::string("<tetrapage.ImpactAnswer ") + impact_name(a.result.impact) +
+        return std::string("<tetrapage.ImpactAnswer ") + to_string(a.result.impact) +
                " free until " + std::to_string(a.result.free_until) + ">";
       });
 }
@@ -465,18 +432,6 @@ QueryOptions query_options(const std::string& mode, const std::string& accuracy,
   options.motion = parse_name<Motion>(
       motion, {{"discrete", Motion::discrete}, {"swept", Motion::swept}}, "motion");
   return options;
-}
-
-std::string containment_name(Containment containment) {
-  switch (containment) {
-    case Containment::none:
-      return "none";
-    case Containment::object_inside_obstacle:
-      return "object_inside_obstacle";
-    case Containment::obstacle_inside_object:
-      return "obstacle_inside_object";
-  }
-  return "?";
 }
 
 py::dict counters_dict(const StepCounters& c) {

@@ -92,11 +92,8 @@ void QueryAnswerFile::write_contacts(std::uint64_t step, FlyingObject& object, c
 }
 
 void QueryAnswerFile::write_distance(std::uint64_t step, const DistanceResult& result) {
-  static constexpr const char* kSeparation[] = {"touching", "apart", "farther"};
   const bool has_pair = result.environment_triangle != DistanceResult::kNoTriangle;
-  const bool has_points = result.separation == Separation::apart ||
-                          (result.separation == Separation::touching && has_pair &&
-                           result.object_triangle != Contact::kNoObjectTriangle);
+  const bool has_points = has_closest_points(result);
   std::string row = std::to_string(step) + ',' + number_field(result.distance) + ',';
   row += has_points ? point_fields(result.on_environment) + ',' + point_fields(result.on_object) : ",,,,,";
   row += ',';
@@ -104,14 +101,13 @@ void QueryAnswerFile::write_distance(std::uint64_t step, const DistanceResult& r
                         (result.object_triangle == Contact::kNoObjectTriangle ? std::string()
                                                                                : std::to_string(result.object_triangle))
                   : std::string(",,");
-  row += std::string(",") + kSeparation[int(result.separation)] + ',' + number_field(result.lower_bound) + ',' +
+  row += std::string(",") + to_string(result.separation) + ',' + number_field(result.lower_bound) + ',' +
          number_field(result.upper_bound);
   file_.row(row);
 }
 
 void QueryAnswerFile::write_impact(std::uint64_t step, const ImpactResult& result) {
-  static constexpr const char* kImpact[] = {"none", "hit", "unresolved"};
-  std::string row = std::to_string(step) + ',' + kImpact[int(result.impact)] + ',' +
+  std::string row = std::to_string(step) + ',' + to_string(result.impact) + ',' +
                     number_field(result.free_until) + ',' + number_field(result.contact_at) + ',';
   row += result.has_contact ? std::to_string(result.environment_part) + ',' +
                                   std::to_string(result.environment_triangle) + ',' +

@@ -31,6 +31,12 @@ enum class Separation : std::uint8_t {
   farther,
 };
 
+/// "touching", "apart", "farther": the words of answer files and bindings.
+constexpr const char* to_string(Separation separation) {
+  constexpr const char* kNames[] = {"touching", "apart", "farther"};
+  return kNames[static_cast<int>(separation)];
+}
+
 struct DistanceResult {
   Separation separation = Separation::farther;
   /// The computed distance |on_environment - on_object|; 0 when touching; when farther, the

@@ -135,6 +135,22 @@ enum class Containment : std::uint8_t {
                            ///< the object
 };
 
+/// "none", "object_inside_obstacle", "obstacle_inside_object".
+constexpr const char* to_string(Containment containment) {
+  constexpr const char* kNames[] = {"none", "object_inside_obstacle", "obstacle_inside_object"};
+  return kNames[static_cast<int>(containment)];
+}
+
+/// Whether a distance answer holds closest points: apart, or touching through a contact (a
+/// containment touches with nothing measured, and "farther" measures nothing; their points are
+/// then meaningless zeros).
+inline bool has_closest_points(const DistanceResult& result) {
+  return result.separation == Separation::apart ||
+         (result.separation == Separation::touching &&
+          result.environment_triangle != DistanceResult::kNoTriangle &&
+          result.object_triangle != Contact::kNoObjectTriangle);
+}
+
 struct QueryResult {
   /// Surfaces touch (contacts), or one body contains the other (containment).
   bool collides = false;

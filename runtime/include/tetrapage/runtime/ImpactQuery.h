@@ -22,6 +22,12 @@ enum class Impact : std::uint8_t {
   unresolved,  ///< max_iterations ran out: no contact up to free_until, nothing known after
 };
 
+/// "none", "hit", "unresolved": the words of answer files and bindings.
+constexpr const char* to_string(Impact impact) {
+  constexpr const char* kNames[] = {"none", "hit", "unresolved"};
+  return kNames[static_cast<int>(impact)];
+}
+
 struct ImpactResult {
   Impact impact = Impact::none;
   /// No contact at any time in [0, free_until) (certified by distance bounds over the
