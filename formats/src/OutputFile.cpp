@@ -1,4 +1,4 @@
-#include "OutputFile.h"
+#include "tetrapage/formats/OutputFile.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -9,13 +9,27 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
 
-namespace tetrapage::detail {
+namespace tetrapage {
+
+namespace {
+
+// The checks before the temporary exists: its rename must not replace anything but a file.
+std::filesystem::path checked_temporary(const std::filesystem::path& output) {
+  check_outputs(std::span<const std::filesystem::path>(&output, 1), {});
+  remove_stale_temporaries(output);
+  return temporary_path(output);
+}
+
+}  // namespace
+
+OutputFile::OutputFile(std::filesystem::path output)
+    : OutputFile(checked_temporary(output), output) {}
 
 OutputFile::OutputFile(std::filesystem::path path, std::filesystem::path output)
     : path_(std::move(path)), output_(std::move(output)), guard_(path_) {
   // The temporary is renamed over the output at the end: never over a device, FIFO or folder.
   check_outputs(std::span<const std::filesystem::path>(&output_, 1), {});
-  descriptor_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  descriptor_ = ::open(path_.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0666);
   if (descriptor_ < 0) fail("create", errno);
   buffer_ = std::make_unique_for_overwrite<char[]>(capacity_);
 }
@@ -94,4 +108,4 @@ void OutputFile::rename_to(const std::filesystem::path& final_path) {
   renamed_ = true;
 }
 
-}  // namespace tetrapage::detail
+}  // namespace tetrapage

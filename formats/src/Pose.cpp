@@ -9,9 +9,9 @@
 #include <string>
 
 #include "InputFile.h"
-#include "OutputFile.h"
 #include "TextNumbers.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/OutputFile.h"
 
 namespace tetrapage {
 
@@ -133,7 +133,7 @@ void write_poses(const std::filesystem::path& path, std::span<const Pose> poses)
                          " is not finite");
     }
   }
-  detail::OutputFile output(path.string() + ".tmp", path);
+  OutputFile output(path);
   output.write("tx,ty,tz,qw,qx,qy,qz\n");
   for (const Pose& pose : poses) {
     char* line = output.reserve(8 * detail::max_double_chars);
@@ -147,7 +147,7 @@ void write_poses(const std::filesystem::path& path, std::span<const Pose> poses)
     }
     output.advance(static_cast<std::size_t>(end - line));
   }
-  output.rename_to(path);
+  output.commit();
 }
 
 }  // namespace tetrapage

@@ -29,6 +29,10 @@ extern "C" void remove_and_reraise(int signal_number) {
   ::raise(signal_number);
 }
 
+// The signals whose default action ends the process.
+constexpr std::array kEndingSignals{SIGINT,  SIGTERM, SIGHUP,  SIGPIPE, SIGQUIT,   SIGALRM,
+                                    SIGUSR1, SIGUSR2, SIGXCPU, SIGXFSZ, SIGVTALRM, SIGPROF};
+
 bool process_exists(long pid) { return ::kill(pid_t(pid), 0) == 0 || errno == EPERM; }
 
 }  // namespace
@@ -58,9 +62,17 @@ void remove_temporaries_on_signals() {
     struct sigaction action {};
     action.sa_handler = remove_and_reraise;
     sigemptyset(&action.sa_mask);
-    ::sigaction(SIGINT, &action, nullptr);
-    ::sigaction(SIGTERM, &action, nullptr);
+    for (const int signal_number : kEndingSignals) {
+      struct sigaction previous {};
+      if (::sigaction(signal_number, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN)
+        continue;
+      ::sigaction(signal_number, &action, nullptr);
+    }
   });
+}
+
+std::filesystem::path temporary_path(const std::filesystem::path& output) {
+  return std::filesystem::path(output.string() + ".tmp-" + std::to_string(::getpid()));
 }
 
 std::vector<std::filesystem::path> remove_stale_temporaries(const std::filesystem::path& output) {

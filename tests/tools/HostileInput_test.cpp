@@ -15,10 +15,8 @@
 #include <sstream>
 #include <thread>
 
-#include "RunCli.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "HostileSupport.h"
 #include "tetrapage/formats/Pose.h"
-#include "tetrapage/tools/TetrasGenerator.h"
 
 namespace tetrapage {
 namespace {
@@ -26,63 +24,11 @@ namespace {
 namespace fs = std::filesystem;
 
 using CliRun = test::CliResult;
-
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
-// Under a 60 s timeout: a hang fails, it never blocks the suite.
-CliRun run(const fs::path& folder, const std::string& arguments) {
-  return test::run_cli_in(folder, arguments, 60);
-}
-
-void expect_refused(const CliRun& r, const std::string& what, int status = 1) {
-  EXPECT_EQ(r.status, status) << r.err;
-  ASSERT_FALSE(r.err.empty());
-  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
-  EXPECT_NE(r.err.find(what), std::string::npos) << r.err;
-  EXPECT_LT(r.err.size(), 400u) << r.err;
-}
-
-std::vector<std::string> leftovers(const fs::path& folder) {
-  std::vector<std::string> found;
-  for (const auto& entry : fs::directory_iterator(folder)) {
-    const std::string name = entry.path().filename().string();
-    if (name.find(".tmp") != std::string::npos ||
-        name.find(".tetrapage-spill") != std::string::npos)
-      found.push_back(name);
-  }
-  return found;
-}
-
-class HostileInput : public ::testing::Test {
- protected:
-  void SetUp() override {
-    folder_ = fs::path(TETRAPAGE_TEST_TMP) /
-              ("hostile-" + std::to_string(::getpid()) + "-" +
-               ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(folder_);
-    fs::create_directories(folder_);
-  }
-  void TearDown() override {
-    std::error_code ignored;
-    fs::remove_all(folder_, ignored);
-  }
-  // A model of `triangles` random tetrahedra's faces.
-  fs::path make_model(const std::string& name, std::uint64_t triangles) const {
-    const fs::path path = folder_ / name;
-    TetrasOptions options;
-    options.triangles = triangles;
-    MeshWriter writer(path);
-    generate_tetras(options, writer);
-    writer.commit();
-    return path;
-  }
-  fs::path folder_;
-};
+using test::expect_refused;
+using test::leftovers;
+using test::read_file;
+using test::run;
+using HostileInput = test::HostileFolder;
 
 TEST_F(HostileInput, AnOutputThatIsAnInputIsRefusedAndTheInputKept) {
   const fs::path model = make_model("same.ply", 400);
@@ -173,11 +119,12 @@ TEST_F(HostileInput, CoordinatesThatWouldOverflowAreNamed) {
   expect_refused(run(folder_, "fly model.tpi --object huge.obj --path far.csv"), "1e+308");
 }
 
-// SIGINT and SIGTERM during a preprocess that spills remove its temporary index and spill
-// files; a SIGKILL's leftovers are removed by the next preprocess of the same output.
+// SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGALRM and SIGUSR1 during a preprocess that spills remove
+// its temporary index and spill files; a SIGKILL's leftovers are removed by the next preprocess of
+// the same output.
 TEST_F(HostileInput, InterruptedAndKilledRunsLeaveNothingBehind) {
   make_model("model.ply", 300'000);
-  for (const int signal_number : {SIGINT, SIGTERM, SIGKILL}) {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGPIPE, SIGALRM, SIGUSR1, SIGKILL}) {
     const pid_t child = ::fork();
     ASSERT_GE(child, 0);
     if (child == 0) {

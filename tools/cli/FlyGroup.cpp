@@ -81,7 +81,8 @@ void run_fly_group(const FlyArguments& args) {
   ObjectGroup group(index, models);
   group.set_obstacles(load_obstacles(args, index));
   std::optional<CsvFile> answers;
-  if (!args.answers.empty()) answers.emplace(args.answers, "step,object,collides,environment,objects", "answers file");
+  if (!args.answers.empty())
+    answers.emplace(args.answers, "step,object,collides,environment,objects");
 
   const std::size_t steps = flights.front().size();
   std::vector<Pose> poses(models.size());

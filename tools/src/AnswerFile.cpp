@@ -5,29 +5,16 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/OutputFile.h"
 
 namespace tetrapage {
 
 void write_answers(const std::filesystem::path& path, std::span<const std::uint8_t> collides) {
-  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
-  const std::filesystem::path temporary(path.string() + ".tmp");
-  {
-    std::ofstream out(temporary);
-    if (!out) throw IoError("cannot create answers file '" + temporary.string() + "'");
-    out << "step,collides\n";
-    for (std::size_t i = 0; i < collides.size(); ++i) out << i << ',' << (collides[i] ? 1 : 0) << '\n';
-    if (!out.flush()) {
-      out.close();
-      std::filesystem::remove(temporary);
-      throw IoError("cannot write answers file '" + temporary.string() + "' (disk full?)");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    throw IoError("cannot rename answers file to '" + path.string() + "'");
-  }
+  OutputFile out(path);
+  out.write("step,collides\n");
+  for (std::size_t i = 0; i < collides.size(); ++i)
+    out.write(std::to_string(i) + (collides[i] ? ",1\n" : ",0\n"));
+  out.commit();
 }
 
 std::vector<std::uint8_t> read_answers(const std::filesystem::path& path) {

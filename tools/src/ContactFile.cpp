@@ -20,8 +20,7 @@ Vec3 representative_point(const geometry::ContactGeometry& meet) {
 }  // namespace
 
 ContactFile::ContactFile(const std::filesystem::path& path, const CollisionIndex& index)
-    : file_(path, "step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z",
-            "contacts file"),
+    : file_(path, "step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z"),
       index_(index) {}
 
 void ContactFile::write_row(std::uint64_t step, const char* kind, std::uint32_t part,

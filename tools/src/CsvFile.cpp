@@ -1,10 +1,6 @@
 #include "tetrapage/tools/CsvFile.h"
 
 #include <cstdio>
-#include <span>
-
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage {
 
@@ -21,29 +17,13 @@ std::string number_field(double value) {
   return text;
 }
 
-CsvFile::CsvFile(const std::filesystem::path& path, const std::string& header, std::string what)
-    : path_(path), temporary_(path.string() + ".tmp"), what_(std::move(what)) {
-  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
-  guard_.emplace(temporary_);
-  out_.open(temporary_, std::ios::binary);
-  if (!out_) throw IoError("cannot create " + what_ + " '" + temporary_.string() + "'");
-  out_ << header << '\n';
-}
-
-CsvFile::~CsvFile() {
-  if (committed_) return;
-  out_.close();
-  std::error_code ignored;
-  std::filesystem::remove(temporary_, ignored);
+CsvFile::CsvFile(const std::filesystem::path& path, const std::string& header) : out_(path) {
+  out_.write(header);
+  out_.write("\n", 1);
 }
 
 void CsvFile::commit() {
-  if (!out_.flush()) throw IoError("cannot write " + what_ + " '" + temporary_.string() + "' (disk full?)");
-  out_.close();
-  std::error_code error;
-  std::filesystem::rename(temporary_, path_, error);
-  if (error) throw IoError("cannot rename " + what_ + " to '" + path_.string() + "': " + error.message());
-  committed_ = true;
+  out_.commit();
 }
 
 }  // namespace tetrapage

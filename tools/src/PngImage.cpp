@@ -10,6 +10,7 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/OutputFile.h"
 
 namespace tetrapage {
 namespace {
@@ -61,25 +62,9 @@ void write_png(const std::filesystem::path& path, const RgbImage& image) {
   put_chunk(file, "IDAT", packed);
   put_chunk(file, "IEND", {});
 
-  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
-  const std::filesystem::path temporary = path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError("cannot create '" + temporary.string() + "'");
-    out.write(reinterpret_cast<const char*>(file.data()), std::streamsize(file.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      std::filesystem::remove(temporary, ignored);
-      throw IoError("cannot write '" + temporary.string() + "' (disk full?)");
-    }
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) {
-    std::filesystem::remove(temporary, error);
-    throw IoError("cannot rename '" + temporary.string() + "' to '" + path.string() + "'");
-  }
+  OutputFile out(path);
+  out.write(file.data(), file.size());
+  out.commit();
 }
 
 RgbImage read_png(const std::filesystem::path& path) {

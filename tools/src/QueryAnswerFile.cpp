@@ -75,7 +75,7 @@ const char* fly_query_name(FlyQuery query) {
 
 QueryAnswerFile::QueryAnswerFile(const std::filesystem::path& path, FlyQuery query,
                                  const CollisionIndex& index)
-    : file_(path, header_of(query), "answers file"), index_(index) {}
+    : file_(path, header_of(query)), index_(index) {}
 
 void QueryAnswerFile::write_contacts(std::uint64_t step, FlyingObject& object, const QueryResult& result) {
   const IndexParts& parts = index_.parts();

@@ -6,29 +6,19 @@
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/OutputFile.h"
 
 namespace tetrapage {
 
 void write_report(const std::filesystem::path& path, const nlohmann::json& report) {
-  check_outputs(std::span<const std::filesystem::path>(&path, 1), {});
-  const auto temporary = std::filesystem::path(path.string() + ".tmp");
-  {
-    std::ofstream out(temporary);
-    if (!out) throw IoError("cannot write report '" + temporary.string() + "'");
-    out << report.dump(2) << '\n';
-    if (!out.flush()) throw IoError("cannot write report '" + temporary.string() + "'");
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, path, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    throw IoError("cannot rename report to '" + path.string() + "': " + ec.message());
-  }
+  OutputFile out(path);
+  out.write(report.dump(2) + '\n');
+  out.commit();
 }
 
 void check_writable(const std::filesystem::path& path) {
   if (path.empty()) return;
-  const auto temporary = std::filesystem::path(path.string() + ".tmp");
+  const std::filesystem::path temporary = temporary_path(path);
   {
     std::ofstream probe(temporary);
     if (!probe)

@@ -4,7 +4,8 @@
 /// temporary while it exists; a command installs handlers so that SIGINT and SIGTERM remove
 /// every registered file before the process ends as the signal asks. After a SIGKILL (no
 /// handler runs) the next writer of the same output removes the temporaries of processes
-/// that no longer exist.
+/// that no longer exist. Every writer names its temporary temporary_path(output), so that
+/// the sweep recognises any of them.
 
 #include <cstddef>
 #include <filesystem>
@@ -25,9 +26,16 @@ class TemporaryFileGuard {
   int slot_ = -1;
 };
 
-/// SIGINT and SIGTERM remove every registered temporary, then end the process as the signal's
-/// default action would (exit status 128 + signal for a shell). Idempotent.
+/// Every signal whose default action ends the process (SIGINT, SIGTERM, SIGHUP, SIGPIPE: a
+/// reader of stdout that went away, SIGQUIT, SIGALRM, SIGUSR1, SIGUSR2, SIGXCPU, SIGXFSZ,
+/// SIGVTALRM, SIGPROF) removes every registered temporary, then ends the process as the
+/// signal's default action would (exit status 128 + signal for a shell). A signal the process
+/// was started with ignored (nohup's SIGHUP) stays ignored. Idempotent.
 void remove_temporaries_on_signals();
+
+/// The temporary a writer of `output` fills before renaming it over `output`:
+/// "OUTPUT.tmp-PID" beside it.
+std::filesystem::path temporary_path(const std::filesystem::path& output);
 
 /// Removes `OUTPUT.tmp-PID` files beside `output` whose process PID no longer exists (left by a
 /// killed writer); returns what it removed.

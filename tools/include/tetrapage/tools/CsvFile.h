@@ -5,11 +5,9 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <optional>
 #include <string>
 
-#include "tetrapage/formats/TemporaryFiles.h"
+#include "tetrapage/formats/OutputFile.h"
 
 namespace tetrapage {
 
@@ -20,17 +18,14 @@ std::string number_field(double value);
 
 class CsvFile {
  public:
-  /// Opens `path` under a temporary name and writes `header` (without the line break).
-  /// `what` names the file in errors ("contacts file"). @throw IoError.
-  CsvFile(const std::filesystem::path& path, const std::string& header, std::string what);
-  /// Removes the temporary unless commit() ran.
-  ~CsvFile();
-  CsvFile(const CsvFile&) = delete;
-  CsvFile& operator=(const CsvFile&) = delete;
+  /// Opens `path` under a temporary name (OutputFile.h) and writes `header` (without the line
+  /// break); the temporary is removed unless commit() ran. @throw InputError or IoError.
+  CsvFile(const std::filesystem::path& path, const std::string& header);
 
   /// One row (its fields joined by commas already).
   void row(const std::string& fields) {
-    out_ << fields << '\n';
+    out_.write(fields);
+    out_.write("\n", 1);
     ++rows_;
   }
   std::uint64_t rows() const { return rows_; }
@@ -38,12 +33,8 @@ class CsvFile {
   void commit();
 
  private:
-  std::filesystem::path path_, temporary_;
-  std::string what_;
-  std::optional<TemporaryFileGuard> guard_;
-  std::ofstream out_;
+  OutputFile out_;
   std::uint64_t rows_ = 0;
-  bool committed_ = false;
 };
 
 }  // namespace tetrapage

@@ -1,7 +1,9 @@
 #pragma once
-// Internal: a temporary output file written through a large buffer, every system call checked
-// (a full disk is an IoError naming the output, never a silently short file). The file is
-// removed on destruction unless it was renamed to its final name.
+/// @file OutputFile.h
+/// An output written under a temporary name through a large buffer, every system call checked
+/// (a full disk is an IoError naming the output, never a silently short file), and renamed over
+/// the output only when complete. The temporary is removed on destruction (and by the signal
+/// handlers of TemporaryFiles.h) unless it was renamed.
 
 #include <cstdint>
 #include <cstring>
@@ -12,12 +14,16 @@
 
 #include "tetrapage/formats/TemporaryFiles.h"
 
-namespace tetrapage::detail {
+namespace tetrapage {
 
 class OutputFile {
  public:
-  /// Creates (truncates) `path`. `output` is the name the user asked for, used in messages.
-  /// @throw IoError if the file cannot be created.
+  /// Checks `output` (FileChecks.h: a regular file or nothing), removes the temporaries that
+  /// killed writers left beside it and creates temporary_path(output); commit() renames it.
+  /// @throw InputError or IoError naming the output.
+  explicit OutputFile(std::filesystem::path output);
+  /// Creates (truncates) the temporary `path`, not followed if it is a link. `output` is the
+  /// name the user asked for, used in messages. @throw IoError if it cannot be created.
   OutputFile(std::filesystem::path path, std::filesystem::path output);
   ~OutputFile();
   OutputFile(const OutputFile&) = delete;
@@ -53,6 +59,8 @@ class OutputFile {
   /// Flushes, closes and renames to `final_path`; the file is then no longer removed.
   /// @throw IoError if a write, the close or the rename fails.
   void rename_to(const std::filesystem::path& final_path);
+  /// rename_to the output named at construction.
+  void commit() { rename_to(output_); }
 
   void flush();
 
@@ -71,4 +79,4 @@ class OutputFile {
   std::uint64_t written_ = 0;
 };
 
-}  // namespace tetrapage::detail
+}  // namespace tetrapage
