@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "ReaderSupport.h"
+#include "tetrapage/formats/FileChecks.h"
 
 namespace tetrapage::detail {
 namespace {
@@ -89,6 +90,8 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
     InputFile probe(path, 4096);
     report.bytes = probe.size();
   }
+  // A glTF's buffers are opened by Assimp: a FIFO among them would block it forever.
+  for (const auto& file : files_read_from(path)) require_regular_file(file);
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
   if (scene != nullptr && scene->mNumMeshes == 0) {

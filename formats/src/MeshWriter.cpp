@@ -17,16 +17,16 @@
 #include <nlohmann/json.hpp>
 
 #include "PathSupport.h"
-#include "OutputFile.h"
 #include "TextNumbers.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/OutputFile.h"
 
 namespace tetrapage {
 
 class MeshWriter::Impl {
  public:
-  explicit Impl(const std::filesystem::path& path)
-      : path_(path), output_(temporary(path, ".tmp"), path) {}
+  explicit Impl(const std::filesystem::path& path) : path_(path), output_(path) {}
   virtual ~Impl() = default;
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -65,12 +65,15 @@ class MeshWriter::Impl {
   std::uint64_t parts = 0;
 
  protected:
-  static std::filesystem::path temporary(const std::filesystem::path& path, const char* suffix) {
-    return std::filesystem::path(path.string() + suffix);
+  // A temporary beside the output's own ("OUTPUT.faces.tmp-PID"), swept like it after a kill.
+  static std::filesystem::path side_file(const std::filesystem::path& path, const char* suffix) {
+    const std::filesystem::path side(path.string() + suffix);
+    remove_stale_temporaries(side);
+    return temporary_path(side);
   }
 
   std::filesystem::path path_;
-  detail::OutputFile output_;
+  OutputFile output_;
   bool committed_ = false;
   bool failed_ = false;
 };
@@ -230,8 +233,8 @@ class CountedHeaderWriter : public MeshWriter::Impl {
  public:
   explicit CountedHeaderWriter(const std::filesystem::path& path)
       : Impl(path),
-        vertex_file_(temporary(path, ".vertices.tmp"), path),
-        face_file_(temporary(path, ".faces.tmp"), path) {}
+        vertex_file_(side_file(path, ".vertices"), path),
+        face_file_(side_file(path, ".faces"), path) {}
 
   void finish() override {
     output_.write(header());
@@ -245,8 +248,8 @@ class CountedHeaderWriter : public MeshWriter::Impl {
   /// Bytes after the faces.
   virtual std::string trailer() const { return {}; }
 
-  detail::OutputFile vertex_file_;
-  detail::OutputFile face_file_;
+  OutputFile vertex_file_;
+  OutputFile face_file_;
 };
 
 // Parts go into a `part` element after `face` (Assimp 5.2 fails on an element before it): per
@@ -535,11 +538,14 @@ class GltfWriter final : public MeshWriter::Impl {
 // temporary folder that commit() renames before it renames the manifest.
 class ManifestWriter final : public MeshWriter::Impl {
  public:
-  explicit ManifestWriter(const std::filesystem::path& path)
+  ManifestWriter(const std::filesystem::path& path, std::string length_unit)
       : Impl(path),
+        length_unit_(length_unit.empty() ? "m" : std::move(length_unit)),
         folder_name_(path.stem().string() + ".parts"),
         final_folder_(path.parent_path() / folder_name_),
-        temporary_folder_(path.parent_path() / (folder_name_ + ".tmp")) {
+        temporary_folder_(temporary_path(final_folder_)) {
+    metres_per_unit(length_unit_);  // an unknown unit is an InputError naming it
+    // Impl's OutputFile checked the part folder (check_outputs): it holds part files alone.
     std::error_code error;
     std::filesystem::remove_all(temporary_folder_, error);
     if (!std::filesystem::create_directories(temporary_folder_, error) && error)
@@ -572,7 +578,7 @@ class ManifestWriter final : public MeshWriter::Impl {
     if (current_) current_->commit();
     current_.reset();  // removes its side files before the folder moves
     nlohmann::ordered_json manifest;
-    manifest["units"] = "m";
+    manifest["units"] = length_unit_;
     auto& list = manifest["parts"] = nlohmann::ordered_json::array();
     for (std::size_t k = 0; k < files_.size(); ++k)
       list.push_back({{"name", names_[k]}, {"file", folder_name_ + "/" + files_[k]}});
@@ -598,6 +604,7 @@ class ManifestWriter final : public MeshWriter::Impl {
     return name;
   }
 
+  std::string length_unit_;
   std::string folder_name_;
   std::filesystem::path final_folder_, temporary_folder_;
   std::unique_ptr<MeshWriter> current_;  ///< the part file being written
@@ -615,7 +622,7 @@ bool can_write_mesh(const std::filesystem::path& path) {
   return false;
 }
 
-MeshWriter::MeshWriter(const std::filesystem::path& path) {
+MeshWriter::MeshWriter(const std::filesystem::path& path, std::string length_unit) {
   const std::string extension = detail::lower_extension(path);
   if (extension == ".obj") {
     impl_ = std::make_unique<ObjWriter>(path);
@@ -628,7 +635,7 @@ MeshWriter::MeshWriter(const std::filesystem::path& path) {
   } else if (extension == ".gltf" || extension == ".glb") {
     impl_ = std::make_unique<GltfWriter>(path, extension == ".glb");
   } else if (extension == ".json") {
-    impl_ = std::make_unique<ManifestWriter>(path);
+    impl_ = std::make_unique<ManifestWriter>(path, std::move(length_unit));
   } else {
     throw InputError("'" + path.string() + "': cannot write meshes with the extension '" +
                      extension + "' (writable: .obj, .stl, .ply, .off, .gltf, .glb, and .json: a manifest of parts)");
@@ -724,8 +731,9 @@ std::string_view path_of(const TriangleSoup& soup, std::size_t part) {
 
 }  // namespace
 
-void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup) {
-  MeshWriter writer(path);
+void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup,
+                std::string length_unit) {
+  MeshWriter writer(path, std::move(length_unit));
   if (soup.part_count() <= 1) {
     if (soup.part_count() == 1) {
       writer.add_part(soup.vertices, soup.triangles, soup.part_names[0], path_of(soup, 0));

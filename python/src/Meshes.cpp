@@ -177,18 +177,23 @@ void bind_meshes(py::module_& module) {
         set_deflection(tessellation, deflection, "deflection");
         tessellation.angular_deflection = angular_deflection;
         tessellation.skip_bad_parts = skip_bad_parts;
-        ReadReport report;
         Mesh mesh;
-        {
-          py::gil_scoped_release unlocked;
+        py::gil_scoped_release unlocked;
+        if (is_manifest_path(path)) {
+          // An assembly, placed as every command places it, in its manifest's units.
+          mesh.soup = load_inputs({path}, nullptr, Progress::silent(), tessellation);
+          mesh.length_unit = read_manifest(path).units;
+        } else {
+          ReadReport report;
           mesh.soup = read_mesh(path, &report, tessellation);
+          mesh.length_unit = report.length_unit;
         }
-        mesh.length_unit = report.length_unit;
         return mesh;
       },
       py::arg("path"), py::arg("deflection") = "0.1%", py::arg("angular_deflection") = 0.5,
       py::arg("skip_bad_parts") = false,
-      "Reads OBJ, PLY, OFF, STL, glTF/GLB, STEP or IGES into a Mesh. STEP and IGES are read in "
+      "Reads OBJ, PLY, OFF, STL, glTF/GLB, STEP, IGES or an assembly manifest (.json, placed in "
+      "its units) into a Mesh. STEP and IGES are read in "
       "mm and tessellated: `deflection` is the largest distance between a triangle and the "
       "surface, as a percentage of each shape's diagonal (\"0.1%\") or a length in mm "
       "(\"0.01\"); `angular_deflection` in radians. Raises IoError, FormatError or InputError "

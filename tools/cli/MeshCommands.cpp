@@ -65,6 +65,19 @@ void print_bounds(const BoundingBox& box) {
               box.lo[2], box.hi[0], box.hi[1], box.hi[2]);
 }
 
+// The first parts by name and instance path, one a line: a long assembly is summed up after.
+void print_parts(const TriangleSoup& soup) {
+  constexpr std::size_t kListed = 20;
+  for (std::size_t part = 0; part < soup.part_count() && part < kListed; ++part) {
+    const std::string& name = soup.part_names[part];
+    const std::string& path = soup.part_path(part);
+    std::printf("  part %zu: %s%s%s\n", part, name.empty() ? "(unnamed)" : name.c_str(),
+                path == name ? "" : "  at ", path == name ? "" : path.c_str());
+  }
+  if (soup.part_count() > kListed)
+    std::printf("  ... and %zu more parts\n", soup.part_count() - kListed);
+}
+
 void run_info(const InfoArguments& args) {
   check_outputs(std::span<const std::filesystem::path>(&args.report, 1), args.files);
   nlohmann::json files = nlohmann::json::array();
@@ -93,6 +106,7 @@ void run_info(const InfoArguments& args) {
         soup.part_count(), static_cast<unsigned long long>(degenerate),
         static_cast<unsigned long long>(polygons));
     print_bounds(box);
+    print_parts(soup);
     for (const auto& report : reports) {
       if (!report.length_unit.empty()) std::printf("  %s: unit %s", report.path.c_str(), report.length_unit.c_str());
       if (report.tessellation_deflection > 0)
@@ -130,12 +144,20 @@ void run_info(const InfoArguments& args) {
   }
 }
 
+// The unit of the coordinates load_inputs gave for one input: a manifest's own, else the one
+// its file states (STEP and IGES: mm), else none.
+std::string unit_of_input(const std::filesystem::path& input,
+                          const std::vector<ReadReport>& reports) {
+  if (is_manifest_path(input)) return read_manifest(input).units;
+  return reports.empty() ? std::string() : reports.front().length_unit;
+}
+
 void run_convert(const ConvertArguments& args) {
   check_outputs_writable({args.output, args.report}, {args.input});
   if (!can_write_mesh(args.output)) {
     throw InputError("'" + args.output.string() + "': cannot write meshes with the extension '" +
                      args.output.extension().string() +
-                     "' (writable: .obj, .stl, .ply, .off, .gltf, .glb)");
+                     "' (writable: .obj, .stl, .ply, .off, .gltf, .glb, .json)");
   }
   const auto start = std::chrono::steady_clock::now();
   std::vector<ReadReport> reports;
@@ -144,7 +166,7 @@ void run_convert(const ConvertArguments& args) {
   reading.finish();
   const double read_seconds = seconds_since(start);
   const auto write_start = std::chrono::steady_clock::now();
-  write_mesh(args.output, soup);
+  write_mesh(args.output, soup, unit_of_input(args.input, reports));
   const double write_seconds = seconds_since(write_start);
   std::uint64_t degenerate = 0;
   for (const auto& report : reports) degenerate += report.degenerate_dropped;

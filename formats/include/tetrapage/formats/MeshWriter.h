@@ -31,7 +31,7 @@
 ///   until commit(): meant for small files (objects, examples), not for multi-million-triangle
 ///   models. Parts without a triangle are left out (glTF accessors cannot be empty).
 /// - .json: an assembly manifest (formats/Manifest.h); each part goes to its own binary PLY in
-///   "<stem>.parts/" next to it (written to "<stem>.parts.tmp" and renamed at commit), so
+///   "<stem>.parts/" next to it (written to "<stem>.parts.tmp-PID" and renamed at commit), so
 ///   that preprocess reads one part at a time, whatever the size of the assembly; the
 ///   manifest names it by its path (unique), "#2", "#3", ... appended where one repeats.
 /// Text numbers are the shortest form that reads back as the same double, so OBJ, PLY and
@@ -42,6 +42,7 @@
 #include <filesystem>
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 
 #include "tetrapage/formats/TriangleSoup.h"
@@ -52,9 +53,12 @@ class MeshWriter {
  public:
   /// Opens a temporary file next to `path` (`<path>.tmp`); the format is chosen by the
   /// extension (.obj, .stl (binary), .ply (binary little-endian, double), .off, .gltf, .glb).
-  /// @throw InputError for an extension that cannot be written.
+  /// `length_unit` (a name metres_per_unit knows) is the unit of the coordinates: a manifest
+  /// states it as its "units" (empty: "m"); the other formats hold no unit.
+  /// @throw InputError for an extension that cannot be written, an unknown unit, or a
+  ///        manifest whose part folder holds files other than part files.
   /// @throw IoError if the temporary file cannot be created.
-  explicit MeshWriter(const std::filesystem::path& path);
+  explicit MeshWriter(const std::filesystem::path& path, std::string length_unit = {});
   /// Removes the temporary files unless commit() succeeded.
   ~MeshWriter();
   MeshWriter(const MeshWriter&) = delete;
@@ -106,6 +110,7 @@ bool mesh_format_keeps_parts(const std::filesystem::path& path);
 /// consecutive in the soup (an OBJ file that returns to an earlier group is the exception).
 /// @throw InputError for inconsistent soups (indices or part ids out of range) and as
 ///        MeshWriter; IoError as MeshWriter.
-void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup);
+void write_mesh(const std::filesystem::path& path, const TriangleSoup& soup,
+                std::string length_unit = {});
 
 }  // namespace tetrapage

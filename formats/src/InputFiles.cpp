@@ -1,0 +1,119 @@
+// files_read_from (FileChecks.h): every file a read of an input opens, so that an output is
+// checked against all of them, however they are named.
+
+#include <cctype>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "PathSupport.h"
+#include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/Manifest.h"
+
+namespace tetrapage {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A glTF's JSON larger than this is not parsed here (its reader refuses it, or reads it
+// without external files worth guarding).
+constexpr std::uintmax_t kLargestGltfJson = std::uintmax_t(64) << 20;
+
+// The JSON text of a .gltf, or the JSON chunk of a .glb; empty when it cannot be had.
+std::string gltf_json(const fs::path& path, bool binary) {
+  std::error_code error;
+  if (!fs::is_regular_file(path, error)) return {};
+  std::ifstream in(path, std::ios::binary);
+  if (!binary) {
+    if (fs::file_size(path, error) > kLargestGltfJson || error) return {};
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  // GLB: a 12-byte header, then the JSON chunk's length and type.
+  unsigned char header[20];
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return {};
+  std::uint32_t length = 0;
+  std::memcpy(&length, header + 12, 4);  // little-endian, as the machine
+  if (std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0 ||
+      length > kLargestGltfJson)
+    return {};
+  std::string text(length, '\0');
+  if (!in.read(text.data(), std::streamsize(length))) return {};
+  return text;
+}
+
+// A URI's percent escapes decoded ("a%20b.bin" -> "a b.bin").
+std::string decoded_uri(const std::string& uri) {
+  std::string path;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() &&
+        std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+      path += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      path += uri[i];
+    }
+  }
+  return path;
+}
+
+// The files a glTF's buffers and images name (data URIs and other schemes are not files).
+void add_gltf_files(const fs::path& path, bool binary, std::vector<fs::path>& files) {
+  const nlohmann::json document = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
+  if (!document.is_object()) return;
+  for (const char* list : {"buffers", "images"}) {
+    const auto entries = document.find(list);
+    if (entries == document.end() || !entries->is_array()) continue;
+    for (const auto& entry : *entries) {
+      if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
+      const std::string uri = entry["uri"].get<std::string>();
+      if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos)
+        continue;
+      // Readers differ on percent escapes (Assimp 5.2 opens the URI as written): both count.
+      files.push_back(path.parent_path() / uri);
+      if (const std::string decoded = decoded_uri(uri); decoded != uri)
+        files.push_back(path.parent_path() / decoded);
+    }
+  }
+}
+
+void add_mesh_files(const fs::path& path, std::vector<fs::path>& files) {
+  files.push_back(path);
+  const std::string extension = detail::lower_extension(path);
+  if (extension == ".gltf" || extension == ".glb") add_gltf_files(path, extension == ".glb", files);
+}
+
+void add_manifest_files(const Manifest& manifest, std::set<const Manifest*>& seen,
+                        std::vector<fs::path>& files) {
+  if (!seen.insert(&manifest).second) return;
+  files.push_back(manifest.path);
+  for (const ManifestPart& part : manifest.parts) {
+    if (part.assembly) {
+      add_manifest_files(*part.assembly, seen, files);
+    } else {
+      add_mesh_files(part.file, files);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<fs::path> files_read_from(const fs::path& input) {
+  std::vector<fs::path> files;
+  if (input.empty()) return files;
+  std::error_code error;
+  if (is_manifest_path(input) && fs::is_regular_file(input, error)) {
+    const Manifest manifest = read_manifest(input);
+    std::set<const Manifest*> seen;
+    add_manifest_files(manifest, seen, files);
+  } else {
+    add_mesh_files(input, files);
+  }
+  return files;
+}
+
+}  // namespace tetrapage
