@@ -216,3 +216,41 @@ def test_names_without_ids_and_an_empty_mesh(tmp_path):
     for extent in (0.0, -1.0, float("nan")):
         with pytest.raises(tetrapage.InputError, match="query_extent"):
             tetrapage.preprocess(source, tmp_path / "t.tpi", query_extent=extent)
+
+
+def test_obstacles_save_replaces_nothing_but_an_overlay(cube_index, tmp_path):
+    """save on the index it was opened from, on another index or on a device is refused and
+    leaves the file as it was; an overlay is replaced."""
+    before = cube_index.read_bytes()
+    obstacles = tetrapage.Obstacles(tetrapage.Index(cube_index))
+    vertices, triangles = cube()
+    obstacles.insert((vertices * 0.1, triangles), pose(0.4, 0.4, 0.4), name="box")
+    with pytest.raises(tetrapage.InputError, match="refusing"):
+        obstacles.save(cube_index)
+    assert cube_index.read_bytes() == before
+    other = tmp_path / "other.tpi"
+    other.write_bytes(before)
+    with pytest.raises(tetrapage.InputError, match="something else"):
+        obstacles.save(other)
+    assert other.read_bytes() == before
+    with pytest.raises(tetrapage.InputError, match="character device"):
+        obstacles.save("/dev/full")
+    saved = tmp_path / "v.tpo"
+    obstacles.save(saved)
+    obstacles.save(saved)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["other.tpi", "v.tpo"]
+    with pytest.raises(tetrapage.InputError, match="line break"):
+        obstacles.insert((vertices * 0.1, triangles), pose(0.4, 0.4, 0.4), name="a\nb")
+
+
+def test_read_mesh_reads_manifests_as_the_commands_do(tmp_path):
+    """A manifest in mm placing one file twice: read_mesh gives both placements, in mm."""
+    vertices, triangles = cube()
+    tetrapage.write_mesh(tmp_path / "cube.ply", (vertices, triangles))
+    (tmp_path / "a.json").write_text(
+        '{"units": "mm", "parts": [{"file": "cube.ply", "instances": '
+        '[{"translation": [0, 0, 0]}, {"translation": [5, 0, 0]}]}]}')
+    mesh = tetrapage.read_mesh(tmp_path / "a.json")
+    assert mesh.length_unit == "mm"
+    assert len(mesh) == 2 * len(triangles)
+    assert mesh.vertices[:, 0].max() == 6.0

@@ -9,6 +9,19 @@
 #include "tetrapage/formats/Error.h"
 
 namespace tetrapage {
+namespace {
+
+// A name the overlay file can hold on a line of its own and read back.
+void require_savable_name(const std::string& name, DynamicPartId id) {
+  if (name.find('\n') != std::string::npos)
+    throw InputError("dynamic part " + std::to_string(id) + ": a name may not hold a line break");
+  if (name.size() > kMaxObstacleNameBytes)
+    throw InputError("dynamic part " + std::to_string(id) + ": its name has " +
+                     std::to_string(name.size()) + " bytes, more than " +
+                     std::to_string(kMaxObstacleNameBytes));
+}
+
+}  // namespace
 
 DynamicObstacles::DynamicObstacles(std::shared_ptr<const CollisionIndex> index, double cell_size)
     : index_(std::move(index)) {
@@ -123,6 +136,7 @@ DynamicPartId DynamicObstacles::insert(std::shared_ptr<const ObjectModel> model,
                                        std::string name) {
   if (!model) throw InputError("dynamic part " + std::to_string(next_id_) + " has no model");
   if (next_id_ == 0xffffffffu) throw InputError("dynamic obstacles: every part id was used");
+  require_savable_name(name, next_id_);
   const DynamicPartId id = next_id_;
   const geometry::Box box = placed_box(*model, pose, id);
   ++next_id_;

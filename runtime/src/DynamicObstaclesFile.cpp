@@ -19,15 +19,20 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <span>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <type_traits>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/OutputFile.h"
 #include "tetrapage/runtime/DynamicObstacles.h"
 
 namespace tetrapage {
@@ -37,48 +42,85 @@ namespace {
 constexpr const char* kMagic = "tetrapage-dynamic-obstacles";
 constexpr int kVersion = 1;
 
+// Text of the file shown in a message: a few dozen characters, control bytes escaped.
+std::string excerpt(const std::string& text) {
+  constexpr std::size_t kShown = 40;
+  std::string shown;
+  for (std::size_t i = 0; i < text.size() && i < kShown; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x20 && c < 0x7f) {
+      shown += char(c);
+    } else {
+      char escape[8];
+      std::snprintf(escape, sizeof escape, "\\x%02x", c);
+      shown += escape;
+    }
+  }
+  return text.size() > kShown ? shown + "..." : shown;
+}
+
 std::string hex(double x) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%a", x);
   return buffer;
 }
 
-void write_part(std::ostream& out, const DynamicObstacles::Part& part) {
+void write_part(OutputFile& out, const DynamicObstacles::Part& part) {
   const TriangleSoup& mesh = part.model->mesh;
-  out << "part " << part.id << ' ' << part.name.size() << '\n' << part.name << '\n';
-  out << "pose";
-  for (const double x : part.pose.translation) out << ' ' << hex(x);
-  for (const double x : part.pose.rotation) out << ' ' << hex(x);
-  out << "\nmesh " << mesh.vertices.size() << ' ' << mesh.triangles.size() << '\n';
+  out.write("part " + std::to_string(part.id) + ' ' + std::to_string(part.name.size()) + '\n' +
+            part.name + '\n');
+  std::string pose = "pose";
+  for (const double x : part.pose.translation) pose += ' ' + hex(x);
+  for (const double x : part.pose.rotation) pose += ' ' + hex(x);
+  out.write(pose + "\nmesh " + std::to_string(mesh.vertices.size()) + ' ' +
+            std::to_string(mesh.triangles.size()) + '\n');
   for (const auto& v : mesh.vertices)
-    out << "v " << hex(v[0]) << ' ' << hex(v[1]) << ' ' << hex(v[2]) << '\n';
-  for (const auto& t : mesh.triangles) out << "f " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
-  out << "end\n";
+    out.write("v " + hex(v[0]) + ' ' + hex(v[1]) + ' ' + hex(v[2]) + '\n');
+  for (const auto& t : mesh.triangles)
+    out.write("f " + std::to_string(t[0]) + ' ' + std::to_string(t[1]) + ' ' +
+              std::to_string(t[2]) + '\n');
+  out.write("end\n");
+}
+
+// save replaces an existing file only when it is empty or an overlay: an index, a mesh or any
+// other file of the user's named by mistake is kept.
+void require_replaceable(const std::filesystem::path& path) {
+  std::error_code error;
+  if (!std::filesystem::exists(path, error) || std::filesystem::file_size(path, error) == 0) return;
+  std::ifstream in(path, std::ios::binary);
+  std::string start(std::string_view(kMagic).size(), '\0');
+  if (!in.read(start.data(), std::streamsize(start.size())) || start != kMagic)
+    throw InputError("refusing to write the dynamic obstacles to '" + path.string() +
+                     "': it holds something else (an overlay file starts with '" + kMagic + "')");
 }
 
 // Reads the file line by line; every failure names the file and the line.
 class LineReader {
  public:
-  explicit LineReader(const std::filesystem::path& path) : path_(path), in_(path) {
+  explicit LineReader(const std::filesystem::path& path) : path_(path) {
+    require_regular_file(path_);  // a FIFO or /dev/zero would block or grow forever
+    in_.open(path_, std::ios::binary);
     if (!in_) throw FormatError(path_.string() + ": cannot open the dynamic obstacles file");
   }
-  [[noreturn]] void fail(const std::string& what) const {
-    throw FormatError(path_.string() + ": line " + std::to_string(line_) + ": " + what);
+  [[noreturn]] void fail(const std::string& what) const { fail_at(line_, what); }
+  [[noreturn]] void fail_at(std::size_t line, const std::string& what) const {
+    throw FormatError(path_.string() + ": line " + std::to_string(line) + ": " + what);
   }
   // The next line, which must start with `word`: the rest of it as a stream.
   std::istringstream record(const std::string& word) {
     std::string text = next_line("'" + word + "'");
     std::istringstream fields(text);
     std::string first;
-    if (!(fields >> first) || first != word) fail("expected '" + word + "', read '" + text + "'");
+    if (!(fields >> first) || first != word)
+      fail("expected '" + word + "', read '" + excerpt(text) + "'");
     return fields;
   }
   std::string next_line(const std::string& expected) {
     std::string text;
-    if (!std::getline(in_, text)) fail("the file ends where " + expected + " was expected");
-    ++line_;
+    if (!bounded_line(text)) fail("the file ends where " + expected + " was expected");
     return text;
   }
+  std::size_t line() const { return line_; }
   // Reads `n` numbers of type T from `fields`, then requires the end of the line.
   template <class T>
   void numbers(std::istringstream& fields, T* out, int n) {
@@ -88,7 +130,7 @@ class LineReader {
       out[i] = parse<T>(token);
     }
     std::string extra;
-    if (fields >> extra) fail("unexpected '" + extra + "'");
+    if (fields >> extra) fail("unexpected '" + excerpt(extra) + "'");
   }
   template <class T>
   T parse(const std::string& token) const {
@@ -96,28 +138,48 @@ class LineReader {
     errno = 0;
     if constexpr (std::is_floating_point_v<T>) {
       const double x = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') fail("'" + token + "' is not a number");
+      if (end == token.c_str() || *end != '\0') fail("'" + excerpt(token) + "' is not a number");
       return x;
     } else {
-      if (token.empty() || token[0] == '-') fail("'" + token + "' is not a count or an id");
+      if (token.empty() || token[0] == '-')
+        fail("'" + excerpt(token) + "' is not a count or an id");
       const unsigned long long x = std::strtoull(token.c_str(), &end, 10);
       if (end == token.c_str() || *end != '\0' || errno == ERANGE ||
           x > std::numeric_limits<T>::max())
-        fail("'" + token + "' is not a count or an id");
+        fail("'" + excerpt(token) + "' is not a count or an id");
       return T(x);
     }
   }
   // Nothing but blank lines may follow the last part.
   void expect_end() {
     std::string text;
-    while (std::getline(in_, text)) {
-      ++line_;
+    while (bounded_line(text)) {
       if (text.find_first_not_of(" \t\r") != std::string::npos)
-        fail("unexpected '" + text + "' after the last part");
+        fail("unexpected '" + excerpt(text) + "' after the last part");
     }
   }
 
  private:
+  // The longest line the format holds: a name, or a pose of seven "%a" numbers.
+  static constexpr std::size_t kMaxLineBytes = kMaxObstacleNameBytes + 1;
+
+  // Reads the next line into `text` (false at the end of the file); a line longer than the
+  // format holds fails, so that no input grows memory without bound.
+  bool bounded_line(std::string& text) {
+    text.clear();
+    int c = 0;
+    while ((c = in_.get()) != std::char_traits<char>::eof() && c != '\n') {
+      if (text.size() == kMaxLineBytes) {
+        ++line_;
+        fail("the line is longer than " + std::to_string(kMaxLineBytes) + " bytes");
+      }
+      text += char(c);
+    }
+    if (c == std::char_traits<char>::eof() && text.empty()) return false;
+    ++line_;
+    return true;
+  }
+
   std::filesystem::path path_;
   std::ifstream in_;
   std::size_t line_ = 0;
@@ -125,6 +187,7 @@ class LineReader {
 
 // One part's record; its mesh and pose (the part is inserted by the caller).
 struct ReadPart {
+  std::size_t pose_line = 0;  ///< where the pose stands (insert checks it)
   DynamicPartId id = 0;
   std::string name;
   Pose pose;
@@ -144,6 +207,7 @@ ReadPart read_part(LineReader& reader) {
     reader.fail("the name has " + std::to_string(part.name.size()) + " bytes, not " +
                 std::to_string(fields[1]));
   auto pose = reader.record("pose");
+  part.pose_line = reader.line();
   double p[7];
   reader.numbers(pose, p, 7);
   part.pose.translation = {p[0], p[1], p[2]};
@@ -156,12 +220,18 @@ ReadPart read_part(LineReader& reader) {
     auto v = reader.record("v");
     Vec3 x;
     reader.numbers(v, x.data(), 3);
+    if (!std::isfinite(x[0]) || !std::isfinite(x[1]) || !std::isfinite(x[2]))
+      reader.fail("a coordinate is not finite");
     part.mesh.vertices.push_back(x);
   }
   for (std::uint32_t i = 0; i < counts[1]; ++i) {
     auto f = reader.record("f");
     TriangleIndices t;
     reader.numbers(f, t.data(), 3);
+    for (const auto corner : t)
+      if (corner >= counts[0])
+        reader.fail("vertex " + std::to_string(corner) + " is beyond the part's " +
+                    std::to_string(counts[0]));
     part.mesh.triangles.push_back(t);
   }
   reader.record("end");
@@ -173,26 +243,22 @@ ReadPart read_part(LineReader& reader) {
 }  // namespace
 
 void DynamicObstacles::save(const std::filesystem::path& path) const {
-  const std::filesystem::path temporary = path.string() + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    if (!out) throw IoError(temporary.string() + ": cannot write the dynamic obstacles");
-    out << kMagic << ' ' << kVersion << "\nnext_id " << next_id_ << "\nhidden " << hidden_count_;
-    for (const std::uint32_t p : hidden_parts()) out << ' ' << p;
-    out << "\nparts " << parts_.size() << '\n';
-    // In id order: the file does not depend on the order of removals.
-    std::vector<const Part*> sorted;
-    for (const Part& part : parts_) sorted.push_back(&part);
-    std::sort(sorted.begin(), sorted.end(),
-              [](const Part* a, const Part* b) { return a->id < b->id; });
-    for (const Part* part : sorted) write_part(out, *part);
-    out.flush();
-    if (!out) throw IoError(temporary.string() + ": cannot write the dynamic obstacles");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error)
-    throw IoError(path.string() + ": cannot write the dynamic obstacles: " + error.message());
+  const std::filesystem::path& index_file = index_->path();
+  check_outputs(std::span<const std::filesystem::path>(&path, 1),
+                std::span<const std::filesystem::path>(&index_file, 1));
+  require_replaceable(path);
+  OutputFile out(path);
+  std::string header = std::string(kMagic) + ' ' + std::to_string(kVersion) + "\nnext_id " +
+                       std::to_string(next_id_) + "\nhidden " + std::to_string(hidden_count_);
+  for (const std::uint32_t p : hidden_parts()) header += ' ' + std::to_string(p);
+  out.write(header + "\nparts " + std::to_string(parts_.size()) + '\n');
+  // In id order: the file does not depend on the order of removals.
+  std::vector<const Part*> sorted;
+  for (const Part& part : parts_) sorted.push_back(&part);
+  std::sort(sorted.begin(), sorted.end(),
+            [](const Part* a, const Part* b) { return a->id < b->id; });
+  for (const Part* part : sorted) write_part(out, *part);
+  out.commit();
 }
 
 DynamicObstacles DynamicObstacles::load(std::shared_ptr<const CollisionIndex> index,
@@ -233,7 +299,9 @@ DynamicObstacles DynamicObstacles::load(std::shared_ptr<const CollisionIndex> in
       overlay.next_id_ = part.id;  // the saved id
       overlay.insert(std::move(part.mesh), part.pose, std::move(part.name));
     } catch (const InputError& e) {
-      reader.fail(std::string("part ") + std::to_string(part.id) + ": " + e.what());
+      // Lines are checked as they are read: what insert refuses is the pose or the whole mesh.
+      reader.fail_at(part.pose_line,
+                     std::string("part ") + std::to_string(part.id) + ": " + e.what());
     }
   }
   reader.expect_end();

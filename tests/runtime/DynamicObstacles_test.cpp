@@ -8,6 +8,7 @@
 // answers; damaged files fail with a FormatError naming the file; the C API answers as C++.
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
@@ -640,6 +641,136 @@ TEST(DynamicObstacles, DamagedFilesFailWithAFormatErrorNamingTheFile) {
   expect_format_error(text + "garbage\n", "trailing garbage");
   expect_format_error(std::string("\x00\xff\x10", 3), "binary");
   EXPECT_THROW(DynamicObstacles::load(scene().index, scene().folder / "missing.tpo"), FormatError);
+}
+
+// save writes under a temporary name renamed into place, and replaces nothing but a regular
+// file that is empty or an overlay: not the index it was opened on, not another index, not what
+// a link points to, never a FIFO or a device.
+TEST(DynamicObstacles, SaveReplacesNothingButAnOverlay) {
+  auto overlay = std::make_shared<DynamicObstacles>(scene().index);
+  Random random(9);
+  overlay->insert(part_model(116, 0.15, 2), random_pose(random, 0.2, 0.8), "a");
+  const fs::path folder = scene().folder / "save-rules";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  auto bytes_of = [](const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const fs::path index_file = scene().folder / "scene.tpi";
+  const std::string index_bytes = bytes_of(index_file);
+  EXPECT_THROW(overlay->save(index_file), InputError);
+  fs::copy_file(index_file, folder / "other.tpi");
+  EXPECT_THROW(overlay->save(folder / "other.tpi"), InputError);
+  fs::create_symlink(folder / "other.tpi", folder / "link.tpo");
+  EXPECT_THROW(overlay->save(folder / "link.tpo"), InputError);
+  ASSERT_EQ(::mkfifo((folder / "fifo.tpo").c_str(), 0600), 0);
+  EXPECT_THROW(overlay->save(folder / "fifo.tpo"), InputError);
+  EXPECT_THROW(overlay->save("/dev/full"), InputError);
+  EXPECT_EQ(bytes_of(index_file), index_bytes);
+  EXPECT_EQ(bytes_of(folder / "other.tpi"), index_bytes);
+  struct stat status {};
+  ASSERT_EQ(::stat("/dev/full", &status), 0);
+  EXPECT_TRUE(S_ISCHR(status.st_mode));
+  // An overlay is replaced; a failed save leaves no temporary.
+  overlay->save(folder / "v.tpo");
+  overlay->insert(part_model(116, 0.15, 3), random_pose(random, 0.2, 0.8), "b");
+  overlay->save(folder / "v.tpo");
+  EXPECT_EQ(DynamicObstacles::load(scene().index, folder / "v.tpo").size(), 2u);
+  for (const auto& entry : fs::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  // The C API says the same, with the reason.
+  tetrapage_index* index = nullptr;
+  ASSERT_EQ(tetrapage_open(index_file.c_str(), TETRAPAGE_DEFAULT_BUDGET_BYTES, &index),
+            TETRAPAGE_OK);
+  tetrapage_obstacles* obstacles = nullptr;
+  ASSERT_EQ(tetrapage_obstacles_create(index, &obstacles), TETRAPAGE_OK);
+  EXPECT_EQ(tetrapage_obstacles_save(obstacles, index_file.c_str()), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_obstacles_save(obstacles, (folder / "other.tpi").c_str()),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_obstacles_save(obstacles, "/dev/full"), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(bytes_of(index_file), index_bytes);
+  tetrapage_obstacles_destroy(obstacles);
+  tetrapage_close(index);
+}
+
+// A name save could not write back on a line of its own is refused when the part is inserted.
+TEST(DynamicObstacles, NamesThatCannotRoundTripAreRefused) {
+  DynamicObstacles overlay(scene().index);
+  Random random(10);
+  const Pose pose = random_pose(random, 0.2, 0.8);
+  EXPECT_THROW(overlay.insert(part_model(116, 0.15, 2), pose, "two\nlines"), InputError);
+  EXPECT_THROW(
+      overlay.insert(part_model(116, 0.15, 2), pose, std::string(kMaxObstacleNameBytes + 1, 'n')),
+      InputError);
+  EXPECT_EQ(overlay.size(), 0u);
+  const std::string longest(kMaxObstacleNameBytes, 'n');
+  overlay.insert(part_model(116, 0.15, 2), pose, longest);
+  overlay.insert(part_model(116, 0.15, 3), pose, "tab\tand\rreturn");
+  const fs::path path = scene().folder / "names.tpo";
+  overlay.save(path);
+  const DynamicObstacles loaded = DynamicObstacles::load(scene().index, path);
+  ASSERT_EQ(loaded.size(), 2u);
+  EXPECT_EQ(loaded.find(1)->name, longest);
+  EXPECT_EQ(loaded.find(2)->name, "tab\tand\rreturn");
+}
+
+// Loading reads bounded lines from regular files only, and names the line at fault with a few
+// dozen characters of it, whatever the file holds.
+TEST(DynamicObstacles, LoadIsBoundedAndNamesTheLineAtFault) {
+  EXPECT_THROW(DynamicObstacles::load(scene().index, "/dev/zero"), IoError);
+  const fs::path folder = scene().folder;
+  auto load_error = [&](const std::string& content) -> std::string {
+    {
+      std::ofstream out(folder / "hostile.tpo", std::ios::binary | std::ios::trunc);
+      out << content;
+    }
+    try {
+      DynamicObstacles::load(scene().index, folder / "hostile.tpo");
+    } catch (const FormatError& e) {
+      return e.what();
+    }
+    return "loaded";
+  };
+  const std::string long_line = load_error(std::string(8u << 20, 'x'));
+  EXPECT_NE(long_line.find("line 1: the line is longer than"), std::string::npos)
+      << long_line.substr(0, 200);
+  EXPECT_LT(long_line.size(), 300u);
+  const std::string binary =
+      load_error("tetrapage-dynamic-obstacles \x01\x02" + std::string(500, '\xff') + "\n");
+  EXPECT_LT(binary.size(), 300u) << binary;
+  EXPECT_NE(binary.find("\\x01"), std::string::npos) << binary;
+  // A non-finite coordinate or a vertex out of range: the line that holds it.
+  DynamicObstacles overlay(scene().index);
+  Random random(11);
+  overlay.insert(part_model(116, 0.15, 2), random_pose(random, 0.2, 0.8), "a");
+  overlay.save(folder / "fine.tpo");
+  std::ifstream in(folder / "fine.tpo", std::ios::binary);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  auto joined = [](const std::vector<std::string>& list) {
+    std::string text;
+    for (const auto& line : list) text += line + "\n";
+    return text;
+  };
+  for (const char* kind : {"v ", "f "}) {
+    std::size_t at = 0;
+    while (lines[at].rfind(kind, 0) != 0) ++at;
+    at += 2;  // the third of its kind
+    std::vector<std::string> damaged = lines;
+    damaged[at] = kind == std::string("v ") ? "v 0 nan 0" : "f 0 1 4000000";
+    const std::string message = load_error(joined(damaged));
+    EXPECT_NE(message.find("line " + std::to_string(at + 1) + ":"), std::string::npos)
+        << kind << message;
+  }
+  // A pose insert refuses (not unit): the pose's line.
+  std::size_t pose_line = 0;
+  while (lines[pose_line].rfind("pose ", 0) != 0) ++pose_line;
+  std::vector<std::string> damaged = lines;
+  damaged[pose_line] = "pose 0 0 0 2 0 0 0";
+  const std::string message = load_error(joined(damaged));
+  EXPECT_NE(message.find("line " + std::to_string(pose_line + 1) + ":"), std::string::npos)
+      << message;
 }
 
 TEST(DynamicObstacles, TheCApiAnswersAsCxx) {

@@ -47,6 +47,8 @@ namespace tetrapage {
 /// A dynamic part's id: stable, never reused by its overlay; 0 is no part.
 using DynamicPartId = std::uint32_t;
 inline constexpr DynamicPartId kNoDynamicPart = 0;
+/// The longest name a dynamic part may have, in bytes (an overlay file's line is bounded).
+inline constexpr std::size_t kMaxObstacleNameBytes = 4096;
 
 class DynamicObstacles {
  public:
@@ -70,9 +72,10 @@ class DynamicObstacles {
 
   /// A new part: `mesh` (built into an ObjectModel, tens of microseconds for 100 triangles) or
   /// a shared model, at `pose`. Returns its id.
-  /// @throw InputError for a mesh ObjectModel rejects, a null model, or a bad pose (as
+  /// @throw InputError for a mesh ObjectModel rejects, a null model, a bad pose (as
   ///        FlyingObject::query: non-finite, non-unit, a translation beyond
-  ///        kMaxCoordinateMagnitude).
+  ///        kMaxCoordinateMagnitude), or a name save could not write back (a line break, or
+  ///        more than kMaxObstacleNameBytes bytes).
   DynamicPartId insert(TriangleSoup mesh, const Pose& pose, std::string name = {});
   DynamicPartId insert(std::shared_ptr<const ObjectModel> model, const Pose& pose,
                        std::string name = {});
@@ -108,14 +111,18 @@ class DynamicObstacles {
   const std::shared_ptr<const CollisionIndex>& index() const { return index_; }
 
   /// Writes the overlay (parts, names, poses, meshes, hidden parts) to `path` as text
-  /// (the format is described in DynamicObstacles.cpp), under a temporary name renamed when
-  /// complete. Coordinates are written as hexadecimal floats: they read back bit for bit.
-  /// @throw IoError when the file cannot be written.
+  /// (the format is described in DynamicObstaclesFile.cpp), under a temporary name renamed
+  /// when complete (OutputFile.h). Coordinates are written as hexadecimal floats: they read
+  /// back bit for bit. It replaces nothing but a regular file that is empty or an overlay
+  /// already, and never the index's own file.
+  /// @throw InputError for a `path` it refuses; IoError when the file cannot be written.
   void save(const std::filesystem::path& path) const;
   /// An overlay on `index` read from `path`: the same ids, names, poses, meshes and hidden
   /// parts (ids inserted later continue after the saved ones).
-  /// @throw FormatError naming the file (and the line) for a missing, truncated or malformed
-  ///        file, or one that does not fit `index` (a hidden part it does not list).
+  /// @throw IoError for a path that is not a regular file (a FIFO, a device); FormatError
+  ///        naming the file and the line at fault for a missing, truncated or malformed file
+  ///        (a line longer than the format allows too), or one that does not fit `index` (a
+  ///        hidden part it does not list).
   static DynamicObstacles load(std::shared_ptr<const CollisionIndex> index,
                                const std::filesystem::path& path, double cell_size = 0);
 
