@@ -12,6 +12,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <set>
 #include <span>
 #include <sstream>
 
@@ -137,6 +138,9 @@ constexpr int kMaxJsonDepth = 64;
 /// Thrown by the parser callback, caught in read_manifest.
 struct TooDeep {
   int depth = 0;
+};
+struct RepeatedKey {
+  std::string key;
 };
 
 void require_keys(const json& object, const JsonPlace& place,
@@ -271,18 +275,29 @@ json parse_document(const std::filesystem::path& path) {
   if (!stream) throw IoError("cannot open manifest '" + file + "': " + std::strerror(errno));
   json document;
   try {
-    // The callback sees each array or object open, with the number already open around it.
-    const json::parser_callback_t limit_depth = [](int depth, json::parse_event_t event, json&) {
+    // The callback sees each array or object open, with the number already open around it, and
+    // each key: a key given twice in one object would silently keep the last value.
+    std::vector<std::set<std::string>> keys_of_open_objects;
+    const json::parser_callback_t check_structure = [&](int depth, json::parse_event_t event,
+                                                        json& parsed) {
       if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
           depth + 1 > kMaxJsonDepth)
         throw TooDeep{depth + 1};
+      if (event == json::parse_event_t::object_start) keys_of_open_objects.emplace_back();
+      if (event == json::parse_event_t::object_end) keys_of_open_objects.pop_back();
+      if (event == json::parse_event_t::key &&
+          !keys_of_open_objects.back().insert(parsed.get<std::string>()).second)
+        throw RepeatedKey{parsed.get<std::string>()};
       return true;
     };
     // Comments are allowed, so a manifest can explain itself.
-    document = json::parse(stream, limit_depth, true, true);
+    document = json::parse(stream, check_structure, true, true);
   } catch (const TooDeep& deep) {
     throw FormatError(file + ": arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
                       " levels (depth " + std::to_string(deep.depth) + "); a manifest needs 6");
+  } catch (const RepeatedKey& repeated) {
+    throw FormatError(file + ": the key " + in_quotes(repeated.key) +
+                      " is given twice in one object");
   } catch (const json::exception& error) {
     // A syntax error, or a number beyond double's range (out_of_range, found by fuzzing). Its
     // text quotes the token read last, which can be as long as the file.

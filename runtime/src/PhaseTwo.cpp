@@ -4,6 +4,7 @@
 #include <cmath>
 #include <tuple>
 
+#include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
 #include "tetrapage/runtime/geometry/TriangleDistance.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
@@ -40,6 +41,9 @@ PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, Placed
 void PhaseTwo::add_contact(const Source& source, const geometry::Triangle& environment,
                            std::uint32_t object_triangle) {
   result_.collides = true;
+  if (all_ && result_.contacts.size() == options_.max_contacts)
+    throw InputError("the step finds more than " + std::to_string(options_.max_contacts) +
+                     " contacts (the limit of one step; raise it, or narrow the clearance)");
   if (all_ || result_.contacts.empty()) {
     if (source.part != kNoDynamicPart) {
       result_.contacts.push_back(

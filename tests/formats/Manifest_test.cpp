@@ -223,6 +223,12 @@ TEST(Manifest, ErrorsNameTheFileAndTheJsonPath) {
        {"parts[0].units", "sub-assembly"}},
       {R"({"parts": [{"file": "sub.json"}]})", false, {"parts[0].file", "'manifest'"}},
       {R"({"parts": [{"manifest": ""}]})", false, {"parts[0].manifest", "empty"}},
+      {R"({"parts": [{"file": "frame.obj"}], "parts": [{"file": "sub/bracket.off"}]})",
+       false,
+       {"'parts'", "twice"}},
+      {R"({"parts": [{"file": "frame.obj", "instances": [{"translation": [1, 2, 3], "translation": [0, 0, 0]}]}]})",
+       false,
+       {"'translation'", "twice"}},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const auto files = write_assembly("manifest_bad", cases[i].json);

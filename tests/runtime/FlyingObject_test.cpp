@@ -464,6 +464,33 @@ void expect_input_error(Body&& body, const std::vector<std::string>& words) {
   }
 }
 
+// A step that would collect more contacts than QueryOptions::max_contacts is refused naming the
+// limit; one at the limit answers in full.
+TEST(FlyingObject, AllContactsStopAtTheirLimit) {
+  const World world = make_world(Kind::scene, 10000, 116, 200, 7, 200);
+  auto index = std::make_shared<const CollisionIndex>(world.index_path);
+  FlyingObject object(index, world.object);
+  QueryOptions all;
+  all.mode = QueryMode::all_contacts;
+  all.accuracy =
+      geometry::Accuracy::within(0.05);  // a billiard flight keeps clear: a margin meets triangles
+  std::size_t busiest = 0;
+  Pose busiest_pose;
+  for (const Pose& pose : world.flight.poses) {
+    const std::size_t found = object.query(pose, all).contacts.size();
+    if (found > busiest) busiest = found, busiest_pose = pose;
+  }
+  ASSERT_GE(busiest, 2u) << "the flight must come near several triangles at once";
+  all.max_contacts = busiest;
+  EXPECT_EQ(object.query(busiest_pose, all).contacts.size(), busiest);
+  all.max_contacts = busiest - 1;
+  expect_input_error([&] { object.query(busiest_pose, all); },
+                     {"more than " + std::to_string(busiest - 1), "contacts"});
+  // The object answers the next step as before.
+  all.max_contacts = busiest;
+  EXPECT_EQ(object.query(busiest_pose, all).contacts.size(), busiest);
+}
+
 // Problems that used to surface at the first query ("mesh walk: point (-nan ...)", "no tet
 // reachable", a cache error) are input errors where the bad value is given.
 TEST(FlyingObject, BadObjectsPosesAndBudgetsAreRejectedUpFront) {

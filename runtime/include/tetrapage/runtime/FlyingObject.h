@@ -66,11 +66,18 @@ enum class Motion : std::uint8_t {
   swept,
 };
 
+/// The most contacts one all_contacts step collects by default (about 32 MB of them).
+inline constexpr std::size_t kDefaultMaxContacts = 1'000'000;
+
 struct QueryOptions {
   geometry::Accuracy accuracy = geometry::Accuracy::exact();
   QueryMode mode = QueryMode::first_hit;
   ObjectShape shape = ObjectShape::mesh;
   Motion motion = Motion::discrete;
+  /// all_contacts: a step that finds more contacts than this throws InputError naming the
+  /// limit (a wide clearance over a dense model can find billions), instead of growing without
+  /// bound.
+  std::size_t max_contacts = kDefaultMaxContacts;
 };
 
 /// One contact: an environment triangle (its part, connected component and model-wide id) and
