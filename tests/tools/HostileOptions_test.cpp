@@ -7,6 +7,8 @@
 
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -15,6 +17,10 @@
 #include <vector>
 
 #include "RunCli.h"
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/UnitQuaternion.h"
+#include "tetrapage/tools/AnswerFile.h"
 
 namespace tetrapage {
 namespace {
@@ -256,6 +262,73 @@ TEST_F(HostileOptions, ASymbolicLinkLoopIsNamedAsOne) {
   expect_usage_error("mesh info loop", "loop of symbolic links");
   expect_usage_error("mesh info missing.ply", "'missing.ply' does not exist");
   expect_nothing_written(1);
+}
+
+// The message `read` throws for `bytes` written to `name`.
+template <typename Read>
+std::string message_reading(const fs::path& path, const std::string& bytes, Read read) {
+  std::ofstream(path, std::ios::binary) << bytes;
+  try {
+    read(path);
+  } catch (const Error& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << path << " was read";
+  return {};
+}
+
+// A message that quotes an input stays one short line of printable text.
+void expect_printable_and_short(const std::string& message) {
+  EXPECT_LT(message.size(), 300u) << message;
+  for (const char c : message)
+    EXPECT_TRUE(c >= 0x20 && c < 0x7f)
+        << "byte " << int(static_cast<unsigned char>(c)) << " in " << message;
+}
+
+TEST_F(HostileOptions, QuotedInputIsCutAndEscaped) {
+  const std::string binary = std::string("\x01\xff\x00tail\n", 7) + std::string(500, 'z');
+  const std::string header = "tx,ty,tz,qw,qx,qy,qz\n";
+  const std::string pose_message =
+      message_reading(folder_ / "poses.csv", header + "0,0,0,1,0,0," + binary + "\n",
+                      [](const fs::path& path) { read_poses(path); });
+  expect_printable_and_short(pose_message);
+  EXPECT_NE(pose_message.find("'\\x01\\xff\\x00tail"), std::string::npos) << pose_message;
+  EXPECT_NE(pose_message.find("zzz...'"), std::string::npos) << pose_message;
+  const std::string bad_header = message_reading(folder_ / "header.csv", binary + "\n",
+                                                 [](const fs::path& path) { read_poses(path); });
+  expect_printable_and_short(bad_header);
+  const std::string answer_message =
+      message_reading(folder_ / "answers.csv", "step,collides\n0," + binary + "\n",
+                      [](const fs::path& path) { read_answers(path); });
+  expect_printable_and_short(answer_message);
+  EXPECT_NE(answer_message.find("\\x01\\xff\\x00tail"), std::string::npos) << answer_message;
+}
+
+std::string exactly(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+TEST_F(HostileOptions, PoseFilesTakeTheRuntimesRuleForUnitQuaternions) {
+  const std::string header = "tx,ty,tz,qw,qx,qy,qz\n";
+  const auto read = [](const fs::path& path) { read_poses(path); };
+  // Length 2: once normalised silently, while the C API and Python refused it.
+  const std::string twice =
+      message_reading(folder_ / "twice.csv", header + "0,0,0,1,0,0,0\n0,0,0,2,0,0,0\n", read);
+  EXPECT_NE(twice.find("line 3"), std::string::npos) << twice;
+  EXPECT_NE(twice.find("length 2"), std::string::npos) << twice;
+  // Just beyond and just within the tolerance of the squared length.
+  const double beyond = std::sqrt(1 + 2 * kUnitQuaternionTolerance);
+  const double within = std::sqrt(1 + 0.5 * kUnitQuaternionTolerance);
+  const std::string off =
+      message_reading(folder_ / "off.csv", header + "0,0,0," + exactly(beyond) + ",0,0,0\n", read);
+  EXPECT_NE(off.find("line 2"), std::string::npos) << off;
+  std::ofstream(folder_ / "near.csv") << header << "0,0,0," << exactly(within) << ",0,0,0\n";
+  const std::vector<Pose> near = read_poses(folder_ / "near.csv");
+  ASSERT_EQ(near.size(), 1u);
+  EXPECT_TRUE(is_unit_quaternion(near[0].rotation));
+  EXPECT_DOUBLE_EQ(near[0].rotation[0], 1.0);  // normalised
 }
 
 }  // namespace
