@@ -5,6 +5,7 @@
 #include "tetrapage/formats/Pose.h"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -12,6 +13,7 @@
 #include "TextNumbers.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/OutputFile.h"
+#include "tetrapage/formats/UnitQuaternion.h"
 
 namespace tetrapage {
 
@@ -109,10 +111,13 @@ std::vector<Pose> read_poses(const std::filesystem::path& path) {
     pose.rotation = {values[3], values[4], values[5], values[6]};
     const double norm2 = values[3] * values[3] + values[4] * values[4] + values[5] * values[5] +
                          values[6] * values[6];
-    if (!(norm2 > 0) || !std::isfinite(norm2)) {
-      throw InputError(where(file) + "the quaternion (" + std::string(fields[3]) + ", " +
-                       std::string(fields[4]) + ", " + std::string(fields[5]) + ", " +
-                       std::string(fields[6]) + ") cannot be normalised");
+    if (!is_unit_quaternion(pose.rotation)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "the quaternion (qw, qx, qy, qz) has length %.9g: a rotation is a unit "
+                    "quaternion (squared length within %g of 1)",
+                    std::sqrt(norm2), kUnitQuaternionTolerance);
+      throw InputError(where(file) + text);
     }
     pose.rotation = unit_quaternion(pose.rotation);
     poses.push_back(pose);

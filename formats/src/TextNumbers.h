@@ -10,6 +10,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "tetrapage/formats/QuotedInput.h"
+
 namespace tetrapage::detail {
 
 inline bool is_space(char c) {
@@ -73,14 +75,9 @@ inline void append_double(std::string& text, double value) {
   text.append(buffer, write_double(buffer, value));
 }
 
-/// A token quoted for an error message, cut short if very long.
+/// A token quoted for an error message: cut short if very long, unprintable bytes escaped.
 inline std::string quote_token(std::string_view token) {
-  constexpr std::size_t limit = 40;
-  // Built by append: GCC 12 warns falsely (-Wrestrict) on "'" + std::string(...).
-  std::string text(1, '\'');
-  text.append(token.substr(0, limit));
-  text.append(token.size() > limit ? "...'" : "'");
-  return text;
+  return quoted_input(token);
 }
 
 }  // namespace tetrapage::detail

@@ -104,7 +104,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   if (inputs.empty()) throw InputError("no input given");
   check_outputs(std::span<const std::filesystem::path>(&output, 1), inputs);
   const std::size_t stale = remove_stale_temporaries(output).size();
-  if (options.memory_bytes < (std::uint64_t(16) << 20))
+  if (options.memory_bytes < kLeastPreprocessMemory)
     throw InputError("--memory " + format_byte_size(options.memory_bytes) +
                      " is below the 16 MiB the pipeline needs to work");
   const auto start = Clock::now();

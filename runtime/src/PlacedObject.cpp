@@ -3,6 +3,7 @@
 #include <cstdio>
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/UnitQuaternion.h"
 
 namespace tetrapage {
 
@@ -22,11 +23,9 @@ void PlacedObject::rebind(const ObjectModel& model) {
 }
 
 void PlacedObject::place(const Pose& pose) {
-  const double n = pose.rotation[0] * pose.rotation[0] + pose.rotation[1] * pose.rotation[1] +
-                   pose.rotation[2] * pose.rotation[2] + pose.rotation[3] * pose.rotation[3];
   if (!(std::isfinite(pose.translation[0]) && std::isfinite(pose.translation[1]) &&
         std::isfinite(pose.translation[2])) ||
-      !std::isfinite(n) || std::fabs(n - 1) > 1e-6) {
+      !is_unit_quaternion(pose.rotation)) {
     char text[200];
     std::snprintf(text, sizeof text,
                   "invalid pose: translation (%g, %g, %g), quaternion (%g, %g, %g, %g)",

@@ -149,12 +149,20 @@ void add_check_location_command(CLI::App& app) {
       "the faces it crosses name the tet. Ties (points on or within float error of a shared\n"
       "face, edge or vertex) are decided by the exact point-in-tet predicate.\n"
       "Prints `disagreements: K` and exits 0 only when K == 0.");
-  command->add_option("index", args->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
-  command->add_option("--points", args->points,
-                      "Points to check: half random, 20% on faces, 20% on edges, 10% on vertices")
-      ->capture_default_str();
-  command->add_option("--seed", args->seed, "Seed of the points and start tets")->capture_default_str();
-  command->add_option("--threads", args->threads, "Worker threads (0: all cores)")->capture_default_str();
+  command->add_option("index", args->index, "Index file (.tpi)")
+      ->required()
+      ->check(existing_file_check());
+  command
+      ->add_option("--points", args->points,
+                   "Points to check: half random, 20% on faces, 20% on edges, 10% on vertices")
+      ->capture_default_str()
+      ->check(whole_number_check(1, kMostPoints));
+  command->add_option("--seed", args->seed, "Seed of the points and start tets")
+      ->capture_default_str()
+      ->check(seed_check());
+  command->add_option("--threads", args->threads, "Worker threads (0: all cores)")
+      ->capture_default_str()
+      ->check(whole_number_check(0, kMostThreads));
   command->add_option("--report", args->report, "Write the figures and every disagreement as JSON");
   command->callback([args] { run_check_location(*args); });
 }

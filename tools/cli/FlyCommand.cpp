@@ -77,7 +77,9 @@ class QueryStep {
   QueryStep(const FlyArguments& args, const QueryOptions& options, const CollisionIndex& index)
       : query_(parse_fly_query(args.query)), options_(options) {
     if (!args.contacts.empty() && (query_ == FlyQuery::distance || query_ == FlyQuery::time_of_impact))
-      throw InputError(std::string("fly: --contacts lists a collision query's contacts, not --query ") + args.query);
+      throw UsageError(
+          std::string("fly: --contacts lists a collision query's contacts, not --query ") +
+          args.query);
     if (query_ == FlyQuery::contacts) options_.mode = QueryMode::all_contacts;
     distance_options_.max_distance = args.max_distance;
     impact_options_.tolerance = args.toi_tolerance;
@@ -154,7 +156,7 @@ class QueryStep {
 
 void run_fly(const FlyArguments& args) {
   if (args.objects.size() != args.paths.size())
-    throw InputError("fly: " + std::to_string(args.objects.size()) + " --object but " +
+    throw UsageError("fly: " + std::to_string(args.objects.size()) + " --object but " +
                      std::to_string(args.paths.size()) + " --path: give one pose file per object");
   if (args.objects.size() > 1) return run_fly_group(args);
   check_outputs_writable({args.answers, args.report, args.contacts},
@@ -314,6 +316,17 @@ void run_fly(const FlyArguments& args) {
   check.finish();
 }
 
+// An option of one query given with another would change nothing: a mistake, not a no-op.
+void refuse_options_of_other_queries(const FlyArguments& args, const CLI::Option& max_distance,
+                                     const CLI::Option& toi_tolerance) {
+  const FlyQuery query = parse_fly_query(args.query);
+  if (max_distance.count() > 0 && query != FlyQuery::distance)
+    throw UsageError("fly: --max-distance applies to --query distance, not to --query " +
+                     args.query);
+  if (toi_tolerance.count() > 0 && query != FlyQuery::time_of_impact)
+    throw UsageError("fly: --toi-tolerance applies to --query toi, not to --query " + args.query);
+}
+
 }  // namespace
 
 void add_fly_command(CLI::App& app) {
@@ -325,32 +338,45 @@ void add_fly_command(CLI::App& app) {
       "percentiles, page-ins, the cache hit rate and the collisions.");
   command->add_option("index", args->index, "Index file (.tpi) from `tetrapage preprocess`")
       ->required()
-      ->check(CLI::ExistingFile);
-  command->add_option("--object", args->objects,
-                      "Flying object: a mesh, a STEP or IGES file (read in mm), or a manifest (.json); converted "
-                      "to the index's unit when both state theirs. Repeat it, with one --path each, to fly "
-                      "several objects at once (each against the environment and against each other; --query "
-                      "collide only)")
+      ->check(existing_file_check());
+  command
+      ->add_option(
+          "--object", args->objects,
+          "Flying object: a mesh, a STEP or IGES file (read in mm), or a manifest (.json); "
+          "converted "
+          "to the index's unit when both state theirs. Repeat it, with one --path each, to fly "
+          "several objects at once (each against the environment and against each other; --query "
+          "collide only)")
       ->required()
-      ->check(CLI::ExistingFile);
-  command->add_option("--object-unit", args->object_unit,
-                      "Unit of an object file that states none (plain meshes): m, cm, mm, um, in or ft");
-  command->add_option("--object-scale", args->object_scale, "Scale applied to the object after the unit conversion")
-      ->capture_default_str();
+      ->check(existing_file_check());
+  command
+      ->add_option(
+          "--object-unit", args->object_unit,
+          "Unit of an object file that states none (plain meshes): m, cm, mm, um, in or ft")
+      ->check(parsed_by([](const std::string& unit) { metres_per_unit(unit); }, "UNIT"));
+  command
+      ->add_option("--object-scale", args->object_scale,
+                   "Scale applied to the object after the unit conversion")
+      ->capture_default_str()
+      ->check(positive_number_check(1e12));
   args->tessellation.add_to(command);
   command->add_option("--contacts", args->contacts,
                       "Write the contacts as CSV: step, kind, environment part (id, name, instance path), "
                       "environment and object triangle, one point where they meet (the first contact of a "
                       "step; every pair with --all-contacts)");
-  command->add_option("--path", args->paths, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz); one per --object, in order")
+  command
+      ->add_option("--path", args->paths,
+                   "Pose file (CSV tx,ty,tz,qw,qx,qy,qz); one per --object, in order")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   add_memory_option(
       command, args->memory,
       "Budget of the decoded shards held in memory; one above the index's shards costs no more");
-  command->add_option("--accuracy", args->accuracy,
-                      "exact, double_eps, float_eps (optionally :EPSILON) or clearance:D")
-      ->capture_default_str();
+  command
+      ->add_option("--accuracy", args->accuracy,
+                   "exact, double_eps, float_eps (optionally :EPSILON) or clearance:D")
+      ->capture_default_str()
+      ->check(parsed_by([](const std::string& text) { geometry::parse_accuracy(text); }, "MODE"));
   command->add_flag("--all-contacts", args->all_contacts, "Collect every contact pair, not only the first hit");
   command->add_flag("--no-prefetch", args->no_prefetch, "Disable the background prefetcher");
   command->add_flag("--prefetch-ahead", args->prefetch_ahead,
@@ -359,37 +385,58 @@ void add_fly_command(CLI::App& app) {
   command->add_flag("--no-shard-arena", args->no_shard_arena,
                     "Decode shards into malloc's memory instead of the arena whose pages a background "
                     "thread faults in ahead of use");
-  command->add_option("--spin-before-sleep", args->spin_before_sleep_us,
-                      "Microseconds a wait between the flying thread and the prefetcher polls before it "
-                      "sleeps (0: sleep at once; polling keeps the prefetch thread's core busy)")
-      ->capture_default_str();
+  command
+      ->add_option(
+          "--spin-before-sleep", args->spin_before_sleep_us,
+          "Microseconds a wait between the flying thread and the prefetcher polls before it "
+          "sleeps (0: sleep at once; polling keeps the prefetch thread's core busy)")
+      ->capture_default_str()
+      ->check(whole_number_check(0, 1'000'000));
   command->add_flag("--preload", args->preload,
                     "Load every shard before the first step (needs --memory of at least the index's shards): "
                     "the all-resident reference; open-to-first-answer then excludes the preload");
-  command->add_option("--query", args->query,
-                      "What each step asks: collide (does the object touch?), contacts (every contact pair with "
-                      "where the triangles meet and their normals), distance (the distance and closest points, "
-                      "0 when touching), toi (the first time of contact during the motion from the previous pose, "
-                      "translation linear and rotation by slerp)")
-      ->capture_default_str();
-  command->add_option("--max-distance", args->max_distance,
-                      "--query distance: distances beyond this (index units) are answered only as 'farther' "
-                      "(cheap in free space); default: measure any distance");
-  command->add_option("--toi-tolerance", args->toi_tolerance,
-                      "--query toi: the width of the certified bracket of the contact time, in the motion's time "
-                      "[0, 1] between two poses")
-      ->capture_default_str();
-  command->add_option("--obstacles", args->obstacles,
-                      "Dynamic obstacles saved beside the index (DynamicObstacles::save, tetrapage_obstacles_save): "
-                      "their parts count as obstacles, the index parts they hide do not")
-      ->check(CLI::ExistingFile);
+  command
+      ->add_option(
+          "--query", args->query,
+          "What each step asks: collide (does the object touch?), contacts (every contact pair "
+          "with "
+          "where the triangles meet and their normals), distance (the distance and closest points, "
+          "0 when touching), toi (the first time of contact during the motion from the previous "
+          "pose, "
+          "translation linear and rotation by slerp)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"collide", "contacts", "distance", "toi"}));
+  auto* max_distance = command
+                           ->add_option("--max-distance", args->max_distance,
+                                        "--query distance: distances beyond this (index units) are "
+                                        "answered only as 'farther' "
+                                        "(cheap in free space); default: measure any distance")
+                           ->check(number_check(0, kLongestLength));
+  auto* toi_tolerance = command
+                            ->add_option("--toi-tolerance", args->toi_tolerance,
+                                         "--query toi: the width of the certified bracket of the "
+                                         "contact time, in the motion's time "
+                                         "[0, 1] between two poses")
+                            ->capture_default_str()
+                            ->check(positive_number_check(1));
+  command
+      ->add_option("--obstacles", args->obstacles,
+                   "Dynamic obstacles saved beside the index (DynamicObstacles::save, "
+                   "tetrapage_obstacles_save): "
+                   "their parts count as obstacles, the index parts they hide do not")
+      ->check(existing_file_check());
   command->add_option("--answers", args->answers,
                       "Write the answers as CSV: step,collides for --query collide; one row per contact, or per "
                       "step with the distance or the time of impact, for the other queries (docs/USAGE.md)");
-  command->add_option("--check", args->check, "Compare with these answers; exit non-zero on any disagreement")
-      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--check", args->check,
+                   "Compare with these answers; exit non-zero on any disagreement")
+      ->check(existing_file_check());
   command->add_option("--report", args->report, "Write figures as JSON");
-  command->callback([args] { run_fly(*args); });
+  command->callback([args, max_distance, toi_tolerance] {
+    refuse_options_of_other_queries(*args, *max_distance, *toi_tolerance);
+    run_fly(*args);
+  });
 }
 
 }  // namespace tetrapage::cli

@@ -24,10 +24,18 @@ namespace {
 // The options one object alone would take that a group does not.
 void refuse_single_object_options(const FlyArguments& args) {
   if (parse_fly_query(args.query) != FlyQuery::collide)
-    throw InputError("fly: several objects answer --query collide only (contacts, distance and toi take one object)");
-  if (!args.contacts.empty()) throw InputError("fly: --contacts takes one object");
-  if (!args.check.empty()) throw InputError("fly: --check takes one object");
-  if (args.preload) throw InputError("fly: --preload takes one object");
+    throw UsageError(
+        "fly: several objects answer --query collide only (contacts, distance and toi take one "
+        "object)");
+  if (!args.contacts.empty()) throw UsageError("fly: --contacts takes one object");
+  if (!args.check.empty()) throw UsageError("fly: --check takes one object");
+  if (args.preload) throw UsageError("fly: --preload takes one object");
+  // The objects are tested against each other exactly: another accuracy would hold against the
+  // environment only, and the answers would mix two rules.
+  if (geometry::parse_accuracy(args.accuracy).mode != geometry::AccuracyMode::exact)
+    throw UsageError(
+        "fly: several objects are tested against each other exactly, not with --accuracy " +
+        args.accuracy + "; fly them one at a time");
 }
 
 // The flights, one per object, all as long as the first.

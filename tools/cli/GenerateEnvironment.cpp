@@ -82,7 +82,8 @@ void add_common_options(CLI::App& command, Common& common, bool with_seed) {
   command.add_option("-o,--output", common.output, formats_help)->required();
   if (with_seed)
     command.add_option("--seed", common.seed, "Random seed (a whole number)")
-        ->capture_default_str();
+        ->capture_default_str()
+        ->check(seed_check());
   command.add_option("--report", common.report, "Also write the figures as JSON to this file");
 }
 
@@ -113,7 +114,7 @@ void add_scene(CLI::App& generate) {
       "The same seed and meshes give the same file.");
   command->add_option("--triangles", options->triangles, "Target number of triangles (a count)")
       ->capture_default_str()
-      ->check(CLI::Range(std::uint64_t{1}, max_scene_triangles));
+      ->check(whole_number_check(1, max_scene_triangles));
   options->open_fraction = default_scene_open_fraction;
   command
       ->add_option("--open-fraction", options->open_fraction,
@@ -121,7 +122,8 @@ void add_scene(CLI::App& generate) {
                    "above a plane at a random 60-90% of the copy's extent along a random direction "
                    "are dropped (of what remains, the largest connected piece is kept). The "
                    "triangle target counts the kept triangles. 0: every copy closed")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(number_check(0, 1));
   add_common_options(*command, *common, true);
   add_meshes_option(*command, *common);
   command->callback([common, options] {
@@ -176,7 +178,7 @@ void add_tetras(CLI::App& generate) {
       ->add_option("--triangles", options->triangles,
                    "Number of triangles (a count, 4 per tetrahedron)")
       ->capture_default_str()
-      ->check(CLI::Range(std::uint64_t{1}, max_tetras_triangles));
+      ->check(whole_number_check(1, max_tetras_triangles));
   add_common_options(*command, *common, true);
   command->callback([common, options] {
     const auto start = std::chrono::steady_clock::now();
@@ -215,13 +217,13 @@ void add_terrain(CLI::App& generate) {
       "surface, one part.");
   command->add_option("--triangles", options->triangles, "Target number of triangles (a count)")
       ->capture_default_str()
-      ->check(CLI::Range(std::uint64_t{1}, max_terrain_triangles));
+      ->check(whole_number_check(1, max_terrain_triangles));
   command
       ->add_option(
           "--roughness", options->roughness,
           "Fractal roughness H, no unit: amplitude ratio 2^-H between levels (1 smooth, 0 noise)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 4.0));
+      ->check(number_check(0, 4));
   add_common_options(*command, *common, true);
   command->callback([common, options] {
     const auto start = std::chrono::steady_clock::now();
@@ -264,17 +266,19 @@ void add_object(CLI::App& generate) {
       "at or above the request is used; with --seed a random one of those.");
   command->add_option("--triangles", options->triangles, "Number of triangles (a count, about)")
       ->capture_default_str()
-      ->check(CLI::Range(std::uint64_t{1}, max_object_triangles));
+      ->check(whole_number_check(1, max_object_triangles));
   command
       ->add_option("--size", options->size,
                    "Side of the cube the object is fitted into, in model units (match the "
                    "environment's: e.g. 65 for a 1300 mm assembly)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestLength));
   command->add_option("-o,--output", common->output, formats_help)->required();
-  command->add_option("--seed", *seed,
-                      "Pick a random real mesh (large objects only; a whole number). Default: "
-                      "the mesh with the fewest triangles at or above the request");
+  command
+      ->add_option("--seed", *seed,
+                   "Pick a random real mesh (large objects only; a whole number). Default: "
+                   "the mesh with the fewest triangles at or above the request")
+      ->check(seed_check());
   command->add_option("--report", common->report, "Also write the figures as JSON to this file");
   add_meshes_option(*command, *common);
   command->callback([common, options, seed] {

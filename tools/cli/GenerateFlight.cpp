@@ -144,29 +144,33 @@ void add_generate_flight_command(CLI::App& generate) {
       "runtime. Writes poses as CSV `tx,ty,tz,qw,qx,qy,qz` (translations in model units); the\n"
       "same seed gives the same file.");
   command->add_option("--env", args->environment, "Environment: a mesh file or a manifest (.json)")
-      ->check(CLI::ExistingFile);
-  command->add_option("--index", args->index,
-                      "Instead of --env: an index (.tpi), collisions decided by tetrapage's exact runtime "
-                      "(for models too large for the in-core oracle, ~150 B a triangle)")
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
+  command
+      ->add_option(
+          "--index", args->index,
+          "Instead of --env: an index (.tpi), collisions decided by tetrapage's exact runtime "
+          "(for models too large for the in-core oracle, ~150 B a triangle)")
+      ->check(existing_file_check());
   add_memory_option(command, args->memory, "With --index: the runtime's budget of decoded shards");
   command->add_option("--object", args->object, "Flying object mesh (its own frame, model units)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   command->add_option("--steps", args->options.steps, "Number of poses written")
       ->capture_default_str()
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32));
-  command->add_option("--seed", args->options.seed, "Random seed")->capture_default_str();
+      ->check(whole_number_check(1, 1ll << 32));
+  command->add_option("--seed", args->options.seed, "Random seed")
+      ->capture_default_str()
+      ->check(seed_check());
   command
       ->add_option("--displacement", args->options.displacement,
                    "Distance moved per step, in model units. Default: the diagonal of the "
                    "environment's bounding box / 346 (0.005 for the unit cube)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestLength));
   command
       ->add_option("--max-rotation", args->options.max_rotation,
                    "Largest rotation per step, in radians")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_check(0, 3.14159265358979));
   command->add_option("-o,--output", args->output, "Pose file to write (CSV)")->required();
   command->add_option("--answers", args->answers,
                       "Also write the oracle's answers (CSV `step,collides`)");

@@ -12,6 +12,9 @@
 namespace tetrapage::cli {
 namespace {
 
+// The longest length a layout option takes: a kilometre, far beyond any rack.
+constexpr double kLongestMillimetres = 1e6;
+
 const std::filesystem::path kKicadParts = "/usr/share/kicad/3dmodels";
 const std::filesystem::path kHeader =
     "Connector_PinHeader_2.54mm.3dshapes/PinHeader_2x05_P2.54mm_Vertical.step";
@@ -103,31 +106,31 @@ void run_generate_rack(RackArguments& args) {
 void add_layout_options(CLI::App& command, RackOptions& o) {
   command.add_option("--board-types", o.board_types, "Distinct boards laid out, used in turn")
       ->capture_default_str()
-      ->check(CLI::Range(std::size_t{1}, std::size_t{64}));
+      ->check(whole_number_check(1, 64));
   command.add_option("--board-length", o.board.length, "Plate length (mm)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestMillimetres));
   command.add_option("--board-width", o.board.width, "Plate width (mm)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestMillimetres));
   command.add_option("--board-thickness", o.board.thickness, "Plate thickness (mm)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestMillimetres));
   command
       .add_option("--gap", o.board.gap,
                   "Free space between footprints and from the plate's edges (mm)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_check(0, kLongestMillimetres));
   command.add_option("--pitch", o.pitch, "Distance between neighbouring boards in a cage (mm)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestMillimetres));
   command.add_option("--slots", o.slots, "Boards per card cage")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_check(1, 10000));
   command
       .add_option("--cages", o.cages, "Cages stacked in one rack (more boards: racks side by side)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number_check(1, 10000));
   command.add_flag(
       "--flat", o.flat,
       "Write one manifest of mesh entries (each placement composed) instead of the rack "
@@ -144,7 +147,7 @@ void add_parts_options(CLI::App& command, RackArguments& args) {
       ->check(CLI::ExistingDirectory);
   command.add_option("--parts", o.parts.count, "Distinct parts drawn from the folder")
       ->capture_default_str()
-      ->check(CLI::Range(std::size_t{1}, std::size_t{100000}));
+      ->check(whole_number_check(1, 100000));
   command
       .add_option("--max-file-size", args.max_file_size,
                   "Files larger than this are passed over (bytes; K, M, G)")
@@ -152,31 +155,31 @@ void add_parts_options(CLI::App& command, RackArguments& args) {
       ->check(byte_size_check());
   command.add_option("--max-height", o.parts.max_height, "Taller parts are passed over (mm)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestMillimetres));
   command
       .add_option("--max-side", o.parts.max_side,
                   "Parts whose footprint has a longer side are passed over (mm)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number_check(kLongestMillimetres));
   command
       .add_option("--connector", o.connector,
                   "A STEP header put first on every board type (default: KiCad's " +
                       kHeader.filename().string() +
                       " under the parts folder, with --plug its socket)")
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   command
       .add_option("--plug", o.plug,
                   "The STEP part inserted into a board's connector (the flying object)")
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   command.add_flag("--no-connector", args.no_connector, "No connector and no insertion flight");
   command.add_option("--insert-steps", o.insert_steps, "Poses of the insertion flight")
       ->capture_default_str()
-      ->check(CLI::Range(std::size_t{2}, std::size_t{1} << 24));
+      ->check(whole_number_check(2, 1ll << 24));
   command
       .add_option("--insert-depth", o.insert_depth,
                   "How far the plug's face travels past the header's top (mm)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(number_check(0, kLongestMillimetres));
 }
 
 }  // namespace
@@ -198,9 +201,10 @@ void add_generate_rack_command(CLI::App& generate) {
       ->add_option("--triangles", args->options.triangles,
                    "Boards are added until the rack holds this many triangles")
       ->capture_default_str()
-      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 40));
+      ->check(whole_number_check(1, 1ll << 40));
   command->add_option("--seed", args->options.parts.seed, "Random seed (parts drawn, layouts)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(seed_check());
   command->add_option("-o,--output", args->output, "Rack manifest to write (.json)")->required();
   command->add_option("--report", args->report, "Also write the figures as JSON to this file");
   add_parts_options(*command, *args);

@@ -2,6 +2,7 @@
 // (and its mesh's stabbing number, by the walk and by Embree), and check it from end to end.
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -18,6 +19,7 @@
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/IndexSchema.h"
 #include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/CollisionIndex.h"
@@ -33,6 +35,37 @@ namespace tetrapage::cli {
 
 namespace schema = index_schema;
 namespace {
+
+// The other format a file name's extension names ("a PNG image"), or empty: an index written
+// under a picture's or a mesh's name would be opened as one by every other program.
+std::string other_format_named(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+  for (const char* image :
+       {".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".ppm", ".svg"})
+    if (extension == image) return "an image";
+  if (extension == ".csv") return "a CSV table";
+  if (extension == ".json") return "a JSON file (a manifest or a report)";
+  if (extension.size() > 1) {
+    try {
+      mesh_format_from_path(path);
+      return "a mesh";
+    } catch (const InputError&) {
+      // no reader claims it: free for an index
+    }
+  }
+  return {};
+}
+
+CLI::Validator index_output_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const std::string format = other_format_named(text);
+        if (format.empty()) return {};
+        return "'" + text + "' names " + format + ", not an index (write MODEL.tpi)";
+      },
+      "", "index file name");
+}
 
 struct PreprocessArguments {
   std::vector<std::filesystem::path> inputs;
@@ -390,10 +423,18 @@ void add_index_commands(CLI::App& app) {
       "Cut an assembly into a coarse tetrahedral mesh of regions, each with a grid or R-tree\n"
       "shard of the triangles it meets (exact test), and write one HDF5 index.\n"
       "The index is written under a temporary name and renamed only when complete.");
-  command->add_option("inputs", pre->inputs, "Mesh files (obj, stl, ply, off, gltf, glb, ...), STEP or IGES files, or manifests (.json)")
+  command
+      ->add_option("inputs", pre->inputs,
+                   "Mesh files (obj, stl, ply, off, gltf, glb, ...), STEP or IGES files, or "
+                   "manifests (.json)")
       ->required()
-      ->check(CLI::ExistingFile);
-  command->add_option("-o,--output", pre->output, "The index file to write (e.g. model.tpi)")->required();
+      ->check(existing_file_check());
+  command
+      ->add_option("-o,--output", pre->output,
+                   "The index file to write (model.tpi; not a mesh's, a picture's, a CSV or a JSON "
+                   "file's name)")
+      ->required()
+      ->check(index_output_check());
   command->add_option("--region-triangles", pre->region_triangles,
                       "Target triangles per region; 0 (the default): 4096, or the model's triangles / 12,000 "
                       "when larger, so that the coarse mesh stays near 100k tets")
@@ -404,8 +445,11 @@ void add_index_commands(CLI::App& app) {
       "Working-memory budget of the stages' data, at least 16M: larger models spill to disk\n"
       "next to the output. It bounds what the stages hold; the process itself (about 22 MiB)\n"
       "and each input file's soup while it is read come on top, and the summary says by how\n"
-      "much the peak exceeded the budget");
-  command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")->capture_default_str();
+      "much the peak exceeded the budget",
+      kLeastPreprocessMemory);
+  command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")
+      ->capture_default_str()
+      ->check(whole_number_check(0, kMostThreads));
   command->add_option("--shard", pre->shard, "Shard kind: auto (measured cost model), grid or rtree")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "grid", "rtree"}));
@@ -422,9 +466,11 @@ void add_index_commands(CLI::App& app) {
                       "decompression, a third of its time)")
       ->capture_default_str()
       ->check(CLI::IsMember({"lz4", "none"}));
-  command->add_option("--query-extent", pre->query_extent,
-                      "Side of the query boxes the cost model plans for (0: 5% of the model's size)")
-      ->capture_default_str();
+  command
+      ->add_option("--query-extent", pre->query_extent,
+                   "Side of the query boxes the cost model plans for (0: 5% of the model's size)")
+      ->capture_default_str()
+      ->check(number_check(0, kLongestLength));
   command->add_option("--interiors", pre->interiors,
                       "Classify each region's reference point against the closed components (connected\n"
                       "surfaces whose every edge is used an even number of times; exact ray parity, one pass\n"
@@ -434,24 +480,34 @@ void add_index_commands(CLI::App& app) {
   command->add_flag("--accept-undecided", pre->accept_undecided,
                    "Store a region whose inside cannot be decided (every reference point tried lies on a\n"
                    "closed surface) as undecided, where containment is then unknown, instead of failing");
-  command->add_option("--unit", pre->unit,
-                      "Length unit of inputs that state none (plain meshes): m, cm, mm, um, in or ft; STEP "
-                      "and IGES are read in mm and a manifest states its units; recorded in the index");
+  command
+      ->add_option(
+          "--unit", pre->unit,
+          "Length unit of inputs that state none (plain meshes): m, cm, mm, um, in or ft; STEP "
+          "and IGES are read in mm and a manifest states its units; recorded in the index")
+      ->check(parsed_by([](const std::string& unit) { metres_per_unit(unit); }, "UNIT"));
   pre->tessellation.add_to(command);
   command->add_option("--report", pre->report, "Write the summary as JSON");
   command->callback([pre] { run_preprocess(*pre); });
 
   auto inspect = std::make_shared<InspectArguments>();
   auto* inspect_command = app.add_subcommand("inspect", "Show what an index holds and where its bytes go");
-  inspect_command->add_option("index", inspect->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
+  inspect_command->add_option("index", inspect->index, "Index file (.tpi)")
+      ->required()
+      ->check(existing_file_check());
   inspect_command->add_option("--report", inspect->report, "Write the figures as JSON");
-  inspect_command->add_option("--parts", inspect->parts_listed, "Parts listed (0: every part)")->capture_default_str();
+  inspect_command->add_option("--parts", inspect->parts_listed, "Parts listed (0: every part)")
+      ->capture_default_str()
+      ->check(whole_number_check(0, 1'000'000'000));
   inspect_command
-      ->add_option("--stabbing-segments", inspect->stabbing_segments,
-                   "Random segments for the stabbing number, counted by the walk and by Embree (0: skip)")
-      ->capture_default_str();
+      ->add_option(
+          "--stabbing-segments", inspect->stabbing_segments,
+          "Random segments for the stabbing number, counted by the walk and by Embree (0: skip)")
+      ->capture_default_str()
+      ->check(whole_number_check(0, kMostPoints));
   inspect_command->add_option("--stabbing-seed", inspect->stabbing_seed, "Seed of those segments")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(seed_check());
   inspect_command->callback([inspect] { run_inspect(*inspect); });
 
   auto valid = std::make_shared<ValidateArguments>();
@@ -462,15 +518,25 @@ void add_index_commands(CLI::App& app) {
       "hold exactly the model's triangles that meet them, and a sample of shards answer random boxes\n"
       "with exactly the stored triangles that meet them (--full: every tet and shard). The model is\n"
       "read from the files the index names, or from the INPUTs given. Exit 0 only when valid.");
-  validate->add_option("index", valid->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
-  validate->add_option("inputs", valid->inputs,
-                       "The model's files, in preprocess's order (default: those the index names; when they\n"
-                       "are missing, the binning check is skipped and said so, unless --full)")
-      ->check(CLI::ExistingFile);
+  validate->add_option("index", valid->index, "Index file (.tpi)")
+      ->required()
+      ->check(existing_file_check());
+  validate
+      ->add_option(
+          "inputs", valid->inputs,
+          "The model's files, in preprocess's order (default: those the index names; when they\n"
+          "are missing, the binning check is skipped and said so, unless --full)")
+      ->check(existing_file_check());
   validate->add_flag("--full", valid->full, "Check every tet and every shard, not a sample");
-  validate->add_option("--sample", valid->sample, "Tets and shards checked without --full")->capture_default_str();
-  validate->add_option("--boxes", valid->boxes, "Random query boxes per shard checked")->capture_default_str();
-  validate->add_option("--seed", valid->seed, "Seed of the samples and boxes")->capture_default_str();
+  validate->add_option("--sample", valid->sample, "Tets and shards checked without --full")
+      ->capture_default_str()
+      ->check(whole_number_check(0, 1'000'000'000));
+  validate->add_option("--boxes", valid->boxes, "Random query boxes per shard checked")
+      ->capture_default_str()
+      ->check(whole_number_check(0, 1'000'000));
+  validate->add_option("--seed", valid->seed, "Seed of the samples and boxes")
+      ->capture_default_str()
+      ->check(seed_check());
   validate->callback([valid] { run_validate(*valid); });
 }
 

@@ -130,13 +130,19 @@ void add_interior_check_command(CLI::App& app) {
       "Prints `disagreements: K`; exits 0 only when K is 0.");
   command->add_option("index", args->index, "Index file (.tpi), preprocessed with --interiors on")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   command
       ->add_option("inputs", args->inputs,
                    "The model's mesh files or manifests (default: those preprocess read)")
-      ->check(CLI::ExistingFile);
-  command->add_option("--points", args->points, "Random points (half in the model's box, half in closed components' boxes)")->capture_default_str();
-  command->add_option("--seed", args->seed, "Seed of the points")->capture_default_str();
+      ->check(existing_file_check());
+  command
+      ->add_option("--points", args->points,
+                   "Random points (half in the model's box, half in closed components' boxes)")
+      ->capture_default_str()
+      ->check(whole_number_check(1, kMostPoints));
+  command->add_option("--seed", args->seed, "Seed of the points")
+      ->capture_default_str()
+      ->check(seed_check());
   command->add_option("--report", args->report, "Write the figures as JSON");
   command->callback([args] { run_check_interiors(*args); });
 }

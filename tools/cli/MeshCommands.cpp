@@ -220,9 +220,10 @@ void add_mesh_commands(CLI::App& app) {
       "Readable: .obj, .stl (ASCII or binary), .ply (ASCII or binary), .off (our own readers,\n"
       "double precision), .gltf, .glb and the other formats Assimp imports (single precision),\n"
       "and assembly manifests (.json).");
-  info->add_option("files", info_args->files, "Mesh files, STEP or IGES files, or manifests (.json)")
+  info->add_option("files", info_args->files,
+                   "Mesh files, STEP or IGES files, or manifests (.json)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   info->add_option("--report", info_args->report, "Also write the figures as JSON");
   info_args->tessellation.add_to(info);
   info->callback([info_args] { run_info(*info_args); });
@@ -236,9 +237,11 @@ void add_mesh_commands(CLI::App& app) {
       "their names in OBJ (`o`/`g`), PLY (a part table), glTF (a node each) and manifests;\n"
       "STL and OFF hold none: a line says so when parts are merged. Triangles go part by\n"
       "part. The output appears only when complete.");
-  convert->add_option("input", convert_args->input, "Mesh file, STEP or IGES file, or manifest (.json)")
+  convert
+      ->add_option("input", convert_args->input,
+                   "Mesh file, STEP or IGES file, or manifest (.json)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   convert->add_option("-o,--output", convert_args->output, "Mesh file to write")->required();
   convert->add_option("--report", convert_args->report, "Also write the figures as JSON");
   convert_args->tessellation.add_to(convert);

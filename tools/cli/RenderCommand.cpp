@@ -143,32 +143,41 @@ void add_render_command(CLI::App& app) {
       "kind (grid blue, R-tree orange), by region, or by how often a flight paged it in\n"
       "(--color page-ins replays --path with --object under --memory; grey: never), with the\n"
       "flight's path drawn in magenta (faint where hidden; start green, end red).");
-  command->add_option("index", args->index, "Index file (.tpi)")->required()->check(CLI::ExistingFile);
+  command->add_option("index", args->index, "Index file (.tpi)")
+      ->required()
+      ->check(existing_file_check());
   command
       ->add_option("-o,--output", args->output,
                    "Image to write, in the format its extension names: " + written_formats())
       ->required();
-  command->add_option("--path", args->path, "Pose file of a flight to draw (CSV tx,ty,tz,qw,qx,qy,qz)")
-      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--path", args->path, "Pose file of a flight to draw (CSV tx,ty,tz,qw,qx,qy,qz)")
+      ->check(existing_file_check());
   command->add_option("--color", args->colour, "kind, regions or page-ins")
       ->check(CLI::IsMember({"kind", "regions", "page-ins"}))
       ->capture_default_str();
-  command->add_option("--object", args->object, "Flying object (for --color page-ins)")->check(CLI::ExistingFile);
+  command->add_option("--object", args->object, "Flying object (for --color page-ins)")
+      ->check(existing_file_check());
   add_memory_option(
       command, args->memory,
       "Budget of the decoded shards (the replay's for --color page-ins: a smaller one pages more)");
   command->add_option("--size", args->size, "Image size WIDTHxHEIGHT (each side 1 to 16384 pixels)")
       ->capture_default_str()
       ->check(image_size_check());
-  command->add_option("--azimuth", args->azimuth, "Camera direction around +z, degrees from +x")->capture_default_str();
-  command->add_option("--elevation", args->elevation, "Camera direction above the xy plane, degrees")
-      ->capture_default_str();
+  command->add_option("--azimuth", args->azimuth, "Camera direction around +z, degrees from +x")
+      ->capture_default_str()
+      ->check(number_check(-360, 360));
+  command
+      ->add_option("--elevation", args->elevation, "Camera direction above the xy plane, degrees")
+      ->capture_default_str()
+      ->check(number_check(-90, 90));
   command->add_option("--zoom", args->zoom, "Move the camera closer (> 1) or away (< 1)")
-      ->check(CLI::PositiveNumber)
+      ->check(number_check(1e-3, 1e3))
       ->capture_default_str();
-  command->add_option("--max-triangles", args->max_triangles,
-                      "Draw every k-th triangle above this many (Embree's scene memory)")
-      ->check(CLI::PositiveNumber)
+  command
+      ->add_option("--max-triangles", args->max_triangles,
+                   "Draw every k-th triangle above this many (Embree's scene memory)")
+      ->check(whole_number_check(1, 1'000'000'000))
       ->capture_default_str();
   command->add_option("--report", args->report, "Write figures as JSON");
   command->callback([args] { run_render(*args); });

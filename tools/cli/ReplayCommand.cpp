@@ -130,20 +130,24 @@ void add_replay_command(CLI::App& app) {
       "AABB_tree, exact predicates; default) or Embree's rtcCollide with exact pair tests.");
   command->add_option("environment", args->environment, "Environment: mesh file or manifest")
       ->required()
-      ->check(CLI::ExistingFile);
-  command->add_option("--object", args->object, "Flying object mesh")->required()->check(CLI::ExistingFile);
+      ->check(existing_file_check());
+  command->add_option("--object", args->object, "Flying object mesh")
+      ->required()
+      ->check(existing_file_check());
   command->add_option("--path", args->path, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(existing_file_check());
   command->add_option("--answers", args->answers, "Write the answers (CSV step,collides)");
-  command->add_option("--check", args->check,
-                      "Compare with these answers; exit non-zero on any disagreement")
-      ->check(CLI::ExistingFile);
+  command
+      ->add_option("--check", args->check,
+                   "Compare with these answers; exit non-zero on any disagreement")
+      ->check(existing_file_check());
   command->add_option("--reference", args->reference,
                       "cgal: the exact oracle (surfaces touch, or one body inside the other);\n"
                       "embree: rtcCollide candidates decided exactly (surfaces touch only)")
       ->check(CLI::IsMember({"cgal", "embree"}));
-  command->add_option("--threads", args->threads, "Embree's threads (0: all; --reference embree)");
+  command->add_option("--threads", args->threads, "Embree's threads (0: all; --reference embree)")
+      ->check(whole_number_check(0, kMostThreads));
   command->add_option("--report", args->report, "Write figures as JSON");
   command->callback([args] { run_replay(*args); });
 }

@@ -1,7 +1,36 @@
 #include "TessellationArguments.h"
 
+#include "Commands.h"
+#include "tetrapage/formats/Error.h"
 
 namespace tetrapage::cli {
+namespace {
+
+// The coarsest tessellation asked for that still means something: the whole shape (100%), or a
+// kilometre.
+constexpr double kLargestRelativeDeflection = 1.0, kLargestDeflectionMillimetres = 1e6;
+
+// --deflection as set_deflection reads it, in a range, checked while the command line is read
+// so that a bad value is a command-line mistake.
+CLI::Validator deflection_check() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        TessellationOptions options;
+        try {
+          set_deflection(options, text, "--deflection");
+        } catch (const Error&) {
+          options.deflection = 0;
+        }
+        const double largest = options.relative_deflection ? kLargestRelativeDeflection
+                                                           : kLargestDeflectionMillimetres;
+        if (!(options.deflection > 0) || options.deflection > largest)
+          return "'" + text + "' is not a length in (0, 1e6] mm nor a percentage in (0, 100]%";
+        return {};
+      },
+      "LENGTH or PERCENT%", "deflection");
+}
+
+}  // namespace
 
 void TessellationArguments::add_to(CLI::App* command) {
   command
@@ -10,13 +39,15 @@ void TessellationArguments::add_to(CLI::App* command) {
           "STEP/IGES tessellation: the largest distance between a triangle and the surface it "
           "stands for, as a percentage of each shape's bounding-box diagonal (0.1%) or as a length "
           "in millimetres, the unit STEP and IGES are read in (0.01)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(deflection_check());
   command
       ->add_option(
           "--angular-deflection", angular_deflection,
           "STEP/IGES tessellation: the largest angle in radians between the surface's normals "
           "along a triangle's edge")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(positive_number_check(3.14159265358979));
   command->add_flag(
       "--skip-bad-parts", skip_bad_parts,
       "Leave out STEP/IGES shapes that fail to tessellate, and list them, instead of failing");

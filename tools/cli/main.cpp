@@ -34,8 +34,10 @@ std::string one_line(const char* message) {
 int main(int argc, char** argv) {
   CLI::App app{
       "tetrapage: out-of-core collision detection for huge CAD models.\n"
-      "Generates the study's environments, objects and billiard flights, reads meshes,\n"
-      "and (as the pipeline grows) preprocesses assemblies into an index and flies through it."};
+      "preprocess cuts meshes, STEP/IGES files and assemblies into an index on disk; fly pages it\n"
+      "in around moving objects to answer collision, contact, distance and time-of-impact\n"
+      "queries; inspect, validate, check-location, check-interiors and render examine an index;\n"
+      "generate, mesh and replay make and read test scenes, objects and flights."};
   app.require_subcommand(1);
   app.set_help_all_flag("--help-all", "Show help for every subcommand");
   // The index format beside the release: indexes open only in a build of the same format.
@@ -56,6 +58,7 @@ int main(int argc, char** argv) {
   tetrapage::cli::add_interior_check_command(app);
   tetrapage::cli::add_check_location_command(app);
   tetrapage::cli::add_render_command(app);
+  tetrapage::cli::refuse_empty_values(app);
 
   // Ctrl-C or a kill during a long command leaves no temporary file behind.
   tetrapage::remove_temporaries_on_signals();
@@ -68,7 +71,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "tetrapage: %s (see --help)\n", e.what());
+    // CLI11 reports a misspelt command as a missing one: name the misspelling instead.
+    const std::string unknown = tetrapage::cli::unknown_name_message(app, argc, argv);
+    std::fprintf(stderr, "tetrapage: %s (see --help)\n",
+                 unknown.empty() ? e.what() : unknown.c_str());
+    return 2;
+  } catch (const tetrapage::cli::UsageError& e) {
+    std::fprintf(stderr, "tetrapage: %s (see --help)\n", one_line(e.what()).c_str());
     return 2;
   } catch (const tetrapage::Error& e) {
     std::fprintf(stderr, "tetrapage: %s\n", one_line(e.what()).c_str());

@@ -6,6 +6,7 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/OutputFile.h"
+#include "tetrapage/formats/QuotedInput.h"
 
 namespace tetrapage {
 
@@ -33,13 +34,14 @@ std::vector<std::uint8_t> read_answers(const std::filesystem::path& path) {
     const auto comma = line.find(',');
     const std::string where =
         "answers file '" + path.string() + "' line " + std::to_string(line_number) + ": ";
-    if (comma == std::string::npos) throw FormatError(where + "expected 'step,collides', got '" + line + "'");
+    if (comma == std::string::npos)
+      throw FormatError(where + "expected 'step,collides', got " + quoted_input(line));
     const std::string step = line.substr(0, comma), value = line.substr(comma + 1);
     if (step != std::to_string(answers.size()))
-      throw FormatError(where + "step '" + step + "' out of sequence (expected " +
+      throw FormatError(where + "step " + quoted_input(step) + " out of sequence (expected " +
                         std::to_string(answers.size()) + ")");
     if (value != "0" && value != "1")
-      throw FormatError(where + "collides must be 0 or 1, got '" + value + "'");
+      throw FormatError(where + "collides must be 0 or 1, got " + quoted_input(value));
     answers.push_back(value == "1" ? 1 : 0);
   }
   return answers;

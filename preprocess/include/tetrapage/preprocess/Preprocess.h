@@ -34,6 +34,9 @@ ShardChoice parse_shard_choice(const std::string& text);
 /// (docs/BENCHMARKS.md, "Region size").
 std::size_t auto_region_triangles(std::uint64_t triangles);
 
+/// The least working memory the pipeline works in (PreprocessOptions::memory_bytes).
+inline constexpr std::uint64_t kLeastPreprocessMemory = std::uint64_t(16) << 20;
+
 struct PreprocessOptions {
   /// Target triangles per region (the leaf size of the adaptive split of centroids); 0: auto,
   /// auto_region_triangles(triangles read).
