@@ -1,5 +1,9 @@
 #include "TessellationArguments.h"
 
+#include <cmath>
+
+#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/Error.h"
 
 namespace tetrapage::cli {
 
@@ -17,6 +21,25 @@ void TessellationArguments::add_to(CLI::App* command) {
           "STEP/IGES tessellation: the largest angle in radians between the surface's normals "
           "along a triangle's edge")
       ->capture_default_str();
+  command
+      ->add_option("--max-cad-occurrences", max_occurrences,
+                   "STEP: refuse files with more placed components than this (0: no limit); "
+                   "OpenCASCADE reads them in time quadratic in their number")
+      ->capture_default_str();
+  command
+      ->add_option(
+          "--max-triangles", max_triangles,
+          "STEP/IGES: refuse a file whose tessellation would make more triangles than this "
+          "(estimated before meshing at a deflection finer than the default; 0: no limit)")
+      ->capture_default_str();
+  command
+      ->add_option(
+          "--cad-timeout", time_limit,
+          "STEP/IGES: seconds the reading and tessellation of one file may take (0: no limit)")
+      ->capture_default_str();
+  command->add_option("--cad-memory", memory_limit,
+                      "STEP/IGES: memory the reading of one file may take (512M, 4G); default: "
+                      "the machine's memory");
   command->add_flag(
       "--skip-bad-parts", skip_bad_parts,
       "Leave out STEP/IGES shapes that fail to tessellate, and list them, instead of failing");
@@ -28,6 +51,13 @@ TessellationOptions TessellationArguments::options(bool show_progress) const {
   options.angular_deflection = angular_deflection;
   options.skip_bad_parts = skip_bad_parts;
   options.show_progress = show_progress;
+  options.max_occurrences = max_occurrences;
+  options.max_triangles = max_triangles;
+  if (!(time_limit >= 0) || !std::isfinite(time_limit))
+    throw InputError("--cad-timeout " + std::to_string(time_limit) +
+                     ": expected seconds, 0 or more");
+  options.time_limit = time_limit;
+  if (!memory_limit.empty()) options.memory_limit = parse_byte_size(memory_limit);
   return options;
 }
 
