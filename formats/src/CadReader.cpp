@@ -6,9 +6,12 @@
 #include "tetrapage/formats/CadReader.h"
 
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include <BRepAdaptor_Surface.hxx>
 #include <BRepBndLib.hxx>
 #include <BRepMesh_IncrementalMesh.hxx>
+#include <BRepTools.hxx>
 #include <BRep_Tool.hxx>
 #include <Bnd_Box.hxx>
 #include <IGESCAFControl_Reader.hxx>
@@ -18,6 +21,7 @@
 #include <Poly_Triangulation.hxx>
 #include <STEPCAFControl_Reader.hxx>
 #include <Standard_Failure.hxx>
+#include <Standard_OutOfMemory.hxx>
 #include <TDF_LabelSequence.hxx>
 #include <TDF_Tool.hxx>
 #include <TDataStd_Name.hxx>
@@ -29,15 +33,22 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <new>
+#include <thread>
 
+#include "CadIsolation.h"
 #include "PathSupport.h"
+#include "StepPrescan.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
@@ -73,18 +84,12 @@ std::string name_of(const TDF_Label& label) {
 // A distinct shape of the document and its triangles in its own frame.
 struct Prototype {
   TopoDS_Shape shape;
-  std::string name;
-  std::vector<Vec3> vertices;
-  std::vector<TriangleIndices> triangles;
-  double deflection = 0;  // the absolute deflection asked for
-  std::string error;      // why it could not be tessellated
+  detail::TessellatedShape mesh;
 };
 
-struct Instance {
-  std::size_t prototype = 0;
-  Placement placement{};
-  std::string path;
-};
+using detail::CadContent;
+using detail::ShapeInstance;
+using detail::TessellatedShape;
 
 // The document's free shapes walked depth first into prototypes and placed instances.
 class AssemblyWalk {
@@ -103,10 +108,10 @@ class AssemblyWalk {
   }
 
   std::vector<Prototype> prototypes;
-  std::vector<Instance> instances;
+  std::vector<ShapeInstance> instances;
 
  private:
-  static constexpr int kMaxDepth = 256;
+  static constexpr int kMaxDepth = detail::kMaxAssemblyDepth;
 
   // Each sibling's path segment: its instance's name, else its shape's, else the file's
   // stem; "#k" numbers siblings that share one.
@@ -156,7 +161,7 @@ class AssemblyWalk {
     if (added) {
       std::string name = name_of(label);
       if (name.empty()) name = path.substr(path.rfind('/') + 1);
-      prototypes.push_back({XCAFDoc_ShapeTool::GetShape(label), std::move(name), {}, {}, 0, {}});
+      prototypes.push_back({XCAFDoc_ShapeTool::GetShape(label), {std::move(name), {}, {}, 0, {}}});
     }
     return it->second;
   }
@@ -166,21 +171,63 @@ class AssemblyWalk {
   std::map<std::string, std::size_t> by_entry_;
 };
 
+// The triangles OCCT's mesher will make of `shape` at `fine`, estimated before it runs: a mesh
+// at `coarse` whose curved faces' counts are scaled by coarse / fine (a curved surface's count
+// grows as 1 / deflection, a plane's does not). The coarse mesh is removed afterwards.
+double estimate_triangles(const TopoDS_Shape& shape, double coarse, double fine, double angular) {
+  BRepMesh_IncrementalMesh mesher(shape, coarse, Standard_False, angular, Standard_False);
+  double estimate = 0;
+  for (TopExp_Explorer faces(shape, TopAbs_FACE); faces.More(); faces.Next()) {
+    const TopoDS_Face& face = TopoDS::Face(faces.Current());
+    TopLoc_Location location;
+    const Handle(Poly_Triangulation) mesh = BRep_Tool::Triangulation(face, location);
+    if (mesh.IsNull()) continue;
+    const bool plane = BRepAdaptor_Surface(face, Standard_False).GetType() == GeomAbs_Plane;
+    estimate += double(mesh->NbTriangles()) * (plane ? 1.0 : coarse / fine);
+  }
+  BRepTools::Clean(shape);
+  return estimate;
+}
+
+// Refuses (in out.error) a deflection finer than the default whose estimated triangles exceed
+// the limit: the mesher would run for minutes and take gigabytes before failing.
+bool within_triangle_limit(const TopoDS_Shape& shape, double diagonal,
+                           const TessellationOptions& options, TessellatedShape& out) {
+  const double coarse = TessellationOptions{}.deflection * diagonal;
+  if (options.max_triangles == 0 || !(out.deflection < coarse)) return true;
+  const double estimate =
+      estimate_triangles(shape, coarse, out.deflection, options.angular_deflection);
+  if (options.show_progress)
+    std::fprintf(stderr, "tetrapage: %s: about %.3g triangles at a deflection of %g mm\n",
+                 out.name.c_str(), estimate, out.deflection);
+  if (estimate <= double(options.max_triangles)) return true;
+  char text[256];
+  std::snprintf(
+      text, sizeof text,
+      "would make about %.3g triangles at a deflection of %g mm, more than the limit of %llu "
+      "(a larger --deflection makes fewer; --max-triangles raises the limit)",
+      estimate, out.deflection, static_cast<unsigned long long>(options.max_triangles));
+  out.error = text;
+  out.refused = true;
+  return false;
+}
+
 void tessellate(Prototype& prototype, const TessellationOptions& options) {
+  TessellatedShape& out = prototype.mesh;
   Bnd_Box box;
   BRepBndLib::Add(prototype.shape, box);
   if (box.IsVoid()) return;  // no geometry: points or empty compounds
   const double diagonal = std::sqrt(box.SquareExtent());
-  prototype.deflection =
-      options.relative_deflection ? options.deflection * diagonal : options.deflection;
-  if (!(prototype.deflection > 0)) {
-    prototype.error = "its size gives a deflection of " + std::to_string(prototype.deflection);
+  out.deflection = options.relative_deflection ? options.deflection * diagonal : options.deflection;
+  if (!(out.deflection > 0)) {
+    out.error = "its size gives a deflection of " + std::to_string(out.deflection);
     return;
   }
-  BRepMesh_IncrementalMesh mesher(prototype.shape, prototype.deflection, Standard_False,
+  if (!within_triangle_limit(prototype.shape, diagonal, options, out)) return;
+  BRepMesh_IncrementalMesh mesher(prototype.shape, out.deflection, Standard_False,
                                   options.angular_deflection, Standard_False);
   if (!mesher.IsDone()) {
-    prototype.error = "OpenCASCADE's mesher failed";
+    out.error = "OpenCASCADE's mesher failed";
     return;
   }
   std::size_t face_number = 0;
@@ -190,14 +237,14 @@ void tessellate(Prototype& prototype, const TessellationOptions& options) {
     TopLoc_Location location;
     const Handle(Poly_Triangulation) mesh = BRep_Tool::Triangulation(face, location);
     if (mesh.IsNull()) {
-      prototype.error = "face " + std::to_string(face_number) + " has no triangulation";
+      out.error = "face " + std::to_string(face_number) + " has no triangulation";
       return;
     }
     const gp_Trsf transform = location.Transformation();
-    const auto base = static_cast<std::uint32_t>(prototype.vertices.size());
+    const auto base = static_cast<std::uint32_t>(out.vertices.size());
     for (Standard_Integer i = 1; i <= mesh->NbNodes(); ++i) {
       const gp_Pnt p = mesh->Node(i).Transformed(transform);
-      prototype.vertices.push_back({p.X(), p.Y(), p.Z()});
+      out.vertices.push_back({p.X(), p.Y(), p.Z()});
     }
     // A reversed face's triangles are wound against its outward normal.
     const bool reversed = face.Orientation() == TopAbs_REVERSED;
@@ -205,37 +252,68 @@ void tessellate(Prototype& prototype, const TessellationOptions& options) {
       Standard_Integer a = 0, b = 0, c = 0;
       mesh->Triangle(i).Get(a, b, c);
       if (reversed) std::swap(b, c);
-      prototype.triangles.push_back(
+      out.triangles.push_back(
           {base + std::uint32_t(a - 1), base + std::uint32_t(b - 1), base + std::uint32_t(c - 1)});
     }
   }
 }
 
+void tessellate_one(Prototype& prototype, const TessellationOptions& options) {
+  try {
+    tessellate(prototype, options);
+  } catch (const Standard_Failure& failure) {
+    prototype.mesh.error = std::string("OpenCASCADE: ") + failure.GetMessageString();
+  }
+}
+
+// Tessellates every prototype on `threads` threads of its own (std::thread: a child made by
+// fork() cannot use TBB's workers), or on TBB's when `threads` is 0.
 void tessellate_all(std::vector<Prototype>& prototypes, const TessellationOptions& options,
-                    const std::filesystem::path& path) {
+                    const std::filesystem::path& path, unsigned threads) {
   Progress progress("tessellating " + path.filename().string(), prototypes.size(),
                     options.show_progress);
   std::mutex progress_mutex;
-  tbb::parallel_for(std::size_t(0), prototypes.size(), [&](std::size_t i) {
-    try {
-      tessellate(prototypes[i], options);
-    } catch (const Standard_Failure& failure) {
-      prototypes[i].error = std::string("OpenCASCADE: ") + failure.GetMessageString();
-    }
+  const auto tessellate_at = [&](std::size_t i) {
+    tessellate_one(prototypes[i], options);
     const std::lock_guard lock(progress_mutex);
     progress.advance();
-  });
+  };
+  if (threads == 0) {
+    tbb::parallel_for(std::size_t(0), prototypes.size(), tessellate_at);
+  } else {
+    std::atomic<std::size_t> next{0};
+    std::vector<std::jthread> workers;
+    for (unsigned t = 0; t < std::min<std::size_t>(threads, prototypes.size()); ++t)
+      workers.emplace_back([&] {
+        for (std::size_t i = next++; i < prototypes.size(); i = next++) tessellate_at(i);
+      });
+  }
   progress.finish();
 }
 
 // Every instance placed: a part each (instances of a shape that failed are skipped or fail).
-TriangleSoup place_instances(const std::vector<Prototype>& prototypes,
-                             const std::vector<Instance>& instances,
-                             const TessellationOptions& options, const std::string& file,
-                             ReadReport& report) {
+// Refuses, before any is placed, instances whose triangles together exceed the limit.
+void check_placed_triangles(const CadContent& content, const TessellationOptions& options,
+                            const std::string& file) {
+  std::uint64_t total = 0;
+  for (const ShapeInstance& instance : content.instances)
+    total += content.shapes[instance.shape].triangles.size();
+  if (options.max_triangles != 0 && total > options.max_triangles)
+    throw InputError(file + ": its " + std::to_string(content.instances.size()) +
+                     " placed shapes make " + std::to_string(total) +
+                     " triangles, more than the limit of " + std::to_string(options.max_triangles) +
+                     " (a larger --deflection makes fewer; --max-triangles raises the limit)");
+}
+
+TriangleSoup place_instances(const CadContent& content, const TessellationOptions& options,
+                             const std::string& file, ReadReport& report) {
+  check_placed_triangles(content, options, file);
   TriangleSoup soup;
-  for (const Instance& instance : instances) {
-    const Prototype& prototype = prototypes[instance.prototype];
+  for (const ShapeInstance& instance : content.instances) {
+    const TessellatedShape& prototype = content.shapes[instance.shape];
+    if (prototype.refused)
+      throw InputError(file + ": part '" + instance.path + "' (" + prototype.name + ") " +
+                       prototype.error);
     if (!prototype.error.empty()) {
       if (!options.skip_bad_parts)
         throw InputError(file + ": part '" + instance.path + "' (" + prototype.name +
@@ -287,12 +365,11 @@ bool transfer(const std::string& file, const char* kind, Handle(TDocStd_Document
 }
 
 // Translates the file into an XCAF document (under the translation lock).
-Handle(TDocStd_Document) translate(const std::filesystem::path& path, ReadReport& report) {
+Handle(TDocStd_Document) translate(const std::filesystem::path& path) {
   const std::string file = path.string();
   Handle(XCAFApp_Application) application = XCAFApp_Application::GetApplication();
   Handle(TDocStd_Document) document;
   application->NewDocument("MDTV-XCAF", document);
-  report.format = is_iges_path(path) ? "iges" : "step";
   const bool translated = is_iges_path(path)
                               ? transfer<IGESCAFControl_Reader>(file, "IGES", document)
                               : transfer<STEPCAFControl_Reader>(file, "STEP", document);
@@ -307,6 +384,68 @@ void silence_occt_messages() {
     // Its parser prints to the terminal; what matters reaches the user as our error.
     Message::DefaultMessenger()->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
   });
+}
+
+void check_options(const std::string& file, const TessellationOptions& options) {
+  if (!(options.deflection > 0) || !std::isfinite(options.deflection))
+    throw InputError(file + ": the deflection must be a positive number, not " +
+                     std::to_string(options.deflection));
+  if (!(options.angular_deflection > 0) || !(options.angular_deflection <= 3.14159265358979))
+    throw InputError(file + ": the angular deflection must be in (0, pi] radians, not " +
+                     std::to_string(options.angular_deflection));
+}
+
+// A FIFO or device would block OCCT's open forever, or feed it endless bytes.
+std::uint64_t checked_file_size(const std::filesystem::path& path) {
+  require_regular_file(path);
+  std::error_code error;
+  const auto bytes = std::filesystem::file_size(path, error);
+  std::ifstream probe(path, std::ios::binary);
+  if (error || !probe) throw IoError(path.string() + ": cannot open the file");
+  return bytes;
+}
+
+// The file translated and its shapes tessellated, in this process (on TBB's threads when
+// `threads` is 0).
+CadContent read_content(const std::filesystem::path& path, const TessellationOptions& options,
+                        unsigned threads) {
+  const std::string file = path.string();
+  silence_occt_messages();
+  std::vector<Prototype> prototypes;
+  CadContent content;
+  {
+    const std::lock_guard lock(translation_mutex());
+    try {
+      Handle(TDocStd_Document) document = translate(path);
+      double metres_per_unit = 0.001;
+      XCAFDoc_DocumentTool::GetLengthUnit(document, metres_per_unit);
+      if (std::fabs(metres_per_unit - 0.001) > 1e-12)
+        throw FormatError(file + ": OpenCASCADE translated it into units of " +
+                          std::to_string(metres_per_unit) + " m, not millimetres");
+      AssemblyWalk walk(XCAFDoc_DocumentTool::ShapeTool(document->Main()), path.stem().string());
+      walk.walk_free_shapes();
+      prototypes = std::move(walk.prototypes);
+      content.instances = std::move(walk.instances);
+      XCAFApp_Application::GetApplication()->Close(document);
+    } catch (const Standard_OutOfMemory&) {
+      throw std::bad_alloc();
+    } catch (const Standard_Failure& failure) {
+      throw FormatError(file + ": OpenCASCADE failed reading it: " + failure.GetMessageString());
+    }
+  }
+  if (content.instances.empty()) throw InputError(file + ": the file holds no shape");
+  tessellate_all(prototypes, options, path, threads);
+  for (Prototype& prototype : prototypes) content.shapes.push_back(std::move(prototype.mesh));
+  return content;
+}
+
+// The same in a child process: OCCT's crash, hang or runaway allocation ends the child only.
+CadContent read_isolated(const std::filesystem::path& path, const TessellationOptions& options) {
+  // The child cannot use TBB's workers: it runs as many threads of its own.
+  const unsigned threads = unsigned(std::max(1, tbb::this_task_arena::max_concurrency()));
+  const detail::IsolationLimits limits{options.memory_limit, options.time_limit};
+  return detail::read_in_child(path.string(), limits,
+                               [&] { return read_content(path, options, threads); });
 }
 
 }  // namespace
@@ -341,45 +480,16 @@ TriangleSoup read_cad(const std::filesystem::path& path, const TessellationOptio
   ReadReport& out = report != nullptr ? *report : local;
   out = ReadReport{};
   out.path = path.string();
+  out.format = is_iges_path(path) ? "iges" : "step";
   const std::string file = path.string();
-  if (!(options.deflection > 0) || !std::isfinite(options.deflection))
-    throw InputError(file + ": the deflection must be a positive number, not " +
-                     std::to_string(options.deflection));
-  if (!(options.angular_deflection > 0) || !(options.angular_deflection <= 3.14159265358979))
-    throw InputError(file + ": the angular deflection must be in (0, pi] radians, not " +
-                     std::to_string(options.angular_deflection));
-  {
-    std::error_code error;
-    const auto bytes = std::filesystem::file_size(path, error);
-    std::ifstream probe(path, std::ios::binary);
-    if (error || !probe) throw IoError(file + ": cannot open the file");
-    out.bytes = bytes;
-  }
-  silence_occt_messages();
-  std::vector<Prototype> prototypes;
-  std::vector<Instance> instances;
-  {
-    const std::lock_guard lock(translation_mutex());
-    try {
-      Handle(TDocStd_Document) document = translate(path, out);
-      double metres_per_unit = 0.001;
-      XCAFDoc_DocumentTool::GetLengthUnit(document, metres_per_unit);
-      if (std::fabs(metres_per_unit - 0.001) > 1e-12)
-        throw FormatError(file + ": OpenCASCADE translated it into units of " +
-                          std::to_string(metres_per_unit) + " m, not millimetres");
-      AssemblyWalk walk(XCAFDoc_DocumentTool::ShapeTool(document->Main()), path.stem().string());
-      walk.walk_free_shapes();
-      prototypes = std::move(walk.prototypes);
-      instances = std::move(walk.instances);
-      XCAFApp_Application::GetApplication()->Close(document);
-    } catch (const Standard_Failure& failure) {
-      throw FormatError(file + ": OpenCASCADE failed reading it: " + failure.GetMessageString());
-    }
-  }
+  check_options(file, options);
+  out.bytes = checked_file_size(path);
+  if (!is_iges_path(path))
+    detail::check_step_structure(path, detail::scan_step_structure(path), options.max_occurrences);
+  const CadContent content =
+      options.isolate ? read_isolated(path, options) : read_content(path, options, 0);
   out.length_unit = "mm";
-  if (instances.empty()) throw InputError(file + ": the file holds no shape");
-  tessellate_all(prototypes, options, path);
-  TriangleSoup soup = place_instances(prototypes, instances, options, file, out);
+  TriangleSoup soup = place_instances(content, options, file, out);
   if (soup.triangles.empty())
     throw InputError(file + ": no triangle (no shape with faces was tessellated)");
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

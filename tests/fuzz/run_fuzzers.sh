@@ -23,8 +23,18 @@ for target in "$@"; do
   # index_data's inputs are lists of edits: long ones from the start.
   options=""
   [ "$target" = index_data ] && options="-max_len=1024 -len_control=0"
+  # STEP and IGES targets also start from OpenCASCADE's samples where Debian's occt-misc is
+  # installed (read there, never copied): inputs are cut at 128 KiB.
+  seeds=""
+  case "$target" in
+    step_scan|step) [ -d /usr/share/opencascade/data/step ] && seeds=/usr/share/opencascade/data/step ;;
+    iges) [ -d /usr/share/opencascade/data/iges ] && seeds=/usr/share/opencascade/data/iges ;;
+  esac
+  case "$target" in step_scan|step|iges) options="-max_len=131072" ;; esac
+  own_seeds="$here/corpus/$target"
+  [ -d "$own_seeds" ] || own_seeds=""
   "$build/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=2048 $options \
-    -print_final_stats=1 -artifact_prefix="$crashes/" "$corpus" "$here/corpus/$target" >"$log" 2>&1
+    -print_final_stats=1 -artifact_prefix="$crashes/" "$corpus" $own_seeds $seeds >"$log" 2>&1
   result=$?
   # libFuzzer's last status line (executions, cov: edges, ft: features, corp: corpus) and stats.
   grep -E '^#[0-9]+' "$log" | tail -n 1

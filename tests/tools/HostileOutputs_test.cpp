@@ -36,10 +36,12 @@ TEST_F(HostileOutputs, FilesNamedInsideManifestsAreNeverOverwritten) {
   write_text(folder_ / "outer.json", R"({"parts":[{"name":"top","manifest":"top.json"}]})");
   write_text(folder_ / "top.json", R"({"parts":[{"file":"part.ply"}]})");
   const std::string top = read_file(folder_ / "top.json");
-  expect_refused(run(folder_, "preprocess a.json -o part.ply"), "which the input 'a.json' reads");
-  expect_refused(run(folder_, "mesh convert a.json -o part.ply"), "part.ply");
-  expect_refused(run(folder_, "preprocess outer.json -o top.json"), "top.json");
-  expect_refused(run(folder_, "preprocess outer.json -o ./sub/../part.ply"), "part.ply");
+  // preprocess writes indexes only (.tpi): a mesh's or a manifest's name is a usage mistake.
+  expect_refused(run(folder_, "preprocess a.json -o part.ply"), "part.ply", 2);
+  expect_refused(run(folder_, "preprocess outer.json -o top.json"), "top.json", 2);
+  expect_refused(run(folder_, "mesh convert a.json -o part.ply"), "which the input 'a.json' reads");
+  expect_refused(run(folder_, "mesh convert outer.json -o ./top.json"), "which the input 'outer.json' reads");
+  expect_refused(run(folder_, "mesh convert outer.json -o ./part.ply"), "part.ply");
   // An object given as a manifest: its part may not become the answers.
   ASSERT_EQ(run(folder_, "preprocess a.json -o model.tpi").status, 0);
   write_poses(folder_ / "flight.csv", std::vector<Pose>(3));

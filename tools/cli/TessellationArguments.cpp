@@ -1,6 +1,9 @@
 #include "TessellationArguments.h"
 
+#include <cmath>
+
 #include "Commands.h"
+#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 
 namespace tetrapage::cli {
@@ -48,6 +51,30 @@ void TessellationArguments::add_to(CLI::App* command) {
           "along a triangle's edge")
       ->capture_default_str()
       ->check(positive_number_check(3.14159265358979));
+  command
+      ->add_option("--max-cad-occurrences", max_occurrences,
+                   "STEP: refuse files with more placed components than this (0: no limit); "
+                   "OpenCASCADE reads them in time quadratic in their number")
+      ->capture_default_str()
+      ->check(whole_number_check(0, 1'000'000'000));
+  command
+      ->add_option(
+          "--max-triangles", max_triangles,
+          "STEP/IGES: refuse a file whose tessellation would make more triangles than this "
+          "(estimated before meshing at a deflection finer than the default; 0: no limit)")
+      ->capture_default_str()
+      ->check(whole_number_check(0, 1'000'000'000'000));
+  command
+      ->add_option(
+          "--cad-timeout", time_limit,
+          "STEP/IGES: seconds the reading and tessellation of one file may take (0: no limit)")
+      ->capture_default_str()
+      ->check(number_check(0, 1e7));
+  command
+      ->add_option("--cad-memory", memory_limit,
+                   "STEP/IGES: memory the reading of one file may take (512M, 4G); default: "
+                   "the machine's memory")
+      ->check(byte_size_check());
   command->add_flag(
       "--skip-bad-parts", skip_bad_parts,
       "Leave out STEP/IGES shapes that fail to tessellate, and list them, instead of failing");
@@ -59,6 +86,13 @@ TessellationOptions TessellationArguments::options(bool show_progress) const {
   options.angular_deflection = angular_deflection;
   options.skip_bad_parts = skip_bad_parts;
   options.show_progress = show_progress;
+  options.max_occurrences = max_occurrences;
+  options.max_triangles = max_triangles;
+  if (!(time_limit >= 0) || !std::isfinite(time_limit))
+    throw InputError("--cad-timeout " + std::to_string(time_limit) +
+                     ": expected seconds, 0 or more");
+  options.time_limit = time_limit;
+  if (!memory_limit.empty()) options.memory_limit = parse_byte_size(memory_limit);
   return options;
 }
 

@@ -5,6 +5,7 @@
 /// unit come through; each distinct shape is tessellated once (BRepMesh_IncrementalMesh), on
 /// all threads, and placed at each of its instances.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -28,6 +29,21 @@ struct TessellationOptions {
   bool skip_bad_parts = false;
   /// Print progress per shape on stderr.
   bool show_progress = false;
+  /// A STEP file with more product occurrences (placed components) than this is refused before
+  /// it is read: OCCT's reader takes time quadratic in them (0: no limit).
+  std::uint64_t max_occurrences = 10000;
+  /// A file whose tessellation would have more triangles than this is refused: before the
+  /// mesher runs, for a shape at a deflection finer than the default (estimated from a mesh
+  /// at the default deflection), and before its instances are placed (0: no limit).
+  std::uint64_t max_triangles = 100'000'000;
+  /// Read and tessellate in a child process, so that OCCT's crash, hang or runaway allocation
+  /// becomes an error naming the file instead of ending the caller.
+  bool isolate = true;
+  /// The child's memory: address space it may add to the caller's, in bytes (0: the
+  /// machine's memory).
+  std::uint64_t memory_limit = 0;
+  /// Seconds the child may take before it is killed (0: no limit).
+  double time_limit = 1800;
 };
 
 /// Sets options.deflection from `text`: a percentage of each shape's bounding-box diagonal
