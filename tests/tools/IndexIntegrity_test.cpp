@@ -246,5 +246,46 @@ TEST(IndexIntegrity, CountsTheHeaderStatesMustMatchTheTables) {
   }
 }
 
+// A manifest placing one tetrahedron (1 across) once at `x` on the x axis.
+void write_placed_part(const fs::path& folder, const std::string& x) {
+  std::ofstream(folder / "tetra.obj")
+      << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  std::ofstream(folder / "far.json")
+      << R"({"units": "m", "parts": [{"name": "bolt", "file": "tetra.obj",
+      "instances": [{"translation": [0, 0, 0]}, {"translation": [)"
+      << x << R"(, 0, 0]}]}]})";
+}
+
+bool has_leftovers(const fs::path& folder) {
+  for (const auto& entry : fs::directory_iterator(folder))
+    if (entry.path().extension() == ".tpi" ||
+        entry.path().string().find(".tmp") != std::string::npos)
+      return true;
+  return false;
+}
+
+TEST(IndexIntegrity, PlacementsOutOfRangeAreRefusedAtTheManifestInstance) {
+  const fs::path folder = test::fresh_folder("integrity", "placements");
+  // Within range: the part is placed and preprocessed.
+  write_placed_part(folder, "1e6");
+  ASSERT_EQ(test::run_cli_in(folder, "preprocess far.json -o near.tpi", 120).status, 0);
+  fs::remove(folder / "near.tpi");
+  // Beyond the coordinates the model accepts: once blamed on the part file.
+  write_placed_part(folder, "1e308");
+  for (const std::string command : {"preprocess far.json -o far.tpi", "mesh info far.json"}) {
+    SCOPED_TRACE(command);
+    expect_one_line_refusal(test::run_cli_in(folder, command, 120),
+                            {"far.json", "part 'bolt' (tetra.obj)", "instance 'bolt#1'",
+                             "x = 1e+308", "accepted coordinates [-1e+300, 1e+300]"});
+  }
+  // Within them, but so far out that rounding flattens the part: once accepted with the part
+  // flattened, or "the 9 sites span no volume" after ingesting.
+  write_placed_part(folder, "1e299");
+  expect_one_line_refusal(test::run_cli_in(folder, "preprocess far.json -o far.tpi", 120),
+                          {"far.json", "instance 'bolt#1'", "1e+299", "loses its shape to rounding",
+                           "2^36 times the part's size"});
+  EXPECT_FALSE(has_leftovers(folder));
+}
+
 }  // namespace
 }  // namespace tetrapage
