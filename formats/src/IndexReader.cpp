@@ -534,6 +534,35 @@ struct IndexReader::Impl {
     }
   }
 
+  /// The counts the header states against the data they count: regions against the coarse
+  /// mesh's tets, stored triangles against the shards' counts, input triangles against the
+  /// parts' counts (where those tables exist). Readers size and loop by the header's counts.
+  void check_header_counts() const {
+    if (header.region_count != tet_count)
+      format_error("root attribute 'region_count' is " + std::to_string(header.region_count) +
+                   ", but '/mesh/tets' holds " + std::to_string(tet_count) + " tets");
+    check_count_against_table<std::uint32_t>(schema::attribute::stored_triangles,
+                                             header.stored_triangles,
+                                             schema::table::shard_triangles);
+    check_count_against_table<std::uint64_t>(schema::attribute::input_triangles,
+                                             header.input_triangles, schema::table::part_triangles);
+  }
+
+  /// The root attribute `attribute`, stating `stated`, equals the sum of table `table`.
+  template <class T>
+  void check_count_against_table(const char* attribute, std::uint64_t stated,
+                                 std::string_view table) const {
+    if (!has_table_named(table)) return;
+    std::uint64_t sum = 0;
+    bool overflows = false;
+    for (const T value : read_table<T>(table))
+      overflows |= __builtin_add_overflow(sum, std::uint64_t(value), &sum);
+    if (overflows || sum != stated)
+      format_error("root attribute '" + std::string(attribute) + "' is " + std::to_string(stated) +
+                   ", but '/tables/" + std::string(table) + "' sums to " +
+                   (overflows ? "more than 2^64" : std::to_string(sum)));
+  }
+
   static std::string length_reason(const std::string& name) {
     if (name.starts_with("shard_"))
       return name == schema::table::shard_bounds ? "6 per shard" : "one per shard";
@@ -1078,6 +1107,7 @@ IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_un
                                           "root attribute 'shard_count'");
   r.list_tables();
   r.check_table_lengths();
+  r.check_header_counts();
   r.shard_data = r.open_dataset(schema::dataset::shard_data);
   r.check_shard_data_layout();
   const auto problems = r.extent_problems();

@@ -7,6 +7,8 @@
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -22,6 +24,7 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/Pose.h"
 
 namespace tetrapage {
 
@@ -504,6 +507,43 @@ void mesh_entries(const Manifest& manifest, std::vector<std::size_t>& prefix,
   }
 }
 
+/// The shortest text that reads back as `value`.
+std::string number_text(double value) {
+  for (int digits = 1; digits < 17; ++digits) {
+    char shorter[32];
+    std::snprintf(shorter, sizeof shorter, "%.*g", digits, value);
+    if (std::strtod(shorter, nullptr) == value) return shorter;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+/// How far from the origin a placement may put a part, in multiples of the part's size: there
+/// coordinates are spaced at most 2^-16 of the size apart (2^36 * 2^-52), so rounding keeps the
+/// part's shape; beyond, it flattens the part or erases it.
+constexpr double kMaxPlacementOverSize = 0x1p36;
+
+/// Refuses placed vertices [first, end) of `assembly` lying further from the origin than
+/// kMaxPlacementOverSize times the placed part's size.
+void check_placement_precision(const std::string& instance, const TriangleSoup& assembly,
+                               std::size_t first) {
+  BoundingBox box;
+  for (std::size_t v = first; v < assembly.vertices.size(); ++v) box.extend(assembly.vertices[v]);
+  if (box.empty()) return;
+  double far = 0, size = 0;
+  for (int a = 0; a < 3; ++a) {
+    far = std::max({far, std::fabs(box.lo[a]), std::fabs(box.hi[a])});
+    size = std::max(size, box.hi[a] - box.lo[a]);
+  }
+  if (far <= size * kMaxPlacementOverSize) return;
+  throw InputError(
+      instance + ": placed " + number_text(far) + " from the origin, where coordinates are " +
+      number_text(std::nextafter(far, HUGE_VAL) - far) + " apart, the part (" + number_text(size) +
+      " across) loses its shape to rounding: accepted placements keep coordinates within 2^36 "
+      "times the part's size");
+}
+
 /// Appends the parts of `source` placed by placement k of `placed`: one soup part per
 /// instance, or per node for a file of several parts.
 void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const PlacedEntry& placed,
@@ -526,12 +566,20 @@ void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const 
     for (std::size_t p = 0; p < source.part_count(); ++p)
       assembly.add_part(node(source.part_names[p]), path + "/" + node(source.part_path(p)));
   }
+  const std::string instance = placed.owner->path.string() + ": part '" + placed.part->name +
+                               "' (" + placed.part->file.filename().string() + "), instance '" +
+                               path + "'";
   for (const Vec3& v : source.vertices) {
     const Vec3 p = apply_transform(m, {v[0] * scale, v[1] * scale, v[2] * scale});
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw InputError(where + ": placing it overflows the coordinates");
+    for (int a = 0; a < 3; ++a)
+      if (!(std::fabs(p[a]) <= kMaxCoordinateMagnitude))
+        throw InputError(instance + ": the placement puts " + "xyz"[a] + " = " + number_text(p[a]) +
+                         ", outside the accepted coordinates [-" +
+                         number_text(kMaxCoordinateMagnitude) + ", " +
+                         number_text(kMaxCoordinateMagnitude) + "]");
     assembly.vertices.push_back(p);
   }
+  check_placement_precision(instance, assembly, vertex_base);
   for (std::size_t t = 0; t < source.triangles.size(); ++t) {
     const auto& tri = source.triangles[t];
     const TriangleIndices p{tri[0] + vertex_base, tri[1] + vertex_base, tri[2] + vertex_base};

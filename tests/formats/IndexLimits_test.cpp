@@ -63,6 +63,7 @@ SmallIndex small_index() {
   }
   index.shard_bounds = {0, 0, 0, 0.5, 0.5, 0.5, 0.25, 0, 0, 1, 1, 1, 0, 0.5, 0, 1, 1, 0.5};
   index.header.precision = "double";
+  index.header.region_count = index.mesh.tet_count();
   index.header.bounds.extend(Vec3{0, 0, 0});
   index.header.bounds.extend(Vec3{1, 1, 1});
   index.header.source = "small";

@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <unordered_map>
 
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
@@ -35,8 +37,8 @@ struct IdDigest {
     id = (id ^ (id >> 27)) * 0x94d049bb133111ebull;
     return id ^ (id >> 31);
   }
-  void add(std::uint64_t id) {
-    const std::uint64_t m = mix(id);
+  void add(std::uint64_t id) { add_mixed(mix(id)); }
+  void add_mixed(std::uint64_t m) {
     count.fetch_add(1, std::memory_order_relaxed);
     sum.fetch_add(m, std::memory_order_relaxed);
     mixed.fetch_xor(m * 0xff51afd7ed558ccdull + 1, std::memory_order_relaxed);
@@ -44,6 +46,20 @@ struct IdDigest {
   bool same(const IdDigest& other) const {
     return count == other.count && sum == other.sum && mixed == other.mixed;
   }
+};
+
+// A triangle as one digest element: its id and its corners' bits, 0 and -0 alike (the shard
+// format stores both as 0).
+std::uint64_t triangle_key(std::uint64_t id, const std::array<Vec3, 3>& corners) {
+  std::uint64_t key = IdDigest::mix(id);
+  for (const Vec3& corner : corners)
+    for (const double x : corner) key = IdDigest::mix(key ^ std::bit_cast<std::uint64_t>(x + 0.0));
+  return key;
+}
+
+// What one tet should hold and what it holds: ids alone, and ids with coordinates.
+struct TetDigests {
+  IdDigest ids, triangles;
 };
 
 // The chosen tets by the uniform-grid cells their boxes overlap; a tet over many cells (the
@@ -137,14 +153,13 @@ void AuditFindings::add(std::string problem) {
   if (problems.size() < 100) problems.push_back(std::move(problem));
 }
 
-void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, const StoredIds& stored_ids,
-                   std::uint64_t input_triangles, std::span<const InputPiece> model,
-                   AuditFindings& findings, Progress& progress) {
-  for (const std::uint32_t t : tets)
-    if (t >= mesh.tet_count())
-      throw InputError("tet " + std::to_string(t) + " is beyond the index's " +
-                       std::to_string(mesh.tet_count()) + " tets");
-  std::vector<IdDigest> expected(tets.size()), stored(tets.size());
+namespace {
+
+// The model's triangles meeting each chosen tet, streamed one piece at a time with ids counted
+// as preprocess counts them (input order); returns the model's triangle count.
+std::uint64_t expected_digests(const TetMesh& mesh, std::span<const std::uint32_t> tets,
+                               CoordinateCheck coordinates, std::span<const InputPiece> model,
+                               std::vector<TetDigests>& expected, Progress& progress) {
   std::vector<Epeck::Tetrahedron_3> solids;
   std::vector<BoundingBox> boxes;
   solids.reserve(tets.size());
@@ -154,8 +169,6 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
     boxes.push_back(mesh.bounds(t));
   }
   const TetGrid grid(mesh, tets);
-
-  // The model, one piece at a time, with ids counted as preprocess counts them (input order).
   std::uint64_t first_id = 0;
   for (const InputPiece& piece : model) {
     const TriangleSoup soup = load_input_piece(piece);
@@ -172,43 +185,141 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
                           near.erase(std::unique(near.begin(), near.end()), near.end());
                           if (near.empty()) continue;
                           const Epeck::Triangle_3 triangle(to_epeck(c[0]), to_epeck(c[1]), to_epeck(c[2]));
-                          for (const std::uint32_t i : near)
-                            if (geometry::boxes_overlap(box, boxes[i]) && CGAL::do_intersect(triangle, solids[i]))
-                              expected[i].add(first_id + t);
+                          for (const std::uint32_t i : near) {
+                            if (!geometry::boxes_overlap(box, boxes[i]) ||
+                                !CGAL::do_intersect(triangle, solids[i]))
+                              continue;
+                            expected[i].ids.add(first_id + t);
+                            if (coordinates == CoordinateCheck::exact)
+                              expected[i].triangles.add_mixed(triangle_key(first_id + t, c));
+                          }
                         }
                       });
     first_id += soup.triangle_count();
     progress.advance();
   }
-  findings.triangles_read += first_id;
-  if (first_id != input_triangles)
-    findings.add("the inputs hold " + std::to_string(first_id) + " triangles, the index was built from " +
-                 std::to_string(input_triangles) + ": they are not its model");
+  return first_id;
+}
 
-  for (std::size_t i = 0; i < tets.size(); ++i) {
-    for (const std::uint64_t id : stored_ids(tets[i])) stored[i].add(id);
-    ++findings.tets_checked;
-    if (!stored[i].same(expected[i]))
-      findings.add("tet " + std::to_string(tets[i]) + " holds " + std::to_string(stored[i].count.load()) +
-                   " triangles; the model's triangles that meet it are " +
-                   std::to_string(expected[i].count.load()) +
-                   (stored[i].count == expected[i].count ? " (other ones)" : ""));
+// "x is 0.5 (0x3fe0000000000000)": a coordinate with its bits, so that a one-bit change shows.
+std::string coordinate_text(int axis, double value) {
+  char text[96];
+  std::snprintf(text, sizeof text, "%c is %.17g (0x%016llx)", "xyz"[axis], value,
+                (unsigned long long)std::bit_cast<std::uint64_t>(value));
+  return text;
+}
+
+// Names every stored coordinate of `differing` that is not the model's: streams the model
+// again for the ids those tets hold (only when a digest already found a difference).
+void name_coordinate_differences(std::span<const std::pair<std::uint32_t, TetContents>> differing,
+                                 std::span<const InputPiece> model, AuditFindings& findings) {
+  std::unordered_multimap<std::uint64_t, std::pair<std::size_t, std::size_t>>
+      wanted;  // id -> (tet, local)
+  for (std::size_t k = 0; k < differing.size(); ++k)
+    for (std::size_t local = 0; local < differing[k].second.triangles.size(); ++local)
+      wanted.emplace(differing[k].second.triangles[local].id, std::pair{k, local});
+  std::uint64_t first_id = 0;
+  for (const InputPiece& piece : model) {
+    const TriangleSoup soup = load_input_piece(piece);
+    for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+      const auto [begin, end] = wanted.equal_range(first_id + t);
+      for (auto at = begin; at != end; ++at) {
+        const auto& [tet, contents] = differing[at->second.first];
+        const StoredTriangle& stored = contents.triangles[at->second.second];
+        const auto model_corners = soup.corners(t);
+        for (int corner = 0; corner < 3; ++corner)
+          for (int axis = 0; axis < 3; ++axis) {
+            const double kept = stored.corners[corner][axis], read = model_corners[corner][axis];
+            if (kept == read) continue;
+            findings.add(contents.shard + " (tet " + std::to_string(tet) + ") triangle " +
+                         std::to_string(stored.id) + " (local " +
+                         std::to_string(at->second.second) + ") corner " + std::to_string(corner) +
+                         ": stored " + coordinate_text(axis, kept) + ", the model's " +
+                         coordinate_text(axis, read));
+          }
+      }
+    }
+    first_id += soup.triangle_count();
   }
+}
+
+}  // namespace
+
+void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets,
+                   const StoredTriangles& stored, CoordinateCheck coordinates,
+                   std::uint64_t input_triangles, std::span<const InputPiece> model,
+                   AuditFindings& findings, Progress& progress) {
+  for (const std::uint32_t t : tets)
+    if (t >= mesh.tet_count())
+      throw InputError("tet " + std::to_string(t) + " is beyond the index's " +
+                       std::to_string(mesh.tet_count()) + " tets");
+  std::vector<TetDigests> expected(tets.size());
+  const std::uint64_t model_triangles =
+      expected_digests(mesh, tets, coordinates, model, expected, progress);
+  findings.triangles_read += model_triangles;
+  if (model_triangles != input_triangles)
+    findings.add("the inputs hold " + std::to_string(model_triangles) +
+                 " triangles, the index was built from " + std::to_string(input_triangles) +
+                 ": they are not its model");
+
+  // Tets whose ids agree but whose coordinates do not; a few are named triangle by triangle.
+  constexpr std::size_t kNamedTets = 16;
+  std::vector<std::pair<std::uint32_t, TetContents>> differing;
+  for (std::size_t i = 0; i < tets.size(); ++i) {
+    TetContents contents = stored(tets[i]);
+    TetDigests held;
+    for (const StoredTriangle& triangle : contents.triangles) {
+      held.ids.add(triangle.id);
+      if (coordinates == CoordinateCheck::exact)
+        held.triangles.add_mixed(triangle_key(triangle.id, triangle.corners));
+    }
+    ++findings.tets_checked;
+    if (!held.ids.same(expected[i].ids)) {
+      findings.add("tet " + std::to_string(tets[i]) + " holds " +
+                   std::to_string(held.ids.count.load()) +
+                   " triangles; the model's triangles that meet it are " +
+                   std::to_string(expected[i].ids.count.load()) +
+                   (held.ids.count == expected[i].ids.count ? " (other ones)" : ""));
+    } else if (!held.triangles.same(expected[i].triangles)) {
+      if (differing.size() < kNamedTets)
+        differing.emplace_back(tets[i], std::move(contents));
+      else
+        findings.add(contents.shard + " (tet " + std::to_string(tets[i]) +
+                     ") stores coordinates that are not the model's");
+    }
+  }
+  if (!differing.empty()) name_coordinate_differences(differing, model, findings);
+}
+
+void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets,
+                   const StoredIds& stored_ids, std::uint64_t input_triangles,
+                   std::span<const InputPiece> model, AuditFindings& findings, Progress& progress) {
+  const StoredTriangles stored = [&](std::uint32_t tet) {
+    TetContents contents{"tet " + std::to_string(tet) + "'s shard", {}};
+    for (const std::uint64_t id : stored_ids(tet)) contents.triangles.push_back({id, {}});
+    return contents;
+  };
+  audit_binning(mesh, tets, stored, CoordinateCheck::ids_only, input_triangles, model, findings,
+                progress);
 }
 
 void audit_binning(const IndexReader& index, std::span<const InputPiece> model,
                    std::span<const std::uint32_t> tets, AuditFindings& findings, Progress& progress) {
   const TetMesh mesh = index.read_mesh();
   const auto tet_shard = index.read_table_uint32(schema::table::tet_shard);
-  const StoredIds stored = [&](std::uint32_t tet) {
-    std::vector<std::uint64_t> ids;
+  const StoredTriangles stored = [&](std::uint32_t tet) {
     const std::uint32_t shard = tet < tet_shard.size() ? tet_shard[tet] : TetMesh::no_neighbour;
-    if (shard == TetMesh::no_neighbour) return ids;
-    const Shard decoded = Shard::decode(index.read_shard(shard), "shard " + std::to_string(shard));
-    for (std::uint32_t local = 0; local < decoded.triangle_count(); ++local) ids.push_back(decoded.triangle_id(local));
-    return ids;
+    TetContents contents{"shard " + std::to_string(shard), {}};
+    if (shard == TetMesh::no_neighbour) return contents;
+    const Shard decoded = Shard::decode(index.read_shard(shard), contents.shard);
+    for (std::uint32_t local = 0; local < decoded.triangle_count(); ++local)
+      contents.triangles.push_back({decoded.triangle_id(local), decoded.triangle(local)});
+    return contents;
   };
-  audit_binning(mesh, tets, stored, index.header().input_triangles, model, findings, progress);
+  const CoordinateCheck coordinates =
+      index.header().precision == "float" ? CoordinateCheck::ids_only : CoordinateCheck::exact;
+  audit_binning(mesh, tets, stored, coordinates, index.header().input_triangles, model, findings,
+                progress);
 }
 
 void audit_shard_queries(const Shard& shard, const std::string& label, std::uint32_t boxes,

@@ -5,6 +5,7 @@
 /// random boxes, exactly the stored triangles that meet the box. The oracle is CGAL's exact
 /// kernel (do_intersect), sharing no code with preprocess's binning or the shard queries.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -42,6 +43,26 @@ std::vector<std::filesystem::path> source_inputs(const IndexHeader& header, cons
 /// The model-wide ids of the triangles a tet holds.
 using StoredIds = std::function<std::vector<std::uint64_t>(std::uint32_t tet)>;
 
+/// One triangle as a shard stores it: its model-wide id and its decoded corners.
+struct StoredTriangle {
+  std::uint64_t id = 0;
+  std::array<Vec3, 3> corners{};
+};
+
+/// What a tet holds: the triangles of its shard, and how problems name that shard
+/// ("shard 17").
+struct TetContents {
+  std::string shard;
+  std::vector<StoredTriangle> triangles;
+};
+using StoredTriangles = std::function<TetContents(std::uint32_t tet)>;
+
+/// Whether the audit compares stored coordinates with the model's as well as ids.
+enum class CoordinateCheck {
+  ids_only,  ///< coordinates rounded on storage (precision "float"): ids only
+  exact,     ///< coordinates stored as read: each must equal the model's (0 and -0 alike)
+};
+
 /// Streams the model (the pieces of the files the index was built from, in the same order,
 /// one at a time: input_pieces in Manifest.h) and checks that each tet in `tets` holds exactly the triangles that meet
 /// its closed region, by model-wide id (the input order), and that the model has
@@ -51,7 +72,15 @@ void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets, con
                    std::uint64_t input_triangles, std::span<const InputPiece> model,
                    AuditFindings& findings, Progress& progress = Progress::silent());
 
-/// The same for an index's tets and shards.
+/// The same, and with CoordinateCheck::exact every stored corner equals the model's corner of
+/// the triangle with that id: a problem names the shard, tet, triangle, corner and axis.
+void audit_binning(const TetMesh& mesh, std::span<const std::uint32_t> tets,
+                   const StoredTriangles& stored, CoordinateCheck coordinates,
+                   std::uint64_t input_triangles, std::span<const InputPiece> model,
+                   AuditFindings& findings, Progress& progress = Progress::silent());
+
+/// The same for an index's tets and shards, comparing coordinates unless the index stores
+/// them rounded (precision "float").
 void audit_binning(const IndexReader& index, std::span<const InputPiece> model,
                    std::span<const std::uint32_t> tets, AuditFindings& findings,
                    Progress& progress = Progress::silent());
