@@ -44,6 +44,11 @@ InputFile::~InputFile() {
   if (descriptor_ >= 0) ::close(descriptor_);
 }
 
+void InputFile::fail_long_line() const {
+  throw FormatError(path_.string() + ": line " + std::to_string(line_ + 1) + " is longer than " +
+                    std::to_string(kLongestLine >> 20) + " MiB (is it a text file?)");
+}
+
 void InputFile::fill() {
   if (eof_) return;
   if (begin_ > 0) {

@@ -14,6 +14,10 @@
 
 namespace tetrapage::detail {
 
+/// The longest line a text reader takes (a face of a million corners fits): a file of one
+/// endless line (/dev/zero's kind, or a binary file named .obj) fails instead of filling memory.
+inline constexpr std::size_t kLongestLine = std::size_t(64) << 20;
+
 class InputFile {
  public:
   /// @throw IoError if the file cannot be opened or is not a regular file.
@@ -32,7 +36,7 @@ class InputFile {
   std::uint64_t line_number() const { return line_; }
 
   /// The next line without its end ('\n' or "\r\n"); false at the end of the file.
-  /// @throw IoError on a read failure.
+  /// @throw IoError on a read failure; FormatError for a line longer than kLongestLine.
   bool next_line(std::string_view& line) {
     for (;;) {
       const char* first = buffer_.get() + begin_;
@@ -54,6 +58,7 @@ class InputFile {
         ++line_;
         return true;
       }
+      if (end_ - begin_ >= kLongestLine) fail_long_line();
       fill();
     }
   }
@@ -92,6 +97,7 @@ class InputFile {
   /// Moves the unread bytes to the front and reads one more block (growing the buffer when a
   /// single line or record does not fit).
   void fill();
+  [[noreturn]] void fail_long_line() const;
   void fill_at_least(std::size_t count);
   void grow(std::size_t minimum);
 

@@ -9,6 +9,7 @@
 #include "../MemoryLimit.h"
 #include "TestSupport.h"
 #include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/Pose.h"
 
 namespace tetrapage::test {
 namespace {
@@ -123,6 +124,18 @@ TEST(ReaderLimits, StlAndObjNeverSizeAnythingByAClaim) {
   for (int k = 0; k < 100000; ++k) text += k % 2 == 0 ? " 1" : " 2";
   write_file(obj, text + " 3\n");
   expect_capped_error("returned", [&] { read_mesh(obj); }, {});
+}
+
+// A line with no end (a binary file given a text format's name) fails at the line limit, under
+// a memory cap, instead of growing the line buffer with the file.
+TEST(ReaderLimits, EndlessLinesFailAtTheLineLimit) {
+  const auto folder = scratch_folder("endless");
+  const auto obj = folder / "endless.obj";
+  write_file(obj, "v 0 0 0\n# " + std::string(70u << 20, 'x'));
+  expect_capped_error("FormatError", [&] { read_mesh(obj); }, {obj.string(), "line 2 is longer than 64 MiB"});
+  const auto poses = folder / "endless.csv";
+  write_file(poses, "tx,ty,tz,qw,qx,qy,qz\n" + std::string(70u << 20, '1'));
+  expect_capped_error("FormatError", [&] { read_poses(poses); }, {poses.string(), "longer than"});
 }
 
 TEST(ReaderLimits, DeeplyNestedManifestIsRejectedByItsDepth) {

@@ -13,6 +13,7 @@
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/CollisionIndex.h"
 #include "tetrapage/runtime/DynamicObstacles.h"
+#include "tetrapage/runtime/FlyingObject.h"
 
 namespace tetrapage::cli {
 
@@ -29,6 +30,7 @@ struct FlyArguments {
   double max_distance = std::numeric_limits<double>::infinity();
   double toi_tolerance = 1e-4;
   bool all_contacts = false;
+  std::uint64_t max_contacts = kDefaultMaxContacts;
   bool no_prefetch = false;
   bool prefetch_ahead = false;
   bool no_shard_arena = false;

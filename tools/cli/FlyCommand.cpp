@@ -164,6 +164,7 @@ void run_fly(const FlyArguments& args) {
   QueryOptions query_options;
   query_options.accuracy = geometry::parse_accuracy(args.accuracy);
   query_options.mode = args.all_contacts ? QueryMode::all_contacts : QueryMode::first_hit;
+  query_options.max_contacts = args.max_contacts;
   const CollisionIndexOptions index_options = fly_index_options(args);
 
   const TriangleSoup object_mesh = load_object(args, args.objects[0]);
@@ -378,6 +379,12 @@ void add_fly_command(CLI::App& app) {
       ->capture_default_str()
       ->check(parsed_by([](const std::string& text) { geometry::parse_accuracy(text); }, "MODE"));
   command->add_flag("--all-contacts", args->all_contacts, "Collect every contact pair, not only the first hit");
+  command
+      ->add_option("--max-contacts", args->max_contacts,
+                   "The most contact pairs one step may collect (--all-contacts, --query contacts): a "
+                   "step that finds more fails, naming the limit")
+      ->capture_default_str()
+      ->check(whole_number_check(1, 1'000'000'000));
   command->add_flag("--no-prefetch", args->no_prefetch, "Disable the background prefetcher");
   command->add_flag("--prefetch-ahead", args->prefetch_ahead,
                     "Also prefetch the next region along the motion at each region change (a walk and a box "

@@ -3,6 +3,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <filesystem>
 #include <new>
 #include <string>
 
@@ -83,7 +84,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "tetrapage: %s\n", one_line(e.what()).c_str());
     return 1;
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "tetrapage: out of memory\n");
+    std::fprintf(stderr,
+                 "tetrapage: out of memory: the system refused an allocation (a smaller --memory, "
+                 "fewer --threads or a smaller input may fit)\n");
+    return 1;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // The path and the system's reason, without the library's "filesystem error:" wording.
+    std::fprintf(stderr, "tetrapage: cannot use '%s': %s\n", e.path1().c_str(), e.code().message().c_str());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "tetrapage: unexpected error: %s\n", one_line(e.what()).c_str());
