@@ -270,19 +270,23 @@ TEST(IndexIntegrity, PlacementsOutOfRangeAreRefusedAtTheManifestInstance) {
   write_placed_part(folder, "1e6");
   ASSERT_EQ(test::run_cli_in(folder, "preprocess far.json -o near.tpi", 120).status, 0);
   fs::remove(folder / "near.tpi");
-  // Beyond the coordinates the model accepts: once blamed on the part file.
-  write_placed_part(folder, "1e308");
-  for (const std::string command : {"preprocess far.json -o far.tpi", "mesh info far.json"}) {
-    SCOPED_TRACE(command);
-    expect_one_line_refusal(test::run_cli_in(folder, command, 120),
-                            {"far.json", "part 'bolt' (tetra.obj)", "instance 'bolt#1'",
-                             "x = 1e+308", "accepted coordinates [-1e+300, 1e+300]"});
+  // Beyond the coordinates the model accepts (where squared distances would overflow, and
+  // far beyond): once blamed on the part file.
+  for (const std::string x : {"1e160", "1e308"}) {
+    write_placed_part(folder, x);
+    for (const std::string command : {"preprocess far.json -o far.tpi", "mesh info far.json"}) {
+      SCOPED_TRACE(command + " at " + x);
+      expect_one_line_refusal(
+          test::run_cli_in(folder, command, 120),
+          {"far.json", "part 'bolt' (tetra.obj)", "instance 'bolt#1'",
+           x == "1e160" ? "x = 1e+160" : "x = 1e+308", "accepted coordinates [-1e+150, 1e+150]"});
+    }
   }
   // Within them, but so far out that rounding flattens the part: once accepted with the part
   // flattened, or "the 9 sites span no volume" after ingesting.
-  write_placed_part(folder, "1e299");
+  write_placed_part(folder, "1e149");
   expect_one_line_refusal(test::run_cli_in(folder, "preprocess far.json -o far.tpi", 120),
-                          {"far.json", "instance 'bolt#1'", "1e+299", "loses its shape to rounding",
+                          {"far.json", "instance 'bolt#1'", "1e+149", "loses its shape to rounding",
                            "2^36 times the part's size"});
   EXPECT_FALSE(has_leftovers(folder));
 }
