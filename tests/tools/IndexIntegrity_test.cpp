@@ -282,6 +282,25 @@ TEST(IndexIntegrity, PlacementsOutOfRangeAreRefusedAtTheManifestInstance) {
            x == "1e160" ? "x = 1e+160" : "x = 1e+308", "accepted coordinates [-1e+150, 1e+150]"});
     }
   }
+  // A pose that far out is refused by every query, naming the value and the limit (the last
+  // line of stderr: fly logs its progress before it).
+  write_placed_part(folder, "1e6");
+  ASSERT_EQ(test::run_cli_in(folder, "preprocess far.json -o near.tpi", 120).status, 0);
+  std::ofstream(folder / "far.csv") << "tx,ty,tz,qw,qx,qy,qz\n0,0,0,1,0,0,0\n0,-1e160,0,1,0,0,0\n";
+  for (const std::string query : {"", " --query contacts", " --query distance", " --query toi"}) {
+    SCOPED_TRACE(query);
+    const std::string answers = query.empty() ? "" : " --answers a.csv";
+    const test::CliResult run = test::run_cli_in(
+        folder, "fly near.tpi --object tetra.obj --path far.csv" + query + answers, 120);
+    EXPECT_NE(run.status, 0);
+    EXPECT_NE(run.status, 124) << "timed out";
+    std::string last = run.err.substr(0, run.err.size() - 1);
+    last = last.substr(last.rfind('\n') + 1);
+    EXPECT_NE(last.find("-1e+160"), std::string::npos) << run.err;
+    EXPECT_NE(last.find("beyond 1e+150"), std::string::npos) << run.err;
+  }
+  fs::remove(folder / "near.tpi");
+  fs::remove(folder / "a.csv");
   // Within them, but so far out that rounding flattens the part: once accepted with the part
   // flattened, or "the 9 sites span no volume" after ingesting.
   write_placed_part(folder, "1e149");
