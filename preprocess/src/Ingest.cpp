@@ -35,16 +35,16 @@ struct LoadedSoup {
   std::vector<SurfaceComponent> components;
 };
 
-// Coordinates beyond kMaxCoordinateMagnitude overflow the coarse mesh's enlarged box and the
+// Coordinates beyond kMaxCoordinateMagnitude overflow the distances to the model and the
 // exact predicates' products: refused, naming the file and the value.
 void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& piece) {
   const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup);
   if (!beyond.found) return;
-  char value[64];
+  char value[64], limit[64];
   std::snprintf(value, sizeof value, "%g", beyond.value);
-  throw InputError(
-      piece.file().string() + ": a vertex coordinate of " + value +
-      " is beyond 1e300 in magnitude: the model's box would overflow; scale the model");
+  std::snprintf(limit, sizeof limit, "%g", kMaxCoordinateMagnitude);
+  throw InputError(piece.file().string() + ": a vertex coordinate of " + value + " is beyond " +
+                   limit + " in magnitude: distances would overflow; scale the model");
 }
 
 LoadedSoup load_soup(const InputPiece& piece, const TessellationOptions& tessellation) {
@@ -54,8 +54,10 @@ LoadedSoup load_soup(const InputPiece& piece, const TessellationOptions& tessell
   for (const auto& report : reports) {
     loaded.degenerate_dropped += report.degenerate_dropped;
     ++loaded.files_read;
-    loaded.tessellation_deflection = std::max(loaded.tessellation_deflection, report.tessellation_deflection);
-    for (const std::string& skipped : report.skipped_parts) loaded.skipped_parts.push_back(report.path + ": " + skipped);
+    loaded.tessellation_deflection =
+        std::max(loaded.tessellation_deflection, report.tessellation_deflection);
+    for (const std::string& skipped : report.skipped_parts)
+      loaded.skipped_parts.push_back(report.path + ": " + skipped);
   }
   loaded.file = piece.input.string();
   if (piece.manifest) {
@@ -104,8 +106,9 @@ void note_length_unit(IngestedModel& model, const LoadedSoup& loaded) {
     model.length_unit = loaded.length_unit;
     model.length_unit_source = loaded.file;
   } else if (model.length_unit != loaded.length_unit) {
-    throw InputError(loaded.file + " is in " + loaded.length_unit + " but " + model.length_unit_source + " in " +
-                     model.length_unit + ": place both in one manifest, which converts each file to its units");
+    throw InputError(loaded.file + " is in " + loaded.length_unit + " but " +
+                     model.length_unit_source + " in " + model.length_unit +
+                     ": place both in one manifest, which converts each file to its units");
   }
 }
 
@@ -116,7 +119,8 @@ void settle_length_unit(IngestedModel& model, const std::string& option) {
   if (model.length_unit.empty()) {
     model.length_unit = option;
   } else if (model.length_unit != option) {
-    throw InputError("--unit " + option + ", but " + model.length_unit_source + " is in " + model.length_unit);
+    throw InputError("--unit " + option + ", but " + model.length_unit_source + " is in " +
+                     model.length_unit);
   }
 }
 
@@ -125,7 +129,8 @@ void settle_length_unit(IngestedModel& model, const std::string& option) {
 void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptions& options,
                  const std::filesystem::path& spill_folder, PreprocessSummary& summary) {
   summary.degenerate_dropped += loaded.degenerate_dropped;
-  summary.skipped_parts.insert(summary.skipped_parts.end(), loaded.skipped_parts.begin(), loaded.skipped_parts.end());
+  summary.skipped_parts.insert(summary.skipped_parts.end(), loaded.skipped_parts.begin(),
+                               loaded.skipped_parts.end());
   summary.files_read += loaded.files_read;
   const auto part_offset = std::uint32_t(model.part_names.size());
   for (std::size_t p = 0; p < loaded.soup.part_count(); ++p) {
@@ -138,7 +143,8 @@ void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptio
   }
   model.part_triangles.insert(model.part_triangles.end(), loaded.part_triangles.begin(),
                               loaded.part_triangles.end());
-  model.tessellation_deflection = std::max(model.tessellation_deflection, loaded.tessellation_deflection);
+  model.tessellation_deflection =
+      std::max(model.tessellation_deflection, loaded.tessellation_deflection);
   note_length_unit(model, loaded);
   if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
     throw InputError("the inputs hold more than 2^32 - 2 connected components");
@@ -194,7 +200,9 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
                                              std::size_t(tbb::this_task_arena::max_concurrency()));
   produce_in_parallel_consume_in_order(
       jobs.size(), in_flight,
-      [&](std::size_t j) { return std::make_shared<LoadedSoup>(load_soup(jobs[j], options.tessellation)); },
+      [&](std::size_t j) {
+        return std::make_shared<LoadedSoup>(load_soup(jobs[j], options.tessellation));
+      },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         // In input order (ids, part numbers and the sample do not depend on the threads).
         append_soup(model, *loaded, options, spill_folder, summary);

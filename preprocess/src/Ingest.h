@@ -36,7 +36,7 @@ struct IngestedModel {
 /// Reads every input once, in input order (ids, part numbers and the sample do not depend on
 /// the threads), spilling the soups beyond a quarter of the budget (`spill_folder`).
 /// @throw InputError when the inputs hold no triangle, more than 2^32 - 2 components, or a
-/// coordinate beyond 1e300; the readers' errors as they throw them.
+/// coordinate beyond kMaxCoordinateMagnitude; the readers' errors as they throw them.
 IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
                      const PreprocessOptions& options, const std::filesystem::path& spill_folder,
                      PreprocessSummary& summary);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "FlyingObjectParts.h"
+#include "PlacedObject.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/PoseMotion.h"
@@ -43,6 +44,10 @@ ImpactResult FlyingObject::time_of_impact(const Pose& from, const Pose& to,
   if (!(options.tolerance > 0 && options.tolerance <= 1))
     throw InputError("time of impact: the tolerance must be in (0, 1], not " +
                      std::to_string(options.tolerance));
+  // Both ends, before any step: advancement may certify the motion free before it reaches
+  // an end that no query could place.
+  check_translation_within_limit(from.translation);
+  check_translation_within_limit(to.translation);
   const PoseMotion motion(from, to);
   const double radius = model_->radius * (1 + 0x1p-40);
   const double speed = motion.speed_bound(radius);

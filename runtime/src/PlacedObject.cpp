@@ -7,6 +7,18 @@
 
 namespace tetrapage {
 
+void check_translation_within_limit(const Vec3& translation) {
+  for (int a = 0; a < 3; ++a)
+    if (std::fabs(translation[a]) > kMaxCoordinateMagnitude) {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "invalid pose: translation %c = %g is beyond %g in magnitude: distances "
+                    "from there would overflow",
+                    "xyz"[a], translation[a], kMaxCoordinateMagnitude);
+      throw InputError(text);
+    }
+}
+
 PlacedObject::PlacedObject(const ObjectModel& model)
     : model_(&model),
       world_(model.mesh.vertices.size()),
@@ -34,16 +46,7 @@ void PlacedObject::place(const Pose& pose) {
     throw InputError(text);
   }
   // Object coordinates are within the same bound (ObjectModel): R x + t then stays finite.
-  for (int a = 0; a < 3; ++a)
-    if (std::fabs(pose.translation[a]) > kMaxCoordinateMagnitude) {
-      char text[200];
-      std::snprintf(
-          text, sizeof text,
-          "invalid pose: translation %c = %g is beyond %g in magnitude: placing the object "
-          "there would overflow",
-          "xyz"[a], pose.translation[a], kMaxCoordinateMagnitude);
-      throw InputError(text);
-    }
+  check_translation_within_limit(pose.translation);
   // rotation_matrix normalises a q off unit norm: every prune here assumes an orthogonal
   // matrix up to rounding.
   rotation_ = rotation_matrix(pose.rotation);

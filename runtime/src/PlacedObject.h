@@ -16,6 +16,10 @@
 
 namespace tetrapage {
 
+/// @throw InputError naming the axis, the value and the limit when a coordinate of
+///        `translation` lies beyond kMaxCoordinateMagnitude in magnitude (NaN is not).
+void check_translation_within_limit(const Vec3& translation);
+
 class PlacedObject {
  public:
   explicit PlacedObject(const ObjectModel& model);

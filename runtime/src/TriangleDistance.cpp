@@ -93,9 +93,13 @@ void offer_edge_pair(const Vector& p, const Vector& p2, const Vector& q, const V
   best.offer(add_scaled(p, s, d1), add_scaled(q, t, d2));
 }
 
+// The pair moved to a[0] and, when its extent is far from 1, scaled by a power of two (exact)
+// to near 1: the solvers multiply up to four lengths, which overflow beyond 2^255 and
+// underflow below 2^-255 and would drop the face and edge cases.
 struct Translated {
   std::array<Vector, 3> a, b;
-  double magnitude;  // M: bounds every translated coordinate and every |v - origin| coordinate
+  double magnitude;    // M: bounds every translated coordinate and every |v - origin| coordinate
+  double unscale = 1;  // the power of two back to world units
 };
 
 Translated translate(const Triangle& a, const Triangle& b) {
@@ -106,6 +110,16 @@ Translated translate(const Triangle& a, const Triangle& b) {
     out.b[i] = sub(b[i], a[0]);
     for (int k = 0; k < 3; ++k) m = std::max({m, std::fabs(out.a[i][k]), std::fabs(out.b[i][k])});
   }
+  if (m > 0x1p200 || (m > 0 && m < 0x1p-200)) {
+    const int exponent = std::ilogb(m);
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) {
+        out.a[i][k] = std::ldexp(out.a[i][k], -exponent);
+        out.b[i][k] = std::ldexp(out.b[i][k], -exponent);
+      }
+    m = std::ldexp(m, -exponent);
+    out.unscale = std::ldexp(1.0, exponent);
+  }
   out.magnitude = m * (1 + 4 * kUnit);
   return out;
 }
@@ -114,6 +128,7 @@ Translated translate(const Triangle& a, const Triangle& b) {
 // the direction n: min over b of n.v - max over a of n.v, divided by |n|. Each computed dot
 // product is within 7 u |n| M of the exact one on the untranslated vertices (translation and
 // dot rounding), so the computed gap is within 18 u |n| M; 24 u |n| M covers it with room.
+// Returned in world units (the scaling is exact).
 double separation_lower_bound(const Translated& t, const Vector& n) {
   const double length = norm(n);
   if (!(length > 0) || !std::isfinite(length)) return 0.0;
@@ -126,7 +141,7 @@ double separation_lower_bound(const Translated& t, const Vector& n) {
   const double padded_length = length * (1 + 4 * kUnit);
   const double numerator = (min_b - max_a) - 24 * kUnit * padded_length * t.magnitude;
   if (!(numerator > 0)) return 0.0;
-  return numerator / padded_length * (1 - 4 * kUnit);
+  return numerator / padded_length * (1 - 4 * kUnit) * t.unscale;
 }
 
 double clearance_upper_bound(double distance, double magnitude) {
@@ -152,13 +167,13 @@ TriangleDistance triangle_distance(const Triangle& a, const Triangle& b) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       offer_edge_pair(t.a[i], t.a[i == 2 ? 0 : i + 1], t.b[j], t.b[j == 2 ? 0 : j + 1], best);
-  result.distance = std::sqrt(best.squared);
-  result.upper_bound = clearance_upper_bound(result.distance, t.magnitude);
+  result.distance = std::sqrt(best.squared) * t.unscale;
+  result.upper_bound = clearance_upper_bound(result.distance, t.magnitude * t.unscale);
   result.lower_bound =
       std::min(separation_lower_bound(t, sub(best.on_second, best.on_first)), result.distance);
   for (int k = 0; k < 3; ++k) {
-    result.on_first[k] = best.on_first[k] + a[0][k];
-    result.on_second[k] = best.on_second[k] + a[0][k];
+    result.on_first[k] = best.on_first[k] * t.unscale + a[0][k];
+    result.on_second[k] = best.on_second[k] * t.unscale + a[0][k];
   }
   return result;
 }
@@ -188,8 +203,12 @@ bool within_distance(const Triangle& a, const Triangle& b, double d) {
 }
 
 bool triangle_outside_ball(const Triangle& triangle, const Point& centre, double radius) {
-  const auto sub = [](const Point& x, const Point& y) { return Point{x[0] - y[0], x[1] - y[1], x[2] - y[2]}; };
-  const auto dot = [](const Point& x, const Point& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+  const auto sub = [](const Point& x, const Point& y) {
+    return Point{x[0] - y[0], x[1] - y[1], x[2] - y[2]};
+  };
+  const auto dot = [](const Point& x, const Point& y) {
+    return x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+  };
   const Point& a = triangle[0];
   const Point& b = triangle[1];
   const Point& c = triangle[2];
@@ -198,7 +217,8 @@ bool triangle_outside_ball(const Triangle& triangle, const Point& centre, double
   const double size = std::sqrt(ab2) + std::sqrt(ac2) + std::sqrt(ap2);
   // Rounding errors below are a few ulps of size^2 over the sine of the triangle's shape: far
   // inside the margin for a triangle whose largest angle's sine is at least 2^-10.
-  const Point n{ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2], ab[0] * ac[1] - ab[1] * ac[0]};
+  const Point n{ab[1] * ac[2] - ab[2] * ac[1], ab[2] * ac[0] - ab[0] * ac[2],
+                ab[0] * ac[1] - ab[1] * ac[0]};
   const Point bc = sub(c, b);
   const double longest2 = std::max({ab2, ac2, dot(bc, bc)});
   const double n2 = dot(n, n);

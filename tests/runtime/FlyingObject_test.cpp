@@ -510,7 +510,7 @@ TEST(FlyingObject, BadObjectsPosesAndBudgetsAreRejectedUpFront) {
   TriangleSoup huge = world.object;
   huge.vertices[1][2] = -1e308;
   expect_input_error([&] { FlyingObject(index, huge); }, {"vertex 1", "-1e+308", "overflow"});
-  huge.vertices[1][2] = 1e300;  // the bound itself is accepted
+  huge.vertices[1][2] = kMaxCoordinateMagnitude;  // the bound itself is accepted
   EXPECT_NO_THROW(FlyingObject(index, huge));
   // A cube with corners at 0 and 1e308: its BVH's box sums overflowed, and the build crashed
   // before the coordinates were checked.

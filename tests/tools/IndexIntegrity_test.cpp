@@ -270,19 +270,42 @@ TEST(IndexIntegrity, PlacementsOutOfRangeAreRefusedAtTheManifestInstance) {
   write_placed_part(folder, "1e6");
   ASSERT_EQ(test::run_cli_in(folder, "preprocess far.json -o near.tpi", 120).status, 0);
   fs::remove(folder / "near.tpi");
-  // Beyond the coordinates the model accepts: once blamed on the part file.
-  write_placed_part(folder, "1e308");
-  for (const std::string command : {"preprocess far.json -o far.tpi", "mesh info far.json"}) {
-    SCOPED_TRACE(command);
-    expect_one_line_refusal(test::run_cli_in(folder, command, 120),
-                            {"far.json", "part 'bolt' (tetra.obj)", "instance 'bolt#1'",
-                             "x = 1e+308", "accepted coordinates [-1e+300, 1e+300]"});
+  // Beyond the coordinates the model accepts (where squared distances would overflow, and
+  // far beyond): once blamed on the part file.
+  for (const std::string x : {"1e160", "1e308"}) {
+    write_placed_part(folder, x);
+    for (const std::string command : {"preprocess far.json -o far.tpi", "mesh info far.json"}) {
+      SCOPED_TRACE(command + " at " + x);
+      expect_one_line_refusal(
+          test::run_cli_in(folder, command, 120),
+          {"far.json", "part 'bolt' (tetra.obj)", "instance 'bolt#1'",
+           x == "1e160" ? "x = 1e+160" : "x = 1e+308", "accepted coordinates [-1e+150, 1e+150]"});
+    }
   }
+  // A pose that far out is refused by every query, naming the value and the limit (the last
+  // line of stderr: fly logs its progress before it).
+  write_placed_part(folder, "1e6");
+  ASSERT_EQ(test::run_cli_in(folder, "preprocess far.json -o near.tpi", 120).status, 0);
+  std::ofstream(folder / "far.csv") << "tx,ty,tz,qw,qx,qy,qz\n0,0,0,1,0,0,0\n0,-1e160,0,1,0,0,0\n";
+  for (const std::string query : {"", " --query contacts", " --query distance", " --query toi"}) {
+    SCOPED_TRACE(query);
+    const std::string answers = query.empty() ? "" : " --answers a.csv";
+    const test::CliResult run = test::run_cli_in(
+        folder, "fly near.tpi --object tetra.obj --path far.csv" + query + answers, 120);
+    EXPECT_NE(run.status, 0);
+    EXPECT_NE(run.status, 124) << "timed out";
+    std::string last = run.err.substr(0, run.err.size() - 1);
+    last = last.substr(last.rfind('\n') + 1);
+    EXPECT_NE(last.find("-1e+160"), std::string::npos) << run.err;
+    EXPECT_NE(last.find("beyond 1e+150"), std::string::npos) << run.err;
+  }
+  fs::remove(folder / "near.tpi");
+  fs::remove(folder / "a.csv");
   // Within them, but so far out that rounding flattens the part: once accepted with the part
   // flattened, or "the 9 sites span no volume" after ingesting.
-  write_placed_part(folder, "1e299");
+  write_placed_part(folder, "1e149");
   expect_one_line_refusal(test::run_cli_in(folder, "preprocess far.json -o far.tpi", 120),
-                          {"far.json", "instance 'bolt#1'", "1e+299", "loses its shape to rounding",
+                          {"far.json", "instance 'bolt#1'", "1e+149", "loses its shape to rounding",
                            "2^36 times the part's size"});
   EXPECT_FALSE(has_leftovers(folder));
 }

@@ -164,8 +164,8 @@ typedef struct tetrapage_object tetrapage_object;
    3 * vertex_count doubles (x, y, z per vertex), `triangles` 3 * triangle_count vertex
    indices (0-based). The arrays are copied. On failure *object is set to NULL.
    Errors: TETRAPAGE_ERROR_INPUT (no triangle, a non-finite coordinate, a coordinate beyond
-           1e300 in magnitude (placing it could overflow), an index out of range, every
-           triangle of zero area),
+           1e150 in magnitude (distances from its placement could overflow), an index out of
+           range, every triangle of zero area),
            TETRAPAGE_ERROR_INVALID_ARGUMENT (a null argument; vertices may be null only when
            vertex_count is 0), TETRAPAGE_ERROR_STALE_HANDLE (a closed index). */
 tetrapage_status tetrapage_object_create(tetrapage_index* index, const double* vertices,
@@ -216,7 +216,7 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
    On success *collides is 1 or 0 and the contacts are kept in the object until its next
    query (tetrapage_contact_count, tetrapage_get_contacts, tetrapage_last_query_info).
    Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, a translation beyond
-           1e300 in magnitude (the placement would overflow), an invalid accuracy or
+           1e150 in magnitude (distances from there would overflow), an invalid accuracy or
            parameter), TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard this query needs
            could not be read or failed its checksum, also when the background prefetcher met
            the fault first: the message names the shard and the file; other shards and other

@@ -14,10 +14,12 @@
 
 namespace tetrapage {
 
-/// The largest magnitude of an object coordinate or a pose translation the runtime accepts:
-/// R(q) x + t then stays far from overflow (under 3e300), and so do the differences and
-/// extents computed from placed coordinates.
-inline constexpr double kMaxCoordinateMagnitude = 1e300;
+/// The largest magnitude of a model coordinate, an object coordinate or a pose translation
+/// that every query answers: R(q) x + t stays under 3e150, so the differences of placed and
+/// model coordinates stay under 6e150, and the sums of their squares (distances, box gaps,
+/// motion speeds) under 1.1e302, far from overflow (DBL_MAX is 1.8e308). Beyond about 1.3e154
+/// a squared difference overflows: an infinite distance.
+inline constexpr double kMaxCoordinateMagnitude = 1e150;
 
 /// The first vertex coordinate of `soup` beyond kMaxCoordinateMagnitude (NaN is not), as
 /// vertex, axis and value; `found` is false if there is none. Objects and environments both
@@ -31,7 +33,8 @@ struct CoordinateBeyondLimit {
 inline CoordinateBeyondLimit find_coordinate_beyond_limit(const TriangleSoup& soup) {
   for (std::size_t v = 0; v < soup.vertices.size(); ++v)
     for (int a = 0; a < 3; ++a)
-      if (std::fabs(soup.vertices[v][a]) > kMaxCoordinateMagnitude) return {true, v, a, soup.vertices[v][a]};
+      if (std::fabs(soup.vertices[v][a]) > kMaxCoordinateMagnitude)
+        return {true, v, a, soup.vertices[v][a]};
   return {};
 }
 
