@@ -205,7 +205,7 @@ bool within_triangle_limit(const TopoDS_Shape& shape, double diagonal,
   std::snprintf(
       text, sizeof text,
       "would make about %.3g triangles at a deflection of %g mm, more than the limit of %llu "
-      "(a larger --deflection makes fewer; --max-triangles raises the limit)",
+      "(a larger --deflection makes fewer; --max-cad-triangles raises the limit)",
       estimate, out.deflection, static_cast<unsigned long long>(options.max_triangles));
   out.error = text;
   out.refused = true;
@@ -302,7 +302,7 @@ void check_placed_triangles(const CadContent& content, const TessellationOptions
     throw InputError(file + ": its " + std::to_string(content.instances.size()) +
                      " placed shapes make " + std::to_string(total) +
                      " triangles, more than the limit of " + std::to_string(options.max_triangles) +
-                     " (a larger --deflection makes fewer; --max-triangles raises the limit)");
+                     " (a larger --deflection makes fewer; --max-cad-triangles raises the limit)");
 }
 
 TriangleSoup place_instances(const CadContent& content, const TessellationOptions& options,

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <sys/wait.h>
 
+#include <chrono>
 #include <csignal>
 #include <fstream>
 #include <random>
@@ -17,6 +18,7 @@
 #include "StepPrescan.h"
 #include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/MemoryUsage.h"
 
 namespace tetrapage {
 namespace {
@@ -210,6 +212,37 @@ TEST(CadHostile, TooManyOccurrencesAreRefusedWithTheLimitToRaise) {
   }
   expect_refused(test::run_cli_in(folder, "mesh info copies.step --max-cad-occurrences 4", 120),
                  "copies.step", "--max-cad-occurrences");
+}
+
+// A deflection far finer than the default is refused by its estimate before the mesher runs
+// (a 40 mm screw at 1e-6 mm once took gigabytes and minutes); the limit can be raised.
+TEST(CadHostile, AHugeTessellationIsRefusedByItsEstimate) {
+  const auto folder = fresh_folder("estimate");
+  const auto start = std::chrono::steady_clock::now();
+  const test::CliResult refused =
+      test::run_cli_in(folder, "mesh info " + (kOcctData / "step" / "screw.step").string() + " --deflection 1e-6", 120);
+  EXPECT_EQ(refused.status, 1) << refused.err;
+  EXPECT_NE(refused.err.find("--max-cad-triangles"), std::string::npos) << refused.err;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(100)) << "refused before tessellating";
+  TessellationOptions options;
+  options.deflection = 1e-6;
+  options.relative_deflection = false;
+  options.max_triangles = 1000;
+  EXPECT_THROW(read_cad(kOcctData / "step" / "screw.step", options), InputError);
+}
+
+// Reading the same STEP and IGES files again and again leaves the caller's resident memory
+// flat: what OpenCASCADE keeps (its caches, the leaks LSan reports in its libraries) stays in
+// the child, and our side of the read keeps nothing.
+TEST(CadHostile, RepeatedReadsKeepTheCallersMemoryFlat) {
+  const std::vector<std::filesystem::path> files = {kOcctData / "step" / "screw.step",
+                                                    kOcctData / "iges" / "hammer.iges"};
+  for (const auto& file : files) (void)read_cad(file);  // allocators warmed up
+  const std::uint64_t before = resident_bytes();
+  for (int round = 0; round < 40; ++round)
+    for (const auto& file : files) EXPECT_GT(read_cad(file).triangle_count(), 0u);
+  const std::uint64_t after = resident_bytes();
+  EXPECT_LT(after, before + (std::uint64_t(8) << 20)) << before << " -> " << after << " bytes resident";
 }
 
 // The child process: whatever its reader does, the caller gets an Error and no zombie.

@@ -132,6 +132,15 @@ TEST_F(HostileOutputs, ConvertedAssembliesKeepTheirUnit) {
   }
 }
 
+// mesh info reports the data's bounds, however far they lie (a model beyond the accepted
+// coordinates is still described before preprocess refuses it).
+TEST_F(HostileOutputs, MeshInfoBoundsAreTheDatas) {
+  write_text(folder_ / "far.obj", "v -1e301 0 0\nv 1e308 1 0\nv 0 -2e305 3e302\nf 1 2 3\n");
+  const test::CliResult info = run(folder_, "mesh info far.obj");
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("bounds [-1e+301, -2e+305, 0] .. [1e+308, 1, 3e+302]"), std::string::npos) << info.out;
+}
+
 // A reader of stdout that goes away (SIGPIPE) ends the flight without leaving a temporary, and
 // a temporary left by a killed run is removed by the next run writing the same output.
 TEST_F(HostileOutputs, TemporariesNeverOutliveTheRun) {

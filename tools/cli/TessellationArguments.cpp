@@ -59,7 +59,7 @@ void TessellationArguments::add_to(CLI::App* command) {
       ->check(whole_number_check(0, 1'000'000'000));
   command
       ->add_option(
-          "--max-triangles", max_triangles,
+          "--max-cad-triangles", max_triangles,
           "STEP/IGES: refuse a file whose tessellation would make more triangles than this "
           "(estimated before meshing at a deflection finer than the default; 0: no limit)")
       ->capture_default_str()

@@ -18,7 +18,7 @@ struct TessellationArguments {
   double time_limit = TessellationOptions{}.time_limit;
   std::string memory_limit;  // empty: the library's default
 
-  /// Adds --deflection, --angular-deflection, --max-cad-occurrences, --cad-timeout,
+  /// Adds --deflection, --angular-deflection, --max-cad-occurrences, --max-cad-triangles, --cad-timeout,
   /// --cad-memory and --skip-bad-parts to `command`.
   void add_to(CLI::App* command);
   /// @throw InputError for a deflection that is not a positive length or percentage.

@@ -35,7 +35,7 @@ struct TessellationOptions {
   /// A file whose tessellation would have more triangles than this is refused: before the
   /// mesher runs, for a shape at a deflection finer than the default (estimated from a mesh
   /// at the default deflection), and before its instances are placed (0: no limit).
-  std::uint64_t max_triangles = 100'000'000;
+  std::uint64_t max_triangles = 20'000'000;
   /// Read and tessellate in a child process, so that OCCT's crash, hang or runaway allocation
   /// becomes an error naming the file instead of ending the caller.
   bool isolate = true;

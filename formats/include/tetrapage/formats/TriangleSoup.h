@@ -30,6 +30,10 @@ struct BoundingBox {
   }
   void extend(const BoundingBox& b) {
     if (b.empty()) return;
+    if (empty()) {
+      *this = b;  // extending the empty box's +-1e300 would clamp a box beyond them
+      return;
+    }
     extend(b.lo);
     extend(b.hi);
   }
@@ -76,6 +80,9 @@ struct TriangleSoup {
 
   BoundingBox bounds() const {
     BoundingBox box;
+    if (vertices.empty()) return box;
+    // From the first vertex: the empty box's +-1e300 would clamp coordinates beyond them.
+    box.lo = box.hi = vertices.front();
     for (const auto& v : vertices) box.extend(v);
     return box;
   }
