@@ -10,6 +10,7 @@
 #include <set>
 #include <vector>
 
+#include "CadIsolation.h"
 #include "ReaderSupport.h"
 #include "tetrapage/formats/FileChecks.h"
 
@@ -81,17 +82,49 @@ void collect_instances(const std::string& file, const aiNode* root, const Matrix
   }
 }
 
-}  // namespace
-
-TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) {
-  {
-    // Our own open first: a missing or unreadable file is an IoError with the system's reason,
-    // which Assimp's message would not tell apart from a malformed file.
-    InputFile probe(path, 4096);
-    report.bytes = probe.size();
+// Mesh `m` of `node`, placed by `transform`, appended to `part`: its vertices, and its faces of
+// three or more corners (points and lines bound no surface) fanned into triangles.
+void add_mesh(const std::filesystem::path& path, const aiScene* scene, const aiNode* node, unsigned m,
+              const Matrix& transform, TessellatedShape& part) {
+  // An importer's scene is input too: a mesh it names must exist and hold its arrays.
+  if (node->mMeshes == nullptr || scene->mMeshes == nullptr || node->mMeshes[m] >= scene->mNumMeshes)
+    throw FormatError(path.string() + ": node '" + node->mName.C_Str() + "' names a mesh the scene lacks");
+  const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
+  if (mesh == nullptr || (mesh->mNumVertices > 0 && mesh->mVertices == nullptr) ||
+      (mesh->mNumFaces > 0 && mesh->mFaces == nullptr))
+    throw FormatError(path.string() + ": mesh " + std::to_string(node->mMeshes[m]) + " of node '" +
+                      node->mName.C_Str() + "' has no vertex or face array");
+  if (part.vertices.size() + mesh->mNumVertices > max_vertices)
+    throw InputError(path.string() + ": more vertices than a soup can index");
+  const auto base = static_cast<std::uint32_t>(part.vertices.size());
+  const std::string where =
+      path.string() + ": node '" + node->mName.C_Str() + "' mesh " + std::to_string(node->mMeshes[m]);
+  for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+    const Vec3 p = transform_point(transform, mesh->mVertices[v]);
+    if (!is_finite(p)) throw_not_finite(where + " vertex " + std::to_string(v) + ": ", p);
+    part.vertices.push_back(p);
   }
-  // A glTF's buffers are opened by Assimp: a FIFO among them would block it forever.
-  for (const auto& file : files_read_from(path)) require_regular_file(file);
+  for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+    const aiFace& face = mesh->mFaces[f];
+    if (face.mNumIndices < 3) continue;
+    if (face.mIndices == nullptr) throw FormatError(where + " face " + std::to_string(f) + ": no vertex indices");
+    for (unsigned k = 0; k < face.mNumIndices; ++k)
+      if (face.mIndices[k] >= mesh->mNumVertices)
+        throw InputError(where + " face " + std::to_string(f) + ": vertex index " + std::to_string(face.mIndices[k]) +
+                         " out of range (" + std::to_string(mesh->mNumVertices) + " vertices)");
+    for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+      part.triangles.push_back({base + face.mIndices[0], base + face.mIndices[k], base + face.mIndices[k + 1]});
+  }
+}
+
+// Assimp's reads are of files a person handles: minutes at most.
+constexpr double kAssimpSeconds = 600;
+
+// Assimp's import and the walk of its scene, in the child process: each node with meshes is a
+// shape of placed vertices and triangles (polygons fanned from their first corner, as the soup
+// would), named as its part. Assimp's crash on a crafted file (a read of freed memory in the
+// glTF importer, found by fuzzing) then ends the child only.
+CadContent import_scene(const std::filesystem::path& path) {
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
   if (scene != nullptr && scene->mNumMeshes == 0) {
@@ -107,11 +140,10 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
   std::vector<MeshInstance> instances;
   const Matrix identity{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
   collect_instances(path.string(), scene->mRootNode, identity, instances);
-
   const std::string stem = path.stem().string();
-  SoupBuilder soup(path.string(), report);
+  CadContent content;
   std::set<std::string> used_names;
-  std::vector<std::uint32_t> corners;
+  std::uint64_t vertices = 0;
   for (std::size_t i = 0; i < instances.size(); ++i) {
     const aiNode* node = instances[i].node;
     std::string name = stem;
@@ -124,45 +156,39 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
     const std::string base_name = name;
     for (int k = 2; used_names.count(name) > 0; ++k) name = base_name + "#" + std::to_string(k);
     used_names.insert(name);
-    soup.begin_part(name);
-    for (unsigned m = 0; m < node->mNumMeshes; ++m) {
-      // An importer's scene is input too: a mesh it names must exist and hold its arrays.
-      if (node->mMeshes == nullptr || scene->mMeshes == nullptr ||
-          node->mMeshes[m] >= scene->mNumMeshes)
-        throw FormatError(path.string() + ": node '" + node->mName.C_Str() +
-                          "' names a mesh the scene lacks");
-      const aiMesh* mesh = scene->mMeshes[node->mMeshes[m]];
-      if (mesh == nullptr || (mesh->mNumVertices > 0 && mesh->mVertices == nullptr) ||
-          (mesh->mNumFaces > 0 && mesh->mFaces == nullptr))
-        throw FormatError(path.string() + ": mesh " + std::to_string(node->mMeshes[m]) +
-                          " of node '" + node->mName.C_Str() + "' has no vertex or face array");
-      if (soup.vertex_count() + mesh->mNumVertices > max_vertices) {
-        throw InputError(path.string() + ": more vertices than a soup can index");
-      }
-      const auto base = static_cast<std::uint32_t>(soup.vertex_count());
-      const std::string where = path.string() + ": node '" + node->mName.C_Str() + "' mesh " +
-                                std::to_string(node->mMeshes[m]);
-      for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
-        const Vec3 p = transform_point(instances[i].transform, mesh->mVertices[v]);
-        if (!is_finite(p)) throw_not_finite(where + " vertex " + std::to_string(v) + ": ", p);
-        soup.add_vertex(p);
-      }
-      for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
-        const aiFace& face = mesh->mFaces[f];
-        if (face.mNumIndices < 3) continue;  // points and lines bound no surface
-        if (face.mIndices == nullptr)
-          throw FormatError(where + " face " + std::to_string(f) + ": no vertex indices");
-        corners.clear();
-        for (unsigned k = 0; k < face.mNumIndices; ++k) {
-          if (face.mIndices[k] >= mesh->mNumVertices) {
-            throw InputError(where + " face " + std::to_string(f) + ": vertex index " +
-                             std::to_string(face.mIndices[k]) + " out of range (" +
-                             std::to_string(mesh->mNumVertices) + " vertices)");
-          }
-          corners.push_back(base + face.mIndices[k]);
-        }
-        soup.add_polygon(corners);
-      }
+    TessellatedShape part;
+    part.name = name;
+    for (unsigned m = 0; m < node->mNumMeshes; ++m) add_mesh(path, scene, node, m, instances[i].transform, part);
+    vertices += part.vertices.size();
+    if (vertices > max_vertices) throw InputError(path.string() + ": more vertices than a soup can index");
+    content.instances.push_back({content.shapes.size(), {}, name});
+    content.shapes.push_back(std::move(part));
+  }
+  return content;
+}
+
+}  // namespace
+
+TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) {
+  {
+    // Our own open first: a missing or unreadable file is an IoError with the system's reason,
+    // which Assimp's message would not tell apart from a malformed file.
+    InputFile probe(path, 4096);
+    report.bytes = probe.size();
+  }
+  // A glTF's buffers are opened by Assimp: a FIFO among them would block it forever.
+  for (const auto& file : files_read_from(path)) require_regular_file(file);
+  const CadContent content =
+      read_in_child(path.string(), IsolationLimits{0, kAssimpSeconds}, [&] { return import_scene(path); });
+  SoupBuilder soup(path.string(), report);
+  std::vector<std::uint32_t> corners(3);
+  for (const TessellatedShape& part : content.shapes) {
+    soup.begin_part(part.name);
+    const auto base = static_cast<std::uint32_t>(soup.vertex_count());
+    for (const Vec3& p : part.vertices) soup.add_vertex(p);
+    for (const TriangleIndices& t : part.triangles) {
+      for (int k = 0; k < 3; ++k) corners[k] = base + t[k];
+      soup.add_polygon(corners);
     }
   }
   return soup.finish();
