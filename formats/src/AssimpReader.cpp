@@ -3,6 +3,8 @@
 // way are floats widened to double. The node transforms are composed in double.
 
 #include <assimp/postprocess.h>
+#include <fcntl.h>
+#include <unistd.h>
 #include <assimp/scene.h>
 
 #include <array>
@@ -125,6 +127,12 @@ constexpr double kAssimpSeconds = 600;
 // would), named as its part. Assimp's crash on a crafted file (a read of freed memory in the
 // glTF importer, found by fuzzing) then ends the child only.
 CadContent import_scene(const std::filesystem::path& path) {
+  // Runs in the child only. Assimp's failed assertions write to stderr before they abort: the
+  // caller's one-line error names the crash instead.
+  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
+    ::dup2(null, STDERR_FILENO);
+    ::close(null);
+  }
   Assimp::Importer importer;
   const aiScene* scene = importer.ReadFile(path.string(), aiProcess_Triangulate);
   if (scene != nullptr && scene->mNumMeshes == 0) {
@@ -179,7 +187,7 @@ TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report) 
   // A glTF's buffers are opened by Assimp: a FIFO among them would block it forever.
   for (const auto& file : files_read_from(path)) require_regular_file(file);
   const CadContent content =
-      read_in_child(path.string(), IsolationLimits{0, kAssimpSeconds}, [&] { return import_scene(path); });
+      read_in_child(path.string(), IsolationLimits{0, kAssimpSeconds, "Assimp"}, [&] { return import_scene(path); });
   SoupBuilder soup(path.string(), report);
   std::vector<std::uint32_t> corners(3);
   for (const TessellatedShape& part : content.shapes) {

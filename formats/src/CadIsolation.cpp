@@ -328,9 +328,9 @@ void prepare_child(int write_fd, pid_t parent, std::uint64_t address_space) {
 }
 
 // Why the child ended without an answer.
-[[noreturn]] void explain_death(const std::string& file, int status) {
+[[noreturn]] void explain_death(const std::string& file, const char* library, int status) {
   if (status != -1 && WIFSIGNALED(status))
-    throw FormatError("reading '" + file + "' crashed OpenCASCADE (signal " +
+    throw FormatError("reading '" + file + "' crashed " + library + " (signal " +
                       std::to_string(WTERMSIG(status)) +
                       (WTERMSIG(status) == SIGKILL ? ": out of memory?" : "") + ")");
   throw FormatError("reading '" + file + "' ended without an answer" +
@@ -403,7 +403,7 @@ CadContent read_in_child(const std::string& file, const IsolationLimits& limits,
     throw InputError("reading '" + file + "' took longer than " +
                      std::to_string(int(limits.seconds)) + " s (--cad-timeout raises it)");
   } catch (const StreamEnded&) {
-    explain_death(file, child.wait());
+    explain_death(file, limits.library, child.wait());
   }
 }
 

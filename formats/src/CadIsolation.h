@@ -43,6 +43,8 @@ struct IsolationLimits {
   std::uint64_t memory_bytes = 0;
   /// Seconds before the child is killed (0: no limit).
   double seconds = 0;
+  /// The library the child runs, named when the child dies of a signal.
+  const char* library = "OpenCASCADE";
 };
 
 /// Runs `read` in a child process made by fork() and returns what it read. The child runs

@@ -32,21 +32,31 @@ std::string quoted_path(const std::filesystem::path& path) {
   return text;
 }
 
+// A file a command reads, and the input that makes it read it.
+struct ReadFile {
+  std::filesystem::path file, input;
+};
+
+// Every file reading `inputs` opens (files_read_from), listed once per check.
+std::vector<ReadFile> files_read(std::span<const std::filesystem::path> inputs) {
+  std::vector<ReadFile> read;
+  for (const auto& input : inputs)
+    for (auto& file : files_read_from(input)) read.push_back({std::move(file), input});
+  return read;
+}
+
 // What the output would destroy among the files read: "the input 'a.ply'", or "'part.ply',
 // which the input 'a.json' reads"; empty when none.
-std::string input_destroyed(const struct stat& output,
-                            std::span<const std::filesystem::path> inputs) {
-  for (const auto& input : inputs) {
-    for (const auto& file : files_read_from(input)) {
-      struct stat other {};
-      if (::stat(file.c_str(), &other) != 0 || !same_file(output, other)) continue;
-      // Appended piece by piece: GCC 12 warns (-Wrestrict) on "literal" + string here.
-      std::string what(file == input ? "the input " : "");
-      if (file != input) what.append(quoted_path(file)).append(", which the input ");
-      what.append(quoted_path(input));
-      if (file != input) what.append(" reads");
-      return what;
-    }
+std::string input_destroyed(const struct stat& output, const std::vector<ReadFile>& read) {
+  for (const auto& [file, input] : read) {
+    struct stat other {};
+    if (::stat(file.c_str(), &other) != 0 || !same_file(output, other)) continue;
+    // Appended piece by piece: GCC 12 warns (-Wrestrict) on "literal" + string here.
+    std::string what(file == input ? "the input " : "");
+    if (file != input) what.append(quoted_path(file)).append(", which the input ");
+    what.append(quoted_path(input));
+    if (file != input) what.append(" reads");
+    return what;
   }
   return {};
 }
@@ -77,24 +87,19 @@ void require_own_part_folder(const std::filesystem::path& output,
 
 // A manifest output replaces the folder of part files beside it (MeshWriter.h): it must be its
 // own, and no file read may live there.
-void check_part_folder(const std::filesystem::path& output,
-                       std::span<const std::filesystem::path> inputs) {
+void check_part_folder(const std::filesystem::path& output, const std::vector<ReadFile>& read) {
   require_own_part_folder(output, output.parent_path() / (output.stem().string() + ".parts"));
   std::error_code error;
-  const std::filesystem::path folder = std::filesystem::weakly_canonical(
-      output.parent_path() / (output.stem().string() + ".parts"), error);
+  const std::filesystem::path folder =
+      std::filesystem::weakly_canonical(output.parent_path() / (output.stem().string() + ".parts"), error);
   if (error) return;
-  for (const auto& input : inputs) {
-    for (const auto& file : files_read_from(input)) {
-      const std::filesystem::path read = std::filesystem::weakly_canonical(file, error);
-      if (error) continue;
-      const auto [end, ignored] =
-          std::mismatch(folder.begin(), folder.end(), read.begin(), read.end());
-      if (end == folder.end())
-        throw InputError("refusing to write '" + output.string() + "': it replaces the folder '" +
-                         folder.string() + "', which holds '" + file.string() +
-                         "' that the input '" + input.string() + "' reads");
-    }
+  for (const auto& [file, input] : read) {
+    const std::filesystem::path path = std::filesystem::weakly_canonical(file, error);
+    if (error) continue;
+    const auto [end, ignored] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
+    if (end == folder.end())
+      throw InputError("refusing to write '" + output.string() + "': it replaces the folder '" + folder.string() +
+                       "', which holds '" + file.string() + "' that the input '" + input.string() + "' reads");
   }
 }
 
@@ -108,15 +113,16 @@ void require_regular_file(const std::filesystem::path& path) {
 }
 
 void check_outputs(std::span<const std::filesystem::path> outputs, std::span<const std::filesystem::path> inputs) {
+  const std::vector<ReadFile> read = files_read(inputs);  // manifests parsed once, not per output
   for (const std::filesystem::path& output : outputs) {
     if (output.empty()) continue;
-    if (is_manifest_path(output)) check_part_folder(output, inputs);
+    if (is_manifest_path(output)) check_part_folder(output, read);
     struct stat status {};
     if (::stat(output.c_str(), &status) != 0) continue;  // a new file: nothing to destroy
     if (!S_ISREG(status.st_mode))
       throw InputError("refusing to write '" + output.string() + "': it is " + kind_of(status.st_mode) +
                        ", not a regular file");
-    if (const std::string destroyed = input_destroyed(status, inputs); !destroyed.empty())
+    if (const std::string destroyed = input_destroyed(status, read); !destroyed.empty())
       throw InputError("refusing to write '" + output.string() + "': it is " + destroyed);
   }
   // Two outputs naming one file, existing or not.

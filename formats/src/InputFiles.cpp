@@ -61,23 +61,34 @@ std::string decoded_uri(const std::string& uri) {
   return path;
 }
 
-// The files a glTF's buffers and images name (data URIs and other schemes are not files).
-void add_gltf_files(const fs::path& path, bool binary, std::vector<fs::path>& files) {
-  const nlohmann::json document = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
-  if (!document.is_object()) return;
-  for (const char* list : {"buffers", "images"}) {
-    const auto entries = document.find(list);
-    if (entries == document.end() || !entries->is_array()) continue;
-    for (const auto& entry : *entries) {
-      if (!entry.is_object() || !entry.contains("uri") || !entry["uri"].is_string()) continue;
-      const std::string uri = entry["uri"].get<std::string>();
-      if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos)
-        continue;
-      // Readers differ on percent escapes (Assimp 5.2 opens the URI as written): both count.
-      files.push_back(path.parent_path() / uri);
-      if (const std::string decoded = decoded_uri(uri); decoded != uri)
-        files.push_back(path.parent_path() / decoded);
+// Every "uri" string member anywhere in a glTF document: buffers and images (glTF 2 lists them
+// in arrays, glTF 1 in objects keyed by id), shaders (glTF 1) and extensions alike.
+void add_uris(const nlohmann::json& value, std::vector<std::string>& uris) {
+  if (value.is_object()) {
+    for (const auto& [key, member] : value.items()) {
+      if (key == "uri" && member.is_string()) uris.push_back(member.get<std::string>());
+      add_uris(member, uris);
     }
+  } else if (value.is_array()) {
+    for (const auto& member : value) add_uris(member, uris);
+  }
+}
+
+// The files a glTF's URIs name (data URIs and other schemes are not files).
+void add_gltf_files(const fs::path& path, bool binary, std::vector<fs::path>& files) {
+  // Values nested deeper than 64 levels are dropped: add_uris recurses, and no glTF nests so.
+  const nlohmann::json::parser_callback_t shallow = [](int level, nlohmann::json::parse_event_t, nlohmann::json&) {
+    return level <= 64;
+  };
+  const nlohmann::json document = nlohmann::json::parse(gltf_json(path, binary), shallow, false);
+  if (!document.is_object()) return;
+  std::vector<std::string> uris;
+  add_uris(document, uris);
+  for (const std::string& uri : uris) {
+    if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos) continue;
+    // Readers differ on percent escapes (Assimp 5.2 opens the URI as written): both count.
+    files.push_back(path.parent_path() / uri);
+    if (const std::string decoded = decoded_uri(uri); decoded != uri) files.push_back(path.parent_path() / decoded);
   }
 }
 

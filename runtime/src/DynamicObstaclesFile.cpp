@@ -33,6 +33,7 @@
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/OutputFile.h"
+#include "tetrapage/formats/QuotedInput.h"
 #include "tetrapage/runtime/DynamicObstacles.h"
 
 namespace tetrapage {
@@ -41,23 +42,6 @@ namespace {
 
 constexpr const char* kMagic = "tetrapage-dynamic-obstacles";
 constexpr int kVersion = 1;
-
-// Text of the file shown in a message: a few dozen characters, control bytes escaped.
-std::string excerpt(const std::string& text) {
-  constexpr std::size_t kShown = 40;
-  std::string shown;
-  for (std::size_t i = 0; i < text.size() && i < kShown; ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (c >= 0x20 && c < 0x7f) {
-      shown += char(c);
-    } else {
-      char escape[8];
-      std::snprintf(escape, sizeof escape, "\\x%02x", c);
-      shown += escape;
-    }
-  }
-  return text.size() > kShown ? shown + "..." : shown;
-}
 
 std::string hex(double x) {
   char buffer[64];
@@ -112,7 +96,7 @@ class LineReader {
     std::istringstream fields(text);
     std::string first;
     if (!(fields >> first) || first != word)
-      fail("expected '" + word + "', read '" + excerpt(text) + "'");
+      fail("expected '" + word + "', read " + quoted_input(text));
     return fields;
   }
   std::string next_line(const std::string& expected) {
@@ -130,7 +114,7 @@ class LineReader {
       out[i] = parse<T>(token);
     }
     std::string extra;
-    if (fields >> extra) fail("unexpected '" + excerpt(extra) + "'");
+    if (fields >> extra) fail("unexpected " + quoted_input(extra));
   }
   template <class T>
   T parse(const std::string& token) const {
@@ -138,15 +122,15 @@ class LineReader {
     errno = 0;
     if constexpr (std::is_floating_point_v<T>) {
       const double x = std::strtod(token.c_str(), &end);
-      if (end == token.c_str() || *end != '\0') fail("'" + excerpt(token) + "' is not a number");
+      if (end == token.c_str() || *end != '\0') fail(quoted_input(token) + " is not a number");
       return x;
     } else {
       if (token.empty() || token[0] == '-')
-        fail("'" + excerpt(token) + "' is not a count or an id");
+        fail(quoted_input(token) + " is not a count or an id");
       const unsigned long long x = std::strtoull(token.c_str(), &end, 10);
       if (end == token.c_str() || *end != '\0' || errno == ERANGE ||
           x > std::numeric_limits<T>::max())
-        fail("'" + excerpt(token) + "' is not a count or an id");
+        fail(quoted_input(token) + " is not a count or an id");
       return T(x);
     }
   }
@@ -155,7 +139,7 @@ class LineReader {
     std::string text;
     while (bounded_line(text)) {
       if (text.find_first_not_of(" \t\r") != std::string::npos)
-        fail("unexpected '" + excerpt(text) + "' after the last part");
+        fail("unexpected " + quoted_input(text) + " after the last part");
     }
   }
 

@@ -85,6 +85,31 @@ TEST_F(HostileOutputs, AGltfsBufferIsAnInput) {
   expect_refused(run(folder_, "mesh info m.gltf"), "FIFO");
 }
 
+// A foreign glTF 1.0 model (Debian's assimp-testmodels): its buffer, image and shaders are
+// named in objects keyed by id, not arrays; every one is an input. With a damaged buffer Assimp
+// aborts on an assertion: the read runs in a child, so the command says so in one line.
+TEST_F(HostileOutputs, AForeignGltfOnesFilesAreInputsAndItsReaderCannotEndTheCommand) {
+  const fs::path model = "/usr/share/assimp/models/glTF/BoxTextured-glTF";
+  ASSERT_TRUE(fs::exists(model / "BoxTextured.gltf")) << "assimp-testmodels (make deps) holds it";
+  fs::copy(model, folder_ / "box");
+  write_text(folder_ / "box" / "a.json", R"({"parts":[{"file":"BoxTextured.gltf"}]})");
+  const std::string buffer = read_file(folder_ / "box" / "BoxTextured.bin");
+  make_model("model.ply", 400);
+  ASSERT_EQ(run(folder_, "preprocess model.ply -o model.tpi").status, 0);
+  write_poses(folder_ / "flight.csv", std::vector<Pose>(3));
+  for (const char* output : {"box/BoxTextured.bin", "box/CesiumLogoFlat.png", "box/BoxTextured0FS.glsl"})
+    expect_refused(run(folder_, std::string("fly model.tpi --object box/a.json --path flight.csv --report ") + output),
+                   "which the input 'box/a.json' reads");
+  EXPECT_EQ(read_file(folder_ / "box" / "BoxTextured.bin"), buffer);
+  EXPECT_EQ(run(folder_, "mesh info box/BoxTextured.gltf").status, 0);
+  // Its buffer replaced by text (what such an overwrite left): Assimp 5.2's glTF 1 importer
+  // fails an assertion and aborts. The command used to end with SIGABRT; now the child does.
+  std::string text = "{\n";
+  for (int k = 0; k < 200; ++k) text += "  \"a\": 1,\n";
+  write_text(folder_ / "box" / "BoxTextured.bin", text + "}\n");
+  expect_refused(run(folder_, "mesh info box/BoxTextured.gltf"), "crashed Assimp");
+}
+
 // A manifest output replaces its part folder: only one that holds part files alone, and never
 // one holding files the command reads.
 TEST_F(HostileOutputs, AManifestsPartFolderIsReplacedOnlyWhenItIsItsOwn) {
