@@ -19,6 +19,7 @@ void report_touching(const QueryResult& touch, DistanceResult& result) {
   result.distance = result.lower_bound = result.upper_bound = 0;
   result.containment = touch.containment;
   result.containing_part = touch.containing_part;
+  result.containing_dynamic_part = touch.containing_dynamic_part;
   if (touch.contacts.empty()) return;
   const Contact& contact = touch.contacts.front();
   result.environment_triangle = contact.environment_triangle;
@@ -29,9 +30,13 @@ void report_touching(const QueryResult& touch, DistanceResult& result) {
 
 }  // namespace
 
-geometry::ContactGeometry FlyingObject::contact_geometry(const Contact& contact) {
-  if (contact.object_triangle == Contact::kNoObjectTriangle) return {};
-  if (contact.dynamic_part != kNoDynamicPart) return dynamic_contact_geometry(contact);
+std::pair<geometry::Triangle, geometry::Triangle> FlyingObject::contact_triangles(
+    const Contact& contact) {
+  if (contact.object_triangle == Contact::kNoObjectTriangle)
+    throw InputError(
+        "contact triangles: a contact of a solid has no object triangle (environment triangle " +
+        std::to_string(contact.environment_triangle) + ")");
+  if (contact.dynamic_part != kNoDynamicPart) return dynamic_contact_triangles(contact);
   if (contact.object_triangle >= model_->mesh.triangles.size())
     throw InputError("contact geometry: the object has no triangle " +
                      std::to_string(contact.object_triangle));
@@ -44,13 +49,19 @@ geometry::ContactGeometry FlyingObject::contact_geometry(const Contact& contact)
     const std::size_t at = (parts_->contact_cursor + k) % tested.size();
     if (tested[at].first != contact.environment_triangle) continue;
     parts_->contact_cursor = at;
-    return geometry::contact_geometry(tested[at].second, placed);
+    return {tested[at].second, placed};
   }
   const auto stored = index_->stored_triangle(contact.environment_triangle);
   if (!stored)
     throw InputError("contact geometry: the index holds no triangle " +
                      std::to_string(contact.environment_triangle));
-  return geometry::contact_geometry(stored->corners, placed);
+  return {stored->corners, placed};
+}
+
+geometry::ContactGeometry FlyingObject::contact_geometry(const Contact& contact) {
+  if (contact.object_triangle == Contact::kNoObjectTriangle) return {};
+  const auto [environment, object] = contact_triangles(contact);
+  return geometry::contact_geometry(environment, object);
 }
 
 void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,
@@ -79,7 +90,8 @@ void FlyingObject::distance(const Pose& pose, const DistanceOptions& options,
     result.from_free_box = true;
     return;
   }
-  parts.distance.measure(*model_, parts.object, box, options.max_distance, parts.obstacles.get(), result);
+  parts.distance.measure(*model_, parts.object, box, options.max_distance, parts.obstacles.get(),
+                         result);
 }
 
 }  // namespace tetrapage

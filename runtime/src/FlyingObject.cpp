@@ -236,7 +236,8 @@ void FlyingObject::set_obstacles(std::shared_ptr<const DynamicObstacles> obstacl
   parts_->obstacles_shows = parts_->obstacles ? parts_->obstacles->shows() : 0;
 }
 
-geometry::ContactGeometry FlyingObject::dynamic_contact_geometry(const Contact& contact) {
+std::pair<geometry::Triangle, geometry::Triangle> FlyingObject::dynamic_contact_triangles(
+    const Contact& contact) {
   const DynamicObstacles::Part* part =
       parts_->obstacles ? parts_->obstacles->find(contact.dynamic_part) : nullptr;
   if (part == nullptr)
@@ -248,9 +249,8 @@ geometry::ContactGeometry FlyingObject::dynamic_contact_geometry(const Contact& 
                      " or the object no triangle " + std::to_string(contact.object_triangle));
   PlacedObject placed(*part->model);
   placed.place(part->pose);
-  return geometry::contact_geometry(
-      placed.world_triangle(std::uint32_t(contact.environment_triangle)),
-      parts_->object.world_triangle(contact.object_triangle));
+  return {placed.world_triangle(std::uint32_t(contact.environment_triangle)),
+          parts_->object.world_triangle(contact.object_triangle)};
 }
 
 const std::shared_ptr<const DynamicObstacles>& FlyingObject::obstacles() const {

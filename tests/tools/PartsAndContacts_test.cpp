@@ -85,19 +85,22 @@ std::vector<ContactRow> read_contacts(const std::filesystem::path& path) {
   std::ifstream in(path);
   std::string line;
   std::getline(in, line);
-  EXPECT_EQ(line, "step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z");
+  EXPECT_EQ(line,
+            "step,kind,part,part_name,part_path,dynamic_part,environment_triangle,object_part,"
+            "object_part_name,object_part_path,object_triangle,environment_x,environment_y,"
+            "environment_z,object_x,object_y,object_z");
   std::vector<ContactRow> rows;
   while (std::getline(in, line)) {
     const auto f = split_csv(line);
-    EXPECT_EQ(f.size(), 10u) << line;
-    if (f.size() != 10 || f[1] != "surface") continue;
+    EXPECT_EQ(f.size(), 17u) << line;
+    if (f.size() != 17 || f[1] != "surface") continue;
     rows.push_back({std::stoull(f[0]),
-                    std::stoull(f[5]),
+                    std::stoull(f[6]),
                     std::uint32_t(std::stoul(f[2])),
-                    std::uint32_t(std::stoul(f[6])),
+                    std::uint32_t(std::stoul(f[10])),
                     f[3],
                     f[4],
-                    {std::stod(f[7]), std::stod(f[8]), std::stod(f[9])}});
+                    {std::stod(f[11]), std::stod(f[12]), std::stod(f[13])}});
   }
   return rows;
 }

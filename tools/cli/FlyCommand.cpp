@@ -92,14 +92,14 @@ class QueryStep {
       case FlyQuery::distance:
         object.distance(poses[i], distance_options_, distance_);
         ++separations_[int(distance_.separation)];
-        if (answers_) answers_->write_distance(i, distance_);
+        if (answers_) answers_->write_distance(i, object, distance_);
         return distance_.separation == Separation::touching;
       case FlyQuery::time_of_impact:
         impact_ = i == 0 ? object.time_of_impact(poses[0], poses[0], impact_options_)
                          : object.time_of_impact(poses[i - 1], poses[i], impact_options_);
         ++impacts_[int(impact_.impact)];
         iterations_ += impact_.iterations;
-        if (answers_) answers_->write_impact(i, impact_);
+        if (answers_) answers_->write_impact(i, object, impact_);
         return impact_.impact == Impact::hit;
       case FlyQuery::contacts:
       case FlyQuery::collide:
@@ -362,9 +362,11 @@ void add_fly_command(CLI::App& app) {
       ->check(positive_number_check(1e12));
   args->tessellation.add_to(command);
   command->add_option("--contacts", args->contacts,
-                      "Write the contacts as CSV: step, kind, environment part (id, name, instance path), "
-                      "environment and object triangle, one point where they meet (the first contact of a "
-                      "step; every pair with --all-contacts)");
+                      "Write the contacts as CSV, one row per contact and per containment: step, kind "
+                      "(surface, near under clearance:D, object_inside, obstacle_inside), the environment "
+                      "part and the object's part (id, name, instance path), both triangles, the point on "
+                      "each side (the first contact of a step; every pair with --all-contacts; the columns "
+                      "of every answer file: docs/USAGE.md, \"Answer files\")");
   command
       ->add_option("--path", args->paths,
                    "Pose file (CSV tx,ty,tz,qw,qx,qy,qz); one per --object, in order")

@@ -1,21 +1,23 @@
 #include "tetrapage/tools/QueryAnswerFile.h"
 
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/tools/AnswerSite.h"
 
 namespace tetrapage {
 
 namespace {
 
-const char* header_of(FlyQuery query) {
+std::string header_of(FlyQuery query) {
+  const std::string site = std::string("step,") + kAnswerSiteHeader;
   switch (query) {
     case FlyQuery::contacts:
-      return "step,part,part_name,environment_triangle,object_triangle,shape,x1,y1,z1,x2,y2,z2,polygon,"
-             "environment_nx,environment_ny,environment_nz,object_nx,object_ny,object_nz";
+      return site +
+             ",shape,x1,y1,z1,x2,y2,z2,polygon,environment_nx,environment_ny,environment_nz,"
+             "object_nx,object_ny,object_nz";
     case FlyQuery::distance:
-      return "step,distance,x1,y1,z1,x2,y2,z2,part,environment_triangle,object_triangle,separation,"
-             "lower_bound,upper_bound";
+      return site + ",separation,distance,lower_bound,upper_bound";
     case FlyQuery::time_of_impact:
-      return "step,impact,free_until,contact_at,part,environment_triangle,object_triangle,iterations";
+      return site + ",impact,free_until,contact_at,iterations";
     case FlyQuery::collide:
       break;
   }
@@ -28,10 +30,14 @@ std::string point_fields(const geometry::Point& p) {
 
 const char* shape_name(geometry::ContactShape shape) {
   switch (shape) {
-    case geometry::ContactShape::point: return "point";
-    case geometry::ContactShape::segment: return "segment";
-    case geometry::ContactShape::polygon: return "polygon";
-    case geometry::ContactShape::none: break;
+    case geometry::ContactShape::point:
+      return "point";
+    case geometry::ContactShape::segment:
+      return "segment";
+    case geometry::ContactShape::polygon:
+      return "polygon";
+    case geometry::ContactShape::none:
+      break;
   }
   return "none";
 }
@@ -42,13 +48,19 @@ std::string geometry_fields(const geometry::ContactGeometry& meet) {
   fields += ',';
   fields += meet.count > 0 ? point_fields(meet.points[0]) : std::string(",,");
   fields += ',';
-  fields += meet.count > 1 ? point_fields(meet.points[1]) : meet.count == 1 ? point_fields(meet.points[0]) : ",,";
+  fields += meet.count > 1    ? point_fields(meet.points[1])
+            : meet.count == 1 ? point_fields(meet.points[0])
+                              : ",,";
   fields += ',';
   if (meet.shape == geometry::ContactShape::polygon)
     for (std::uint8_t i = 0; i < meet.count; ++i) {
       const geometry::Point& p = meet.points[i];
       if (i > 0) fields += ';';
-      fields.append(number_field(p[0])).append(" ").append(number_field(p[1])).append(" ").append(number_field(p[2]));
+      fields.append(number_field(p[0]))
+          .append(" ")
+          .append(number_field(p[1]))
+          .append(" ")
+          .append(number_field(p[2]));
     }
   return fields + ',' + point_fields(meet.first_normal) + ',' + point_fields(meet.second_normal);
 }
@@ -65,10 +77,14 @@ FlyQuery parse_fly_query(const std::string& text) {
 
 const char* fly_query_name(FlyQuery query) {
   switch (query) {
-    case FlyQuery::collide: return "collide";
-    case FlyQuery::contacts: return "contacts";
-    case FlyQuery::distance: return "distance";
-    case FlyQuery::time_of_impact: return "toi";
+    case FlyQuery::collide:
+      return "collide";
+    case FlyQuery::contacts:
+      return "contacts";
+    case FlyQuery::distance:
+      return "distance";
+    case FlyQuery::time_of_impact:
+      return "toi";
   }
   return "collide";
 }
@@ -77,45 +93,37 @@ QueryAnswerFile::QueryAnswerFile(const std::filesystem::path& path, FlyQuery que
                                  const CollisionIndex& index)
     : file_(path, header_of(query)), index_(index) {}
 
-void QueryAnswerFile::write_contacts(std::uint64_t step, FlyingObject& object, const QueryResult& result) {
-  const IndexParts& parts = index_.parts();
+void QueryAnswerFile::write_contacts(std::uint64_t step, FlyingObject& object,
+                                     const QueryResult& result) {
+  const std::string prefix = std::to_string(step) + ',';
+  if (result.containment != Containment::none)
+    file_.row(prefix +
+              site_fields(containment_site(result.containment, result.containing_part,
+                                           result.containing_dynamic_part),
+                          index_, object) +
+              ",none,,,,,,,,,,,,,");
   for (const Contact& contact : result.contacts) {
-    std::string row = std::to_string(step) + ',' + std::to_string(contact.environment_part) + ',' +
-                      csv_field(parts.name(contact.environment_part)) + ',' +
-                      std::to_string(contact.environment_triangle) + ',';
-    if (contact.object_triangle == Contact::kNoObjectTriangle)
-      row.append(",solid,,,,,,,,,,,,,");
-    else
-      row += std::to_string(contact.object_triangle) + ',' + geometry_fields(object.contact_geometry(contact));
+    const AnswerSite site = contact_site(object, contact);
+    std::string row = prefix + site_fields(site, index_, object) + ',';
+    row += contact.object_triangle == Contact::kNoObjectTriangle
+               ? std::string("none,,,,,,,,,,,,,")
+               : geometry_fields(object.contact_geometry(contact));
     file_.row(row);
   }
 }
 
-void QueryAnswerFile::write_distance(std::uint64_t step, const DistanceResult& result) {
-  const bool has_pair = result.environment_triangle != DistanceResult::kNoTriangle;
-  const bool has_points = has_closest_points(result);
-  std::string row = std::to_string(step) + ',' + number_field(result.distance) + ',';
-  row += has_points ? point_fields(result.on_environment) + ',' + point_fields(result.on_object) : ",,,,,";
-  row += ',';
-  row += has_pair ? std::to_string(result.environment_part) + ',' + std::to_string(result.environment_triangle) + ',' +
-                        (result.object_triangle == Contact::kNoObjectTriangle ? std::string()
-                                                                               : std::to_string(result.object_triangle))
-                  : std::string(",,");
-  row += std::string(",") + to_string(result.separation) + ',' + number_field(result.lower_bound) + ',' +
-         number_field(result.upper_bound);
-  file_.row(row);
+void QueryAnswerFile::write_distance(std::uint64_t step, FlyingObject& object,
+                                     const DistanceResult& result) {
+  file_.row(std::to_string(step) + ',' + site_fields(distance_site(result), index_, object) + ',' +
+            to_string(result.separation) + ',' + number_field(result.distance) + ',' +
+            number_field(result.lower_bound) + ',' + number_field(result.upper_bound));
 }
 
-void QueryAnswerFile::write_impact(std::uint64_t step, const ImpactResult& result) {
-  std::string row = std::to_string(step) + ',' + to_string(result.impact) + ',' +
-                    number_field(result.free_until) + ',' + number_field(result.contact_at) + ',';
-  row += result.has_contact ? std::to_string(result.environment_part) + ',' +
-                                  std::to_string(result.environment_triangle) + ',' +
-                                  (result.object_triangle == Contact::kNoObjectTriangle
-                                       ? std::string()
-                                       : std::to_string(result.object_triangle))
-                            : std::string(",,");
-  file_.row(row + ',' + std::to_string(result.iterations));
+void QueryAnswerFile::write_impact(std::uint64_t step, FlyingObject& object,
+                                   const ImpactResult& result) {
+  file_.row(std::to_string(step) + ',' + site_fields(impact_site(object, result), index_, object) +
+            ',' + to_string(result.impact) + ',' + number_field(result.free_until) + ',' +
+            number_field(result.contact_at) + ',' + std::to_string(result.iterations));
 }
 
 }  // namespace tetrapage

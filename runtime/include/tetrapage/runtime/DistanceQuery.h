@@ -65,6 +65,7 @@ struct DistanceResult {
   /// Touching without contact: which body holds the other (its part in containing_part).
   Containment containment{};
   std::uint32_t containing_part = 0;
+  std::uint32_t containing_dynamic_part = 0;  ///< as QueryResult's
   /// Environment triangles measured against the object, and triangle pairs measured.
   std::uint64_t candidates = 0;
   std::uint64_t pair_tests = 0;

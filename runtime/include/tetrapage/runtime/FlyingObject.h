@@ -220,6 +220,12 @@ class FlyingObject {
   /// shard if needed. A contact of a solid (no object triangle) has shape none.
   /// @throw InputError for an environment triangle the index does not hold.
   geometry::ContactGeometry contact_geometry(const Contact& contact);
+  /// A contact's two triangles in world coordinates, the environment's first (the copy phase
+  /// II tested), the object's at the last query's pose: for what contact_geometry does not
+  /// say, such as whether a pair reported under a clearance accuracy meets
+  /// (TriangleTriangle.h) or how far apart it lies (TriangleDistance.h).
+  /// @throw InputError for a contact of a solid (no object triangle), and as contact_geometry.
+  std::pair<geometry::Triangle, geometry::Triangle> contact_triangles(const Contact& contact);
 
   /// The first time in [0, 1] at which the object moving from `from` to `to` (PoseMotion.h)
   /// touches the environment, by conservative advancement: distance queries along the motion,
@@ -259,8 +265,8 @@ class FlyingObject {
   // Phases I and II over the region's shards that the step needs, then containment.
   void test_region(const geometry::Box& box, const QueryOptions& options, bool solid_query,
                    std::chrono::steady_clock::time_point loop_start, QueryResult& result);
-  // contact_geometry of a contact with a dynamic obstacle (at the overlay's current pose).
-  geometry::ContactGeometry dynamic_contact_geometry(const Contact& contact);
+  // contact_triangles of a contact with a dynamic obstacle (at the overlay's current pose).
+  std::pair<geometry::Triangle, geometry::Triangle> dynamic_contact_triangles(const Contact& contact);
   // A step whose box met no tet of the mesh: the dynamic obstacles alone.
   void test_obstacles_alone(const geometry::Box& box, const QueryOptions& options, bool own_frame,
                             bool solid_query, double reach, QueryResult& result);

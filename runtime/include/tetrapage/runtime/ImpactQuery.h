@@ -8,6 +8,8 @@
 
 namespace tetrapage {
 
+enum class Containment : std::uint8_t;
+
 struct ImpactOptions {
   /// The bracket's width at most (in the motion's time, [0, 1]).
   double tolerance = 1e-4;
@@ -41,6 +43,13 @@ struct ImpactResult {
   std::uint64_t environment_triangle = 0;
   std::uint32_t environment_part = 0;
   std::uint32_t object_triangle = 0;
+  /// The contact's dynamic obstacle (DynamicObstacles.h), or 0 for the index's triangles.
+  std::uint32_t dynamic_part = 0;
+  /// A hit with no contact: which body holds the other at contact_at, and its environment
+  /// part (Contact::kDynamicPart with containing_dynamic_part for a dynamic obstacle).
+  Containment containment{};
+  std::uint32_t containing_part = 0;
+  std::uint32_t containing_dynamic_part = 0;
   std::uint32_t iterations = 0;  ///< distance queries run
 };
 

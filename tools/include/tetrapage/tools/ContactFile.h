@@ -1,13 +1,8 @@
 #pragma once
 /// @file ContactFile.h
-/// The contacts of a flight as CSV (`fly --contacts`), one row per contact:
-///   step,kind,part,part_name,part_path,environment_triangle,object_triangle,x,y,z
-/// kind is "surface" (an environment triangle meets an object triangle; x,y,z is a point of
-/// their intersection: the mean of FlyingObject::contact_geometry's corners, within 2^-40 of
-/// the coordinates' magnitude), "solid" (the object was
-/// checked as a solid: hull, box or swept; no object triangle nor point), "object_inside" or
-/// "obstacle_inside" (containment: part is the containing or contained environment part, and
-/// the triangle and point fields are empty). Names are quoted as CSV quotes them.
+/// The contacts of a flight as CSV (`fly --contacts`): one row per contact, and one per
+/// containment, each `step,` and the site columns of AnswerSite.h (kind surface, near,
+/// solid, object_inside or obstacle_inside; the parts on both sides by id, name and path).
 
 #include <cstdint>
 #include <filesystem>
@@ -35,9 +30,6 @@ class ContactFile {
   void commit() { file_.commit(); }
 
  private:
-  void write_row(std::uint64_t step, const char* kind, std::uint32_t part,
-                 const std::string& triangle_fields);
-
   CsvFile file_;
   const CollisionIndex& index_;
 };

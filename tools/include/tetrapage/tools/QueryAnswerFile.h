@@ -1,21 +1,22 @@
 #pragma once
 /// @file QueryAnswerFile.h
-/// The answers of `tetrapage fly --query contacts|distance|toi --answers FILE` as CSV:
-///   contacts: one row per contact pair (every pair of each step):
-///     step,part,part_name,environment_triangle,object_triangle,shape,x1,y1,z1,x2,y2,z2,
-///     polygon,environment_nx,environment_ny,environment_nz,object_nx,object_ny,object_nz
-///     shape is point, segment, polygon or solid (the object checked as a solid: no geometry);
-///     x1..z2 the point, or the segment's ends, or the polygon's first two corners; polygon
-///     every corner of a coplanar overlap as "x y z;x y z;..." (empty otherwise); the normals
-///     are unit, by the right-hand rule of each triangle's corners.
-///   distance: one row per step:
-///     step,distance,x1,y1,z1,x2,y2,z2,part,environment_triangle,object_triangle,separation,
-///     lower_bound,upper_bound
-///     (1: on the environment, 2: on the object; separation touching, apart or farther; the
-///     points and triangles are empty when farther or for a containment).
+/// The answers of `tetrapage fly --query contacts|distance|toi --answers FILE` as CSV, each
+/// row `step,` and the site columns of AnswerSite.h (kind, the environment part, the object
+/// part, both points), then the query's own columns:
+///   contacts: one row per contact pair (every pair of each step) and one per containment:
+///     ...,shape,x1,y1,z1,x2,y2,z2,polygon,environment_nx,environment_ny,environment_nz,
+///     object_nx,object_ny,object_nz
+///     where the triangles meet: shape point, segment or polygon (none for a near pair, a
+///     solid or a containment); x1..z2 the point, or the segment's ends, or the polygon's
+///     first two corners; polygon every corner of a coplanar overlap as "x y z;x y z;..."; the
+///     normals are unit, by the right-hand rule of each triangle's corners.
+///   distance: one row per step: ...,separation,distance,lower_bound,upper_bound
+///     (separation touching, apart or farther; the site is the closest pair, the containment,
+///     or empty when farther).
 ///   toi: one row per step, the motion from the previous pose (step 0: the pose alone):
-///     step,impact,free_until,contact_at,part,environment_triangle,object_triangle,iterations
-///     (impact none, hit or unresolved; the triangles are the first contact at contact_at).
+///     ...,impact,free_until,contact_at,iterations
+///     (impact none, hit or unresolved; the site is the first contact or the containment at
+///     contact_at).
 /// (`--query collide` writes step,collides: AnswerFile.h.)
 
 #include <cstdint>
@@ -41,8 +42,8 @@ class QueryAnswerFile {
 
   /// The contact rows of a step (its geometry from the object at the step's pose).
   void write_contacts(std::uint64_t step, FlyingObject& object, const QueryResult& result);
-  void write_distance(std::uint64_t step, const DistanceResult& result);
-  void write_impact(std::uint64_t step, const ImpactResult& result);
+  void write_distance(std::uint64_t step, FlyingObject& object, const DistanceResult& result);
+  void write_impact(std::uint64_t step, FlyingObject& object, const ImpactResult& result);
   std::uint64_t rows() const { return file_.rows(); }
   /// Flushes and renames the file into place. @throw IoError.
   void commit() { file_.commit(); }

@@ -1,0 +1,168 @@
+#include "tetrapage/tools/AnswerSite.h"
+
+#include "tetrapage/runtime/geometry/TriangleDistance.h"
+#include "tetrapage/runtime/geometry/TriangleTriangle.h"
+#include "tetrapage/tools/CsvFile.h"
+
+namespace tetrapage {
+namespace {
+
+const char* kind_name(AnswerSite::Kind kind) {
+  switch (kind) {
+    case AnswerSite::Kind::surface:
+      return "surface";
+    case AnswerSite::Kind::near:
+      return "near";
+    case AnswerSite::Kind::solid:
+      return "solid";
+    case AnswerSite::Kind::object_inside:
+      return "object_inside";
+    case AnswerSite::Kind::obstacle_inside:
+      return "obstacle_inside";
+    case AnswerSite::Kind::none:
+      break;
+  }
+  return "";
+}
+
+// A point of the intersection: the mean of its corners (a point, a segment's midpoint, a point
+// inside the convex polygon of a coplanar overlap).
+Vec3 representative_point(const geometry::ContactGeometry& meet) {
+  Vec3 mean{0, 0, 0};
+  for (std::uint8_t i = 0; i < meet.count; ++i)
+    for (int a = 0; a < 3; ++a) mean[a] += meet.points[i][a];
+  for (double& x : mean) x /= double(meet.count);
+  return mean;
+}
+
+std::string point_fields(const std::optional<Vec3>& p) {
+  if (!p) return ",,";
+  return number_field((*p)[0]) + ',' + number_field((*p)[1]) + ',' + number_field((*p)[2]);
+}
+
+// part,part_name,part_path,dynamic_part of the environment side.
+std::string environment_fields(const AnswerSite& site, const CollisionIndex& index,
+                               const FlyingObject& object) {
+  if (site.environment_part == Contact::kDynamicPart) {
+    const DynamicObstacles::Part* part =
+        object.obstacles() ? object.obstacles()->find(site.dynamic_part) : nullptr;
+    const std::string name = csv_field(part ? part->name : std::string());
+    std::string fields(1, ',');
+    fields.append(name).append(1, ',').append(name).append(1, ',');
+    return fields.append(std::to_string(site.dynamic_part));
+  }
+  const IndexParts& parts = index.parts();
+  return std::to_string(site.environment_part) + ',' +
+         csv_field(parts.name(site.environment_part)) + ',' +
+         csv_field(parts.path(site.environment_part)) + ',';
+}
+
+// object_part,object_part_name,object_part_path of the object triangle (empty without one).
+std::string object_part_fields(const AnswerSite& site, const TriangleSoup& mesh) {
+  if (!site.object_triangle || *site.object_triangle >= mesh.triangle_count()) return ",,";
+  const std::uint32_t part =
+      *site.object_triangle < mesh.part_of.size() ? mesh.part_of[*site.object_triangle] : 0;
+  if (part >= mesh.part_count()) return std::to_string(part) + ",,";
+  return std::to_string(part) + ',' + csv_field(mesh.part_names[part]) + ',' +
+         csv_field(mesh.part_path(part));
+}
+
+}  // namespace
+
+AnswerSite contact_site(FlyingObject& object, const Contact& contact) {
+  AnswerSite site;
+  site.environment_part = contact.environment_part;
+  site.dynamic_part = contact.dynamic_part;
+  site.environment_triangle = contact.environment_triangle;
+  if (contact.object_triangle == Contact::kNoObjectTriangle) {
+    site.kind = AnswerSite::Kind::solid;
+    return site;
+  }
+  site.object_triangle = contact.object_triangle;
+  const auto [environment, placed] = object.contact_triangles(contact);
+  if (geometry::triangles_intersect(environment, placed)) {
+    site.kind = AnswerSite::Kind::surface;
+    const geometry::ContactGeometry meet = object.contact_geometry(contact);
+    // The constructed intersection can come out empty where the exact test says the pair
+    // meets at a single point: the closest points then stand for it.
+    if (meet.count > 0) {
+      site.on_environment = site.on_object = representative_point(meet);
+      return site;
+    }
+  } else {
+    site.kind = AnswerSite::Kind::near;
+  }
+  const geometry::TriangleDistance closest = geometry::triangle_distance(environment, placed);
+  site.on_environment = closest.on_first;
+  site.on_object = closest.on_second;
+  return site;
+}
+
+AnswerSite containment_site(Containment containment, std::uint32_t part,
+                            std::uint32_t dynamic_part) {
+  AnswerSite site;
+  if (containment == Containment::none) return site;
+  site.kind = containment == Containment::object_inside_obstacle
+                  ? AnswerSite::Kind::object_inside
+                  : AnswerSite::Kind::obstacle_inside;
+  site.environment_part = part;
+  site.dynamic_part = dynamic_part;
+  return site;
+}
+
+AnswerSite distance_site(const DistanceResult& result) {
+  if (result.separation == Separation::farther) return {};
+  if (result.environment_triangle == DistanceResult::kNoTriangle)
+    return containment_site(result.containment, result.containing_part,
+                            result.containing_dynamic_part);
+  AnswerSite site;
+  site.environment_part = result.environment_part;
+  site.dynamic_part = result.dynamic_part;
+  site.environment_triangle = result.environment_triangle;
+  if (result.object_triangle == Contact::kNoObjectTriangle) {
+    site.kind = AnswerSite::Kind::solid;
+    return site;
+  }
+  site.kind = result.separation == Separation::touching ? AnswerSite::Kind::surface
+                                                        : AnswerSite::Kind::near;
+  site.object_triangle = result.object_triangle;
+  if (has_closest_points(result)) {
+    site.on_environment = result.on_environment;
+    site.on_object = result.on_object;
+  }
+  return site;
+}
+
+AnswerSite impact_site(FlyingObject& object, const ImpactResult& result) {
+  if (result.impact != Impact::hit) return {};
+  if (!result.has_contact)
+    return containment_site(result.containment, result.containing_part,
+                            result.containing_dynamic_part);
+  Contact contact;
+  contact.environment_part = result.environment_part;
+  contact.environment_triangle = result.environment_triangle;
+  contact.object_triangle = result.object_triangle;
+  contact.dynamic_part = result.dynamic_part;
+  return contact_site(object, contact);
+}
+
+std::string site_fields(const AnswerSite& site, const CollisionIndex& index,
+                        const FlyingObject& object) {
+  std::string fields = kind_name(site.kind);
+  fields += ',';
+  if (site.kind == AnswerSite::Kind::none) return fields.append(14, ',');
+  fields += environment_fields(site, index, object);
+  fields += ',';
+  fields += site.environment_triangle ? std::to_string(*site.environment_triangle) : std::string();
+  fields += ',';
+  fields += object_part_fields(site, object.object());
+  fields += ',';
+  fields += site.object_triangle ? std::to_string(*site.object_triangle) : std::string();
+  fields += ',';
+  fields += point_fields(site.on_environment);
+  fields += ',';
+  fields += point_fields(site.on_object);
+  return fields;
+}
+
+}  // namespace tetrapage
