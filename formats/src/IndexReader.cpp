@@ -17,6 +17,7 @@
 #include <map>
 #include <mutex>
 #include <numeric>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -213,6 +214,10 @@ struct IndexReader::Impl {
   std::uint64_t file_bytes = 0;
   timespec modified{};  // when the file was last changed, as it was opened
   Descriptor descriptor;
+  // An index opened from bytes in memory (HDF5's core driver) has no descriptor: raw reads
+  // copy from this image instead.
+  std::vector<std::byte> image;
+  bool in_memory = false;
   FileHandle file;
   DatasetHandle shard_data;
   std::uint32_t chunk_bytes = 0;
@@ -254,6 +259,7 @@ struct IndexReader::Impl {
   /// file rewritten or truncated under a running reader, which a message should say rather
   /// than describe the bytes it now finds.
   bool file_changed(std::uint64_t& bytes_now) const {
+    if (in_memory) return false;
     struct stat status {};
     if (::fstat(descriptor.get(), &status) != 0) return false;
     bytes_now = static_cast<std::uint64_t>(status.st_size);
@@ -309,6 +315,25 @@ struct IndexReader::Impl {
 
     require_checksummed_superblock();
     file = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT));
+    inspect_opened_file();
+  }
+
+  void open_image(std::span<const std::byte> bytes) {
+    in_memory = true;
+    image.assign(bytes.begin(), bytes.end());
+    file_bytes = image.size();
+    require_checksummed_superblock();
+    PropertyListHandle access(H5Pcreate(H5P_FILE_ACCESS));
+    // The core driver reads the image HDF5 copies; nothing is written back (no backing store).
+    if (!access || H5Pset_fapl_core(access.get(), 1 << 16, 0) < 0 ||
+        H5Pset_file_image(access.get(), image.data(), image.size()) < 0)
+      hdf5_format_error("cannot set up an in-memory file");
+    file = FileHandle(H5Fopen(path.c_str(), H5F_ACC_RDONLY, access.get()));
+    inspect_opened_file();
+  }
+
+  // The user block and the sizes of addresses and lengths of the file HDF5 opened.
+  void inspect_opened_file() {
     if (!file) hdf5_format_error("HDF5 cannot open it (damaged or truncated)");
     PropertyListHandle creation(H5Fget_create_plist(file.get()));
     hsize_t user_block = 0;
@@ -331,7 +356,7 @@ struct IndexReader::Impl {
     // HDF5 looks for its signature at 0, 512, 1024, 2048, ... (after a user block).
     for (std::uint64_t offset = 0; offset + signature.size() < file_bytes; offset = offset == 0 ? 512 : 2 * offset) {
       std::array<unsigned char, 9> bytes{};
-      if (::pread(descriptor.get(), bytes.data(), bytes.size(), static_cast<off_t>(offset)) !=
+      if (read_at(reinterpret_cast<std::byte*>(bytes.data()), bytes.size(), offset) !=
           static_cast<ssize_t>(bytes.size()))
         break;
       if (!std::equal(signature.begin(), signature.end(), bytes.begin())) continue;
@@ -939,12 +964,50 @@ struct IndexReader::Impl {
     }
   }
 
+  /// The checks of every open after HDF5 opened the file: the header, the mesh's shapes, the
+  /// shard extents and layout, the tables.
+  void check_opened_index() {
+    {
+      GroupHandle root(H5Gopen2(file.get(), "/", H5P_DEFAULT));
+      if (!root) hdf5_format_error("cannot open the root group");
+      require_compact_storage(root.get());
+      read_header(root.get());
+    }
+    check_header_values();
+    check_mesh_shapes();
+    offsets = read_dataset<std::uint64_t>(schema::dataset::shard_offsets, 0, header.shard_count,
+                                          "root attribute 'shard_count'");
+    sizes = read_dataset<std::uint64_t>(schema::dataset::shard_sizes, 0, header.shard_count,
+                                        "root attribute 'shard_count'");
+    list_tables();
+    check_table_lengths();
+    check_header_counts();
+    shard_data = open_dataset(schema::dataset::shard_data);
+    check_shard_data_layout();
+    const auto problems = extent_problems();
+    if (!problems.empty())
+      format_error("inconsistent shard extents: " + problems.front() +
+                   (problems.size() > 1
+                        ? " (and " + std::to_string(problems.size() - 1) + " more problems)"
+                        : std::string()));
+    check_bounds_against_data();
+  }
+
   // ---- raw reads --------------------------------------------------------------------------
+
+  /// pread() of the file, or a copy from the in-memory image (0 past its end).
+  ssize_t read_at(std::byte* buffer, std::uint64_t bytes, std::uint64_t offset) const {
+    if (!in_memory) return ::pread(descriptor.get(), buffer, bytes, static_cast<off_t>(offset));
+    if (offset >= image.size()) return 0;
+    const std::uint64_t count = std::min<std::uint64_t>(bytes, image.size() - offset);
+    std::memcpy(buffer, image.data() + offset, count);
+    return static_cast<ssize_t>(count);
+  }
 
   void pread_all(std::byte* buffer, std::uint64_t bytes, std::uint64_t offset,
                  const std::string& what) const {
     while (bytes > 0) {
-      const ssize_t got = ::pread(descriptor.get(), buffer, bytes, static_cast<off_t>(offset));
+      const ssize_t got = read_at(buffer, bytes, offset);
       if (got < 0) {
         if (errno == EINTR) continue;
         throw IoError("cannot read " + what + " of " + where() + ": " + std::strerror(errno));
@@ -1088,35 +1151,17 @@ struct IndexReader::Impl {
 
 IndexReader::IndexReader(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
   detail::enter_hdf5();
-  Impl& r = *impl_;
-  r.path = path;
-  r.open_file();
-  {
-    GroupHandle root(H5Gopen2(r.file.get(), "/", H5P_DEFAULT));
-    if (!root) r.hdf5_format_error("cannot open the root group");
-    r.require_compact_storage(root.get());
-    r.read_header(root.get());
-  }
-  r.check_header_values();
-  r.check_mesh_shapes();
-  // Shards: extents and layout.
-  const IndexHeader& h = r.header;
-  r.offsets = r.read_dataset<std::uint64_t>(schema::dataset::shard_offsets, 0, h.shard_count,
-                                            "root attribute 'shard_count'");
-  r.sizes = r.read_dataset<std::uint64_t>(schema::dataset::shard_sizes, 0, h.shard_count,
-                                          "root attribute 'shard_count'");
-  r.list_tables();
-  r.check_table_lengths();
-  r.check_header_counts();
-  r.shard_data = r.open_dataset(schema::dataset::shard_data);
-  r.check_shard_data_layout();
-  const auto problems = r.extent_problems();
-  if (!problems.empty())
-    r.format_error("inconsistent shard extents: " + problems.front() +
-                   (problems.size() > 1
-                        ? " (and " + std::to_string(problems.size() - 1) + " more problems)"
-                        : std::string()));
-  r.check_bounds_against_data();
+  impl_->path = path;
+  impl_->open_file();
+  impl_->check_opened_index();
+}
+
+IndexReader::IndexReader(std::span<const std::byte> image, const std::string& name)
+    : impl_(std::make_unique<Impl>()) {
+  detail::enter_hdf5();
+  impl_->path = name;
+  impl_->open_image(image);
+  impl_->check_opened_index();
 }
 
 IndexReader::~IndexReader() = default;

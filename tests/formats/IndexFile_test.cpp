@@ -353,10 +353,11 @@ std::vector<std::byte> read_by_hdf5(const std::filesystem::path& path,
 /// first bytes: the empty one, one byte, a random length, and all but one byte.
 void expect_prefixes_decode(const detail::EncodedChunk& encoded, const std::vector<std::byte>& data,
                             Random& random) {
-  for (const std::size_t length : {std::size_t(0), std::size_t(1), std::size_t(random.below(data.size())),
-                                   data.size() - 1}) {
+  for (const std::size_t length :
+       {std::size_t(0), std::size_t(1), std::size_t(random.below(data.size())), data.size() - 1}) {
     std::vector<std::byte> prefix(length, std::byte{0x5a});
-    EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, prefix, data.size()), "") << length;
+    EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, prefix, data.size()), "")
+        << length;
     EXPECT_TRUE(std::equal(prefix.begin(), prefix.end(), data.begin())) << "prefix of " << length;
   }
   std::vector<std::byte> too_long(data.size() + 8);
@@ -365,7 +366,8 @@ void expect_prefixes_decode(const detail::EncodedChunk& encoded, const std::vect
 
 /// A chunk we encoded decodes back, whole and by prefixes; HDF5 with the plugin (an
 /// independent decoder) reads it as we wrote it; any single flipped byte is caught.
-void expect_chunk_reads_back(const detail::EncodedChunk& encoded, const std::vector<std::byte>& data,
+void expect_chunk_reads_back(const detail::EncodedChunk& encoded,
+                             const std::vector<std::byte>& data,
                              const std::filesystem::path& scratch_file, Random& random) {
   std::vector<std::byte> decoded(data.size());
   EXPECT_EQ(detail::decode_chunk(encoded.bytes, encoded.filter_mask, decoded), "");
@@ -443,7 +445,8 @@ TEST(IndexFile, UncompressedChunksAgreeWithHdf5Filters) {
       // The payload is stored as it is (no decompression), and the padding takes little room.
       EXPECT_NE((encoded.filter_mask & detail::kShuffleSkipped), 0u);
       // (LZ4 takes a byte per 255 zeros, and a few bytes a block.)
-      EXPECT_LE(encoded.bytes.size(), std::max<std::size_t>(payload, (size + 15) / 16) + size / 200 + 400);
+      EXPECT_LE(encoded.bytes.size(),
+                std::max<std::size_t>(payload, (size + 15) / 16) + size / 200 + 400);
       EXPECT_NE(std::search(encoded.bytes.begin(), encoded.bytes.end(), data.begin(),
                             data.begin() + std::ptrdiff_t(payload)),
                 encoded.bytes.end());
@@ -453,9 +456,12 @@ TEST(IndexFile, UncompressedChunksAgreeWithHdf5Filters) {
   detail::EncodedChunk encoded;
   std::vector<std::byte> data(64, std::byte{0});
   data[40] = std::byte{1};
-  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 32, encoded); }, {"byte 40", "not zero"});
-  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 0, encoded); }, {"0 payload bytes"});
-  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 65, encoded); }, {"65 payload bytes"});
+  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 32, encoded); },
+                           {"byte 40", "not zero"});
+  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 0, encoded); },
+                           {"0 payload bytes"});
+  expect_error<InputError>([&] { detail::encode_chunk_uncompressed(data, 65, encoded); },
+                           {"65 payload bytes"});
 }
 
 TEST(IndexFile, UncompressedIndexReadsBackThroughOurReaderAndHdf5) {
@@ -488,7 +494,8 @@ TEST(IndexFile, UncompressedIndexReadsBackThroughOurReaderAndHdf5) {
     const auto chunks = reader.shard_chunks(s);
     for (std::size_t k = 0; k < chunks.size(); ++k) {
       const auto begin = shards[s].begin() + std::ptrdiff_t(k * kChunk);
-      const auto end = shards[s].begin() + std::ptrdiff_t(std::min<std::size_t>((k + 1) * kChunk, shards[s].size()));
+      const auto end = shards[s].begin() +
+                       std::ptrdiff_t(std::min<std::size_t>((k + 1) * kChunk, shards[s].size()));
       const auto stored = file.begin() + std::ptrdiff_t(chunks[k].file_offset);
       EXPECT_NE(std::search(stored, stored + std::ptrdiff_t(chunks[k].stored_bytes), begin, end),
                 stored + std::ptrdiff_t(chunks[k].stored_bytes))
@@ -689,23 +696,28 @@ TEST(IndexFile, DenseStorageOfAttributesOrLinksIsRefused) {
   const auto folder = scratch_folder("dense");
   const WrittenIndex written = write_sample(folder, 3);
   const std::string original = test::read_file(written.path);
-  const auto change = [&](const std::function<void(hid_t file)>& edit) { edit_copy(written.path, original, edit); };
+  const auto change = [&](const std::function<void(hid_t file)>& edit) {
+    edit_copy(written.path, original, edit);
+  };
   change([](hid_t file) {
     const hid_t root = H5Gopen2(file, "/", H5P_DEFAULT);
     // More than the writer keeps compact: HDF5 moves them all to dense storage.
     const hid_t space = H5Screate(H5S_SCALAR);
     for (int i = 0; i < 300; ++i) {
       const std::string name = "extra" + std::to_string(i);
-      const hid_t attribute = H5Acreate2(root, name.c_str(), H5T_STD_U8LE, space, H5P_DEFAULT, H5P_DEFAULT);
+      const hid_t attribute =
+          H5Acreate2(root, name.c_str(), H5T_STD_U8LE, space, H5P_DEFAULT, H5P_DEFAULT);
       H5Aclose(attribute);
     }
     H5Sclose(space);
     H5Gclose(root);
   });
-  expect_error<FormatError>([&] { IndexReader reader(written.path); }, {"model.tpi", "dense storage", "rebuild"});
+  expect_error<FormatError>([&] { IndexReader reader(written.path); },
+                            {"model.tpi", "dense storage", "rebuild"});
   change([](hid_t file) {
     for (int i = 0; i < 5000; ++i)
-      H5Lcreate_soft("/shards/data", file, ("/tables/link" + std::to_string(i)).c_str(), H5P_DEFAULT, H5P_DEFAULT);
+      H5Lcreate_soft("/shards/data", file, ("/tables/link" + std::to_string(i)).c_str(),
+                     H5P_DEFAULT, H5P_DEFAULT);
   });
   expect_error<FormatError>([&] { IndexReader reader(written.path); },
                             {"model.tpi", "'/tables'", "dense storage", "rebuild"});
@@ -717,7 +729,9 @@ TEST(IndexFile, MissingOrMisshapedDatasetsAreRejected) {
   const auto folder = scratch_folder("datasets");
   const WrittenIndex written = write_sample(folder, 6);
   const std::string original = test::read_file(written.path);
-  const auto edit = [&](const std::function<void(hid_t file)>& change) { edit_copy(written.path, original, change); };
+  const auto edit = [&](const std::function<void(hid_t file)>& change) {
+    edit_copy(written.path, original, change);
+  };
   edit([](hid_t file) { H5Ldelete(file, "/shards/sizes", H5P_DEFAULT); });
   expect_error<FormatError>([&] { IndexReader reader(written.path); },
                             {"model.tpi", "'/shards/sizes' is missing"});
@@ -809,6 +823,48 @@ TEST(IndexFile, FlippedByteInShardDataIsCaught) {
   const auto problems = reader.validate();
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_NE(problems[0].find("shard 4, chunk 1 of 4"), std::string::npos) << problems[0];
+}
+
+// An index opened from its bytes in memory (HDF5's core driver) reads as the file does, and
+// damaged images fail as damaged files do: truncated ones at the open, a flipped byte of a
+// shard at its read.
+TEST(IndexFile, AnImageInMemoryReadsAsTheFile) {
+  const auto folder = scratch_folder("image");
+  const WrittenIndex written = write_sample(folder, 10);
+  const std::string whole = test::read_file(written.path);
+  const auto image = [](std::string_view bytes) {
+    return std::span<const std::byte>(reinterpret_cast<const std::byte*>(bytes.data()),
+                                      bytes.size());
+  };
+  {
+    const IndexReader reader(image(whole), "received.tpi");
+    EXPECT_EQ(reader.file_bytes(), whole.size());
+    EXPECT_EQ(reader.header().shard_count, written.shards.size());
+    const TetMesh mesh = reader.read_mesh();
+    EXPECT_EQ(mesh.vertices, written.mesh.vertices);
+    EXPECT_EQ(mesh.tets, written.mesh.tets);
+    EXPECT_EQ(reader.read_table_uint64("ids"), written.ids);
+    for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
+      EXPECT_EQ(reader.read_shard(s), written.shards[s]) << "shard " << s;
+      EXPECT_EQ(reader.read_shard_through_hdf5(s), written.shards[s]) << "shard " << s;
+    }
+    EXPECT_EQ(reader.validate(), std::vector<std::string>{});
+  }
+  for (std::size_t length :
+       {std::size_t{0}, std::size_t{100}, whole.size() / 2, whole.size() - 1}) {
+    SCOPED_TRACE("truncated to " + std::to_string(length));
+    expect_error<FormatError>(
+        [&] { IndexReader reader(image(std::string_view(whole).substr(0, length)), "cut.tpi"); },
+        {"cut.tpi"});
+  }
+  const IndexReader reader(written.path);
+  const auto chunks = reader.shard_chunks(4);
+  std::string damaged = whole;
+  damaged[chunks[1].file_offset + chunks[1].stored_bytes / 2] ^= 0x01;
+  const IndexReader opened(image(damaged), "damaged.tpi");
+  expect_error<FormatError>([&] { opened.read_shard(4); },
+                            {"damaged.tpi", "shard 4", "chunk 1 of 4"});
+  EXPECT_EQ(opened.read_shard(3), written.shards[3]);
 }
 
 }  // namespace

@@ -42,8 +42,8 @@ void add_chunks(hid_t file, const char* name, std::vector<Region>& regions) {
       unsigned mask = 0;
       haddr_t address = HADDR_UNDEF;
       hsize_t size = 0;
-      if (H5Dget_chunk_info(dataset, space, i, offset, &mask, &address, &size) >= 0 && address != HADDR_UNDEF &&
-          size > 4)
+      if (H5Dget_chunk_info(dataset, space, i, offset, &mask, &address, &size) >= 0 &&
+          address != HADDR_UNDEF && size > 4)
         regions.push_back({address, size});
     }
   H5Sclose(space);
@@ -61,8 +61,8 @@ Seed load_seed(const std::string& path) {
   seed.file.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (file < 0) std::abort();
-  for (const char* name : {"/mesh/vertices", "/mesh/tets", "/mesh/neighbours", "/shards/offsets", "/shards/sizes",
-                           "/shards/data"})
+  for (const char* name : {"/mesh/vertices", "/mesh/tets", "/mesh/neighbours", "/shards/offsets",
+                           "/shards/sizes", "/shards/data"})
     add_chunks(file, name, seed.regions);
   const hid_t tables = H5Gopen2(file, "/tables", H5P_DEFAULT);
   hsize_t index = 0;
@@ -88,7 +88,8 @@ std::string edited(const Seed& seed, const std::uint8_t* edits, std::size_t size
   std::string file = seed.file;
   std::vector<bool> touched(seed.regions.size(), false);
   for (std::size_t at = 0; at + 4 <= size && seed.data_bytes > 0; at += 4) {
-    std::uint64_t position = (edits[at] | edits[at + 1] << 8 | edits[at + 2] << 16) % seed.data_bytes;
+    std::uint64_t position =
+        (edits[at] | edits[at + 1] << 8 | edits[at + 2] << 16) % seed.data_bytes;
     for (std::size_t r = 0; r < seed.regions.size(); ++r) {
       if (position >= seed.regions[r].bytes) {
         position -= seed.regions[r].bytes;
@@ -104,7 +105,8 @@ std::string edited(const Seed& seed, const std::uint8_t* edits, std::size_t size
     const Region& region = seed.regions[r];
     const auto* bytes = reinterpret_cast<const std::byte*>(file.data() + region.offset);
     const std::uint32_t checksum = tetrapage::detail::fletcher32({bytes, region.bytes});
-    for (int i = 0; i < 4; ++i) file[region.offset + region.bytes + i] = static_cast<char>((checksum >> (8 * i)) & 0xff);
+    for (int i = 0; i < 4; ++i)
+      file[region.offset + region.bytes + i] = static_cast<char>((checksum >> (8 * i)) & 0xff);
   }
   return file;
 }
@@ -113,10 +115,9 @@ std::string edited(const Seed& seed, const std::uint8_t* edits, std::size_t size
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const std::vector<Seed> seeds = load_seeds();
-  static tetrapage::fuzz::TempFile file(".tpi");
   const Seed& seed = seeds[size == 0 ? 0 : data[0] % seeds.size()];
   const std::string bytes = size == 0 ? seed.file : edited(seed, data + 1, size - 1);
-  file.write(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size());
-  tetrapage::fuzz::read_whole_index(file.path());
+  tetrapage::fuzz::read_whole_index(reinterpret_cast<const std::uint8_t*>(bytes.data()),
+                                    bytes.size());
   return 0;
 }

@@ -7,7 +7,10 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <filesystem>
+#include <span>
+#include <string>
 #include <vector>
 
 #include "tetrapage/formats/Error.h"
@@ -46,9 +49,11 @@ inline void read_and_decode_shards(const IndexReader& reader, std::uint32_t shar
   }
 }
 
-inline void read_whole_index(const std::filesystem::path& path) {
+/// `open` makes the reader: from a file, or from bytes in memory (HDF5's core driver).
+template <class Open>
+inline void read_whole_index(Open open) {
   try {
-    const IndexReader reader(path);
+    const IndexReader reader = open();
     try {
       (void)reader.read_mesh();
     } catch (const Error&) {
@@ -68,6 +73,14 @@ inline void read_whole_index(const std::filesystem::path& path) {
     (void)reader.validate();
   } catch (const Error&) {
   }
+}
+
+/// The reader over an index held in memory: no file is written per input.
+inline void read_whole_index(const std::uint8_t* data, std::size_t size) {
+  read_whole_index([&] {
+    return IndexReader(std::span<const std::byte>(reinterpret_cast<const std::byte*>(data), size),
+                       "fuzz input");
+  });
 }
 
 }  // namespace tetrapage::fuzz

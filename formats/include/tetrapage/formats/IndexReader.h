@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,6 +39,11 @@ class IndexReader {
   ///        attribute), has another version, or any of the checks fails; the message names
   ///        the file, the object and the value found.
   explicit IndexReader(const std::filesystem::path& path);
+  /// Opens an index held in memory (HDF5's core driver on a copy of `image`), with the same
+  /// checks; `name` stands for the file in messages. For indexes received as bytes, and for
+  /// fuzzing the reader without a file system.
+  /// @throw FormatError as the constructor above.
+  IndexReader(std::span<const std::byte> image, const std::string& name);
   ~IndexReader();
   IndexReader(IndexReader&&) noexcept;
   IndexReader& operator=(IndexReader&&) noexcept;
@@ -104,7 +110,8 @@ class IndexReader {
   /// a caller checking the payloads too reads and decompresses the data once.
   /// @throw IoError if the operating system fails a read; what each_shard throws.
   std::vector<std::string> validate(
-      const std::function<void(std::uint32_t shard, std::span<const std::byte> payload)>& each_shard = {}) const;
+      const std::function<void(std::uint32_t shard, std::span<const std::byte> payload)>&
+          each_shard = {}) const;
 
  private:
   struct Impl;
