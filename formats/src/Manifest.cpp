@@ -4,6 +4,7 @@
 #include "tetrapage/formats/Manifest.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <span>
 #include <sstream>
@@ -449,49 +451,92 @@ ReadManifest read_manifest_file(const std::filesystem::path& path, ManifestReadi
   return {std::move(manifest), placements};
 }
 
-/// A mesh entry of an assembly with every place the assembly puts it.
-struct PlacedEntry {
-  const Manifest* owner = nullptr;     ///< the manifest naming the file
-  const ManifestPart* part = nullptr;  ///< its entry there
-  std::vector<Transform> placements;   ///< owner's unit -> the top manifest's unit
-  std::vector<std::string> paths;      ///< each placement's instance path
-};
-
-/// The mesh entry `entries` of `top` (InputPiece::entries), placed: from the top down, each
-/// level's instances compose with the placements above; a sub-assembly's unit scale is folded
-/// in after its instance. A top-level entry's instances are taken as they are.
-PlacedEntry place_entry(const Manifest& top, std::span<const std::size_t> entries) {
-  PlacedEntry placed{&top, nullptr, {identity_transform()}, {std::string()}};
-  for (std::size_t level = 0; level < entries.size(); ++level) {
-    if (placed.part != nullptr || entries[level] >= placed.owner->parts.size())
-      throw InputError(top.path.string() + ": an input piece names no mesh entry of the manifest");
-    const ManifestPart& part = placed.owner->parts[entries[level]];
-    PlacedEntry next{placed.owner, nullptr, {}, {}};
-    for (std::size_t p = 0; p < placed.placements.size(); ++p) {
-      for (std::size_t k = 0; k < part.instances.size(); ++k) {
-        Transform t =
-            level == 0 ? part.instances[k] : compose_transforms(placed.placements[p], part.instances[k]);
-        if (part.assembly) {
-          for (int row = 0; row < 3; ++row)
-            for (int column = 0; column < 3; ++column) t[4 * row + column] *= part.unit_scale;
-        }
-        const std::string label =
-            part.instances.size() == 1 ? part.name : part.name + "#" + std::to_string(k);
-        next.placements.push_back(t);
-        next.paths.push_back(level == 0 ? label : placed.paths[p] + "/" + label);
+/// A mesh entry of an assembly with every place the assembly puts it, computed one placement
+/// at a time: 10^6 placements held whole took 180 MB of transforms and paths.
+class PlacedEntry {
+ public:
+  /// The mesh entry `entries` of `top` (InputPiece::entries).
+  PlacedEntry(const Manifest& top, std::span<const std::size_t> entries) : owner_(&top) {
+    for (std::size_t level = 0; level < entries.size(); ++level) {
+      if (part_ != nullptr || entries[level] >= owner_->parts.size())
+        throw InputError(top.path.string() +
+                         ": an input piece names no mesh entry of the manifest");
+      const ManifestPart& part = owner_->parts[entries[level]];
+      levels_.push_back(&part);
+      count_ *= part.instances.size();
+      if (part.assembly) {
+        owner_ = part.assembly.get();
+      } else {
+        part_ = &part;
       }
     }
-    if (part.assembly) {
-      next.owner = part.assembly.get();
-    } else {
-      next.part = &part;
-    }
-    placed = std::move(next);
+    if (part_ == nullptr)
+      throw InputError(top.path.string() + ": an input piece names no mesh entry of the manifest");
+    prefix_.assign(levels_.size(), identity_transform());
+    digits_.assign(levels_.size(), kNoDigit);
   }
-  if (placed.part == nullptr)
-    throw InputError(top.path.string() + ": an input piece names no mesh entry of the manifest");
-  return placed;
-}
+
+  const Manifest& owner() const { return *owner_; }    ///< the manifest naming the file
+  const ManifestPart& part() const { return *part_; }  ///< its entry there
+  std::size_t count() const { return count_; }
+
+  /// Placement k (owner's unit -> the top manifest's unit), the outer sub-assembly's instance
+  /// varying slowest. From the top down, each level's instance composes with the placement
+  /// above; a sub-assembly's unit scale is folded in after its instance; a top-level entry's
+  /// instance is taken as it is. Levels whose instance did not change since the last call are
+  /// reused (the same operations, so the same bits).
+  const Transform& transform(std::size_t k) {
+    const std::vector<std::size_t> digits = digits_of(k);
+    bool changed = false;
+    for (std::size_t level = 0; level < levels_.size(); ++level) {
+      changed = changed || digits[level] != digits_[level];
+      if (!changed) continue;
+      const ManifestPart& part = *levels_[level];
+      Transform t = level == 0
+                        ? part.instances[digits[level]]
+                        : compose_transforms(prefix_[level - 1], part.instances[digits[level]]);
+      if (part.assembly) {
+        for (int row = 0; row < 3; ++row)
+          for (int column = 0; column < 3; ++column) t[4 * row + column] *= part.unit_scale;
+      }
+      prefix_[level] = t;
+      digits_[level] = digits[level];
+    }
+    return prefix_.back();
+  }
+
+  /// Placement k's instance path, "rack/board#3/U7".
+  std::string path(std::size_t k) const {
+    const std::vector<std::size_t> digits = digits_of(k);
+    std::string path;
+    for (std::size_t level = 0; level < levels_.size(); ++level) {
+      const ManifestPart& part = *levels_[level];
+      if (level > 0) path += '/';
+      path += part.name;
+      if (part.instances.size() != 1) path.append("#").append(std::to_string(digits[level]));
+    }
+    return path;
+  }
+
+ private:
+  static constexpr std::size_t kNoDigit = std::size_t(-1);
+  std::vector<std::size_t> digits_of(std::size_t k) const {
+    std::vector<std::size_t> digits(levels_.size());
+    for (std::size_t level = levels_.size(); level-- > 0;) {
+      const std::size_t n = levels_[level]->instances.size();
+      digits[level] = k % n;
+      k /= n;
+    }
+    return digits;
+  }
+
+  const Manifest* owner_;
+  const ManifestPart* part_ = nullptr;
+  std::vector<const ManifestPart*> levels_;
+  std::size_t count_ = 1;
+  std::vector<Transform> prefix_;    ///< the last placement's transform down to each level
+  std::vector<std::size_t> digits_;  ///< and its instance at each level
+};
 
 /// The mesh entries of `manifest`, depth first (InputPiece::entries each).
 void mesh_entries(const Manifest& manifest, std::vector<std::size_t>& prefix,
@@ -546,29 +591,30 @@ void check_placement_precision(const std::string& instance, const TriangleSoup& 
 
 /// Appends the parts of `source` placed by placement k of `placed`: one soup part per
 /// instance, or per node for a file of several parts.
-void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const PlacedEntry& placed,
-                      std::size_t k, double scale, ReadReport& report) {
-  const Transform& m = placed.placements[k];
-  const std::string& path = placed.paths[k];
-  const std::string where = placed.owner->path.string() + ": part '" + path + "'";
+void append_placement(TriangleSoup& assembly, const TriangleSoup& source, PlacedEntry& placed,
+                      std::size_t k, double scale, std::uint64_t& degenerate_dropped) {
+  const Transform& m = placed.transform(k);
+  const std::string path = placed.path(k);
+  const ManifestPart& part = placed.part();
+  const std::string owner = placed.owner().path.string();
+  const std::string where = owner + ": part '" + path + "'";
   if (assembly.vertices.size() + source.vertices.size() > std::numeric_limits<std::uint32_t>::max())
     throw InputError(where + ": the assembly has more vertices than a soup can index");
   const auto vertex_base = static_cast<std::uint32_t>(assembly.vertices.size());
   const auto part_base = static_cast<std::uint32_t>(assembly.part_count());
   if (source.part_count() == 1) {
-    assembly.add_part(placed.part->name, path == placed.part->name ? std::string() : path);
+    assembly.add_part(part.name, path == part.name ? std::string() : path);
   } else {
     // A file of several parts (glTF nodes, named "stem/node") keeps its node names.
-    const std::string stem = placed.part->file.stem().string() + "/";
+    const std::string stem = part.file.stem().string() + "/";
     const auto node = [&](const std::string& name) {
       return name.starts_with(stem) ? name.substr(stem.size()) : name;
     };
     for (std::size_t p = 0; p < source.part_count(); ++p)
       assembly.add_part(node(source.part_names[p]), path + "/" + node(source.part_path(p)));
   }
-  const std::string instance = placed.owner->path.string() + ": part '" + placed.part->name +
-                               "' (" + placed.part->file.filename().string() + "), instance '" +
-                               path + "'";
+  const std::string instance = owner + ": part '" + part.name + "' (" +
+                               part.file.filename().string() + "), instance '" + path + "'";
   for (const Vec3& v : source.vertices) {
     const Vec3 p = apply_transform(m, {v[0] * scale, v[1] * scale, v[2] * scale});
     for (int a = 0; a < 3; ++a)
@@ -586,7 +632,7 @@ void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const 
     // Rounding in the placement can flatten a sliver: drop it like the reader would.
     if (is_degenerate_triangle(assembly.vertices[p[0]], assembly.vertices[p[1]],
                                assembly.vertices[p[2]])) {
-      ++report.degenerate_dropped;
+      ++degenerate_dropped;
       continue;
     }
     assembly.triangles.push_back(p);
@@ -598,17 +644,12 @@ void append_placement(TriangleSoup& assembly, const TriangleSoup& source, const 
 /// tessellation's deflection is reported in the top manifest's unit.
 void load_entry(TriangleSoup& assembly, const Manifest& top, std::span<const std::size_t> entries,
                 std::vector<ReadReport>* reports, const TessellationOptions& tessellation) {
-  const PlacedEntry placed = place_entry(top, entries);
-  ReadReport report;
-  const TriangleSoup source = read_mesh(placed.part->file, &report, tessellation);
-  const double scale = part_unit_scale(*placed.part, placed.owner->units, report.length_unit);
-  double stretch = 0;
-  for (std::size_t k = 0; k < placed.placements.size(); ++k) {
-    append_placement(assembly, source, placed, k, scale, report);
-    stretch = std::max(stretch, largest_stretch(placed.placements[k]));
-  }
-  report.tessellation_deflection *= scale * stretch;
-  if (reports != nullptr) reports->push_back(std::move(report));
+  // Not owned: `top` outlives the loader.
+  const std::shared_ptr<const Manifest> manifest(std::shared_ptr<const Manifest>(), &top);
+  const PieceLoader loader(InputPiece{top.path, manifest, {entries.begin(), entries.end()}},
+                           tessellation);
+  loader.place(0, loader.copies(), assembly);
+  if (reports != nullptr) reports->push_back(loader.report());
 }
 
 }  // namespace
@@ -683,16 +724,86 @@ std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& i
   return pieces;
 }
 
+struct PieceLoader::Impl {
+  InputPiece piece;
+  ReadReport report;
+  TriangleSoup source;
+  double scale = 1;  ///< the file's unit -> its manifest's
+  std::size_t copies = 1;
+  std::atomic<std::uint64_t> dropped{0};  ///< by the placements
+  mutable std::mutex stretch_mutex;
+  double stretch = 0;  ///< the largest of the placements so far
+};
+
+PieceLoader::PieceLoader(const InputPiece& piece, const TessellationOptions& tessellation)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->piece = piece;
+  if (!piece.manifest) {
+    impl_->source = read_mesh(piece.input, &impl_->report, tessellation);
+    return;
+  }
+  const PlacedEntry placed(*piece.manifest, piece.entries);  // a bad entry before the read
+  impl_->copies = placed.count();
+  impl_->source = read_mesh(placed.part().file, &impl_->report, tessellation);
+  impl_->scale = part_unit_scale(placed.part(), placed.owner().units, impl_->report.length_unit);
+}
+
+PieceLoader::~PieceLoader() = default;
+PieceLoader::PieceLoader(PieceLoader&&) noexcept = default;
+PieceLoader& PieceLoader::operator=(PieceLoader&&) noexcept = default;
+
+std::size_t PieceLoader::copies() const {
+  return impl_->copies;
+}
+const TriangleSoup& PieceLoader::source() const {
+  return impl_->source;
+}
+bool PieceLoader::placed_as_read() const {
+  return !impl_->piece.manifest;
+}
+
+void PieceLoader::place(std::size_t first, std::size_t count, TriangleSoup& soup) const {
+  if (!impl_->piece.manifest) {
+    if (first == 0 && count == 1) soup.append(impl_->source);
+    return;
+  }
+  // A placement cache of its own: batches may be placed on several threads at once.
+  PlacedEntry placed(*impl_->piece.manifest, impl_->piece.entries);
+  std::uint64_t dropped = 0;
+  double stretch = 0;
+  for (std::size_t k = first; k < first + count && k < impl_->copies; ++k) {
+    append_placement(soup, impl_->source, placed, k, impl_->scale, dropped);
+    stretch = std::max(stretch, largest_stretch(placed.transform(k)));
+  }
+  impl_->dropped += dropped;
+  const std::lock_guard lock(impl_->stretch_mutex);
+  impl_->stretch = std::max(impl_->stretch, stretch);
+}
+
+TriangleSoup PieceLoader::take_source() {
+  return std::move(impl_->source);
+}
+
+ReadReport PieceLoader::report() const {
+  ReadReport report = impl_->report;
+  report.degenerate_dropped += impl_->dropped;
+  if (impl_->piece.manifest) {
+    const std::lock_guard lock(impl_->stretch_mutex);
+    report.tessellation_deflection *= impl_->scale * impl_->stretch;
+  }
+  return report;
+}
+
 TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports,
                               const TessellationOptions& tessellation) {
+  PieceLoader loader(piece, tessellation);
   TriangleSoup soup;
-  if (piece.manifest) {
-    load_entry(soup, *piece.manifest, piece.entries, reports, tessellation);
-    return soup;
+  if (loader.placed_as_read()) {
+    soup = loader.take_source();
+  } else {
+    loader.place(0, loader.copies(), soup);
   }
-  ReadReport report;
-  soup = read_mesh(piece.input, &report, tessellation);
-  if (reports != nullptr) reports->push_back(std::move(report));
+  if (reports != nullptr) reports->push_back(loader.report());
   return soup;
 }
 

@@ -1,5 +1,6 @@
 #include "Ingest.h"
 
+#include <sys/stat.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include "Interiors.h"
 #include "OrderedPipeline.h"
 #include "SpillPath.h"
+#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
@@ -19,19 +21,17 @@
 namespace tetrapage {
 namespace {
 
-// One input soup (a manifest's part, or a mesh file) with what can be computed off the
-// ingest's serial path: centroids, and its surfaces' connected components (its part_of then
-// holds each triangle's component, numbered within the soup).
+// One input piece as its producer left it: its file read, and either placed whole with its
+// surfaces' connected components (its part_of then holds each triangle's component, numbered
+// within the soup), or, when its copies do not fit a batch, the loader the in-order consumer
+// places them from, a batch at a time.
 struct LoadedSoup {
-  std::uint64_t degenerate_dropped = 0;
-  std::uint64_t files_read = 0;
+  std::unique_ptr<PieceLoader> loader;  // placed in batches; null when `soup` holds the piece
+  ReadReport report;                    // the file's (placed whole)
   std::string length_unit;  // of its coordinates: the manifest's, or what the reader said
   std::string file;         // what the unit came from, for messages
-  std::vector<std::string> skipped_parts;
-  double tessellation_deflection = 0;
   TriangleSoup soup;
   std::vector<std::uint64_t> part_triangles;
-  std::vector<Vec3> centroids;  // per triangle
   std::vector<SurfaceComponent> components;
 };
 
@@ -47,24 +47,8 @@ void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& pie
                    limit + " in magnitude: distances would overflow; scale the model");
 }
 
-LoadedSoup load_soup(const InputPiece& piece, const TessellationOptions& tessellation) {
-  LoadedSoup loaded;
-  std::vector<ReadReport> reports;
-  loaded.soup = load_input_piece(piece, &reports, tessellation);
-  for (const auto& report : reports) {
-    loaded.degenerate_dropped += report.degenerate_dropped;
-    ++loaded.files_read;
-    loaded.tessellation_deflection =
-        std::max(loaded.tessellation_deflection, report.tessellation_deflection);
-    for (const std::string& skipped : report.skipped_parts)
-      loaded.skipped_parts.push_back(report.path + ": " + skipped);
-  }
-  loaded.file = piece.input.string();
-  if (piece.manifest) {
-    loaded.length_unit = piece.manifest->units;
-  } else if (!reports.empty()) {
-    loaded.length_unit = reports.front().length_unit;
-  }
+// Per triangle: its parts counted, then part_of replaced by its component's number.
+void find_components(LoadedSoup& loaded, const InputPiece& piece) {
   TriangleSoup& soup = loaded.soup;
   loaded.part_triangles.assign(std::max<std::size_t>(soup.part_count(), 1), 0);
   for (const std::uint32_t part : soup.part_of) ++loaded.part_triangles[part];
@@ -72,30 +56,62 @@ LoadedSoup load_soup(const InputPiece& piece, const TessellationOptions& tessell
   SurfaceComponents found = find_surface_components(soup);
   soup.part_of = std::move(found.component_of);
   loaded.components = std::move(found.components);
-  loaded.centroids.resize(soup.triangle_count());
-  for (std::size_t t = 0; t < soup.triangle_count(); ++t)
-    loaded.centroids[t] = centroid(soup.corners(t));
+}
+
+// What one placed copy of `source` takes while its components are found: the soup (24 B a
+// vertex, 16 a triangle) and the component search's tables (about 40 B a vertex, 8 a
+// triangle; SurfaceComponents.cpp).
+std::uint64_t copy_working_bytes(const TriangleSoup& source) {
+  return 64 * std::uint64_t(source.vertices.size()) + 24 * std::uint64_t(source.triangles.size());
+}
+
+// The memory the ingest's pieces in flight share (an eighth of the budget), and each batch of
+// placed copies: a sixteenth, split between the batches placed at once.
+std::uint64_t batch_bytes(const PreprocessOptions& options, std::size_t threads) {
+  return std::max<std::uint64_t>(options.memory_bytes / 16 / (threads + 1), 1);
+}
+
+LoadedSoup load_soup(const InputPiece& piece, const PreprocessOptions& options,
+                     std::size_t threads) {
+  LoadedSoup loaded;
+  auto loader = std::make_unique<PieceLoader>(piece, options.tessellation);
+  loaded.file = piece.input.string();
+  loaded.length_unit = piece.manifest ? piece.manifest->units : loader->report().length_unit;
+  const std::uint64_t whole = copy_working_bytes(loader->source()) * loader->copies();
+  if (loader->copies() > 1 && whole > batch_bytes(options, threads)) {
+    loaded.loader = std::move(loader);
+    return loaded;
+  }
+  if (loader->placed_as_read()) {
+    loaded.soup = loader->take_source();
+  } else {
+    loader->place(0, loader->copies(), loaded.soup);
+  }
+  loaded.report = loader->report();
+  loader.reset();  // the file's soup is not held beside its placed copy
+  find_components(loaded, piece);
   return loaded;
 }
 
-// How many soups the ingest's pipeline may hold at once. One more than the threads left both
+// How many pieces the ingest's pipeline may hold at once. One more than the threads left both
 // threads idle whenever the in-order append waited for a slow file; four times the threads
-// took the 10M ingest from 0.91 to 0.72 s. Bounded so that the soups in flight, taken at 4
-// times their files' bytes, stay within an eighth of the budget. (A loaded soup holds double
-// vertices, indices and a double centroid a triangle: by arithmetic about 2.6 times a binary
-// PLY of float vertices, less for double ones; not measured for every reader.)
-std::size_t ingest_depth(const std::vector<InputPiece>& jobs, std::uint64_t memory_bytes,
+// took the 10M ingest from 0.91 to 0.72 s. Bounded so that the pieces in flight, taken at 4
+// times their files' bytes (a loaded soup holds double vertices and indices, and the component
+// search's tables; a piece placed in batches holds its file and a batch), stay within an
+// eighth of the budget: down to one piece at a time when one file alone exceeds it.
+std::size_t ingest_depth(const std::vector<InputPiece>& jobs, const PreprocessOptions& options,
                          std::size_t threads) {
   std::uint64_t largest = 0;
   for (const InputPiece& job : jobs) {
     std::error_code error;
     const std::uint64_t bytes = std::filesystem::file_size(job.file(), error);
-    if (!error) largest = std::max<std::uint64_t>(largest, bytes * job.copies());
+    if (error) continue;
+    const std::uint64_t copies = std::min<std::uint64_t>(job.copies(), 2);
+    largest = std::max<std::uint64_t>(largest, 4 * bytes * copies);
   }
-  const std::size_t fewest = threads + 1, most = 4 * threads;
-  if (largest == 0) return fewest;
-  return std::clamp<std::size_t>(std::size_t(memory_bytes / 8 / (4 * largest)), fewest,
-                                 std::max(fewest, most));
+  const std::size_t most = 4 * threads;
+  if (largest == 0) return threads + 1;
+  return std::clamp<std::size_t>(std::size_t(options.memory_bytes / 8 / largest), 1, most);
 }
 
 // The model's unit is the one its inputs state; inputs that state different units cannot be
@@ -124,14 +140,115 @@ void settle_length_unit(IngestedModel& model, const std::string& option) {
   }
 }
 
-// Appends a loaded soup's parts, components and triangles to the model; the soups are
-// spilled once they hold more than a quarter of the budget.
+// The bytes a part's and a component's entries take in the model's tables, which stay in
+// memory to the end (the index's part tables, the interiors' components).
+constexpr std::uint64_t kPartEntryBytes = 2 * sizeof(std::string) + sizeof(std::uint64_t);
+constexpr std::uint64_t kComponentEntryBytes = sizeof(SurfaceComponent);
+
+// The tables cannot spill: a model whose tables alone exceed the budget is refused (a tetras
+// file of 50,000 parts, 9.4 MiB of tables, is a model the 16 MiB budget works with).
+void check_table_bytes(std::uint64_t parts, std::uint64_t bytes, const PreprocessOptions& options) {
+  if (bytes <= options.memory_bytes) return;
+  std::string message = std::to_string(parts);
+  message.append(" parts need about ")
+      .append(format_byte_size(bytes))
+      .append(" of part and component tables, above --memory ")
+      .append(format_byte_size(options.memory_bytes))
+      .append(": raise --memory to ")
+      .append(format_byte_size(2 * bytes))
+      .append(" or more");
+  throw InputError(message);
+}
+
+// Up front, before any file is read: each placed copy is at least one part.
+void check_part_count(const std::vector<InputPiece>& jobs, const PreprocessOptions& options) {
+  std::uint64_t parts = 0;
+  for (const InputPiece& job : jobs) parts += job.copies();
+  check_table_bytes(parts, parts * kPartEntryBytes, options);
+}
+
+// The disk the spill and the index need for `triangles` triangles whose soups take
+// `soup_bytes`: the index's 32 B a triangle measured (24 counted), and, once the soups exceed
+// their share of the budget, the soups and at least one binned 88-byte record a triangle.
+struct DiskNeed {
+  std::uint64_t spill = 0, index = 0;
+};
+DiskNeed disk_need(double triangles, double soup_bytes, const PreprocessOptions& options) {
+  constexpr double kIndexBytes = 24, kRecordBytes = sizeof(TriangleRecord);
+  const bool spills = options.force_spill || soup_bytes > double(options.memory_bytes / 4);
+  const double spill = spills ? soup_bytes + kRecordBytes * triangles : 0;
+  const double cap = 1.8e19;  // within std::uint64_t
+  return {std::uint64_t(std::min(spill, cap)),
+          std::uint64_t(std::min(kIndexBytes * triangles, cap))};
+}
+
+// Refuses a model that the free disk cannot hold, as soon as what it places is known.
+void check_disk_room(const DiskRoom& room, double triangles, double soup_bytes,
+                     const PreprocessOptions& options) {
+  const DiskNeed need = disk_need(triangles, soup_bytes, options);
+  const auto refuse = [&](std::uint64_t bytes, const std::filesystem::path& folder,
+                          std::uint64_t free) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.2g", triangles);
+    std::string message = "the model places ";
+    message.append(count)
+        .append(" triangles, about ")
+        .append(format_byte_size(bytes))
+        .append(" of spill and index, but ")
+        .append(folder.string())
+        .append(" has ")
+        .append(format_byte_size(free))
+        .append(" free");
+    throw InputError(message);
+  };
+  if (room.same_device) {
+    if (need.spill + need.index > room.spill_free)
+      refuse(need.spill + need.index, room.spill_folder, room.spill_free);
+    return;
+  }
+  if (need.spill > room.spill_free) refuse(need.spill, room.spill_folder, room.spill_free);
+  if (need.index > room.output_free) refuse(need.index, room.output_folder, room.output_free);
+}
+
+// What the ingest accumulates besides the model: the sample's generator and the figures the
+// checks need.
+struct IngestState {
+  std::size_t sample_capacity = 0;
+  std::mt19937_64 random{0x7e7a9a9e};
+  std::uint64_t soup_bytes = 0;   // of every soup appended (held or spilled)
+  std::uint64_t table_bytes = 0;  // of the parts' and components' tables
+};
+
+// A file's report into the summary, and its unit into the model.
+void note_file(IngestedModel& model, const LoadedSoup& loaded, const ReadReport& report,
+               PreprocessSummary& summary) {
+  summary.degenerate_dropped += report.degenerate_dropped;
+  for (const std::string& skipped : report.skipped_parts)
+    summary.skipped_parts.push_back(report.path + ": " + skipped);
+  ++summary.files_read;
+  model.tessellation_deflection =
+      std::max(model.tessellation_deflection, report.tessellation_deflection);
+  note_length_unit(model, loaded);
+}
+
+// Counts a soup's triangles into the model and keeps its centroids in the reservoir sample
+// (of at most sample_capacity), one at a time: no array of a whole file's centroids.
+void sample_centroids(IngestedModel& model, const TriangleSoup& soup, IngestState& state) {
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t, ++model.triangle_count) {
+    if (model.sample.size() < state.sample_capacity) {
+      model.sample.push_back(centroid(soup.corners(t)));
+    } else {
+      const std::uint64_t slot =
+          std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(state.random);
+      if (slot < state.sample_capacity) model.sample[slot] = centroid(soup.corners(t));
+    }
+  }
+}
+
+// Appends a placed soup's parts, components and triangles to the model (its arrays taken);
+// the soups spill once they would hold more than a quarter of the budget.
 void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptions& options,
-                 const std::filesystem::path& spill_folder, PreprocessSummary& summary) {
-  summary.degenerate_dropped += loaded.degenerate_dropped;
-  summary.skipped_parts.insert(summary.skipped_parts.end(), loaded.skipped_parts.begin(),
-                               loaded.skipped_parts.end());
-  summary.files_read += loaded.files_read;
+                 const std::filesystem::path& spill_folder, IngestState& state) {
   const auto part_offset = std::uint32_t(model.part_names.size());
   for (std::size_t p = 0; p < loaded.soup.part_count(); ++p) {
     model.part_names.push_back(loaded.soup.part_names[p]);
@@ -141,11 +258,11 @@ void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptio
     model.part_names.push_back("part" + std::to_string(part_offset));
     model.part_paths.push_back(model.part_names.back());
   }
+  for (std::size_t p = part_offset; p < model.part_names.size(); ++p)
+    state.table_bytes +=
+        kPartEntryBytes + model.part_names[p].capacity() + model.part_paths[p].capacity();
   model.part_triangles.insert(model.part_triangles.end(), loaded.part_triangles.begin(),
                               loaded.part_triangles.end());
-  model.tessellation_deflection =
-      std::max(model.tessellation_deflection, loaded.tessellation_deflection);
-  note_length_unit(model, loaded);
   if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
     throw InputError("the inputs hold more than 2^32 - 2 connected components");
   const auto component_offset = std::uint32_t(model.components.size());
@@ -154,59 +271,123 @@ void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptio
     model.bounds.extend(c.bounds);
     model.components.push_back(c);
   }
-  model.soups.append(loaded.soup, component_offset);
+  state.table_bytes += kComponentEntryBytes * loaded.components.size();
+  check_table_bytes(model.part_names.size(), state.table_bytes, options);
+  sample_centroids(model, loaded.soup, state);
+  const std::uint64_t bytes = SoupSpill<TriangleRecord>::soup_bytes(loaded.soup);
+  state.soup_bytes += bytes;
   const std::uint64_t held_limit = options.memory_bytes / 4;
-  if (!model.soups.spilled() && (model.soups.held_bytes() > held_limit || options.force_spill))
+  if (!model.soups.spilled() &&
+      (model.soups.held_bytes() + bytes > held_limit || options.force_spill))
     model.soups.spill_to(spill_path(spill_folder, "triangles"));
+  model.soups.append(std::move(loaded.soup), component_offset);
+  loaded.soup = TriangleSoup();
 }
 
-// Counts a soup's triangles into the model and keeps its centroids in the reservoir sample
-// (of at most sample_capacity).
-void sample_centroids(IngestedModel& model, const std::vector<Vec3>& centroids,
-                      std::size_t sample_capacity, std::mt19937_64& random) {
-  for (std::size_t t = 0; t < centroids.size(); ++t, ++model.triangle_count) {
-    if (model.sample.size() < sample_capacity) {
-      model.sample.push_back(centroids[t]);
-    } else {
-      const std::uint64_t slot =
-          std::uniform_int_distribution<std::uint64_t>(0, model.triangle_count)(random);
-      if (slot < sample_capacity) model.sample[slot] = centroids[t];
-    }
+// Places a piece's copies a batch at a time, each batch within its share of the budget, on all
+// threads, appended in order: the same triangles, parts and components, in the same order, as
+// placing them all at once (components never span parts, and each copy is its own parts).
+void append_in_batches(IngestedModel& model, LoadedSoup& loaded, const InputPiece& piece,
+                       const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                       IngestState& state, std::size_t threads) {
+  const PieceLoader& loader = *loaded.loader;
+  const std::uint64_t per_copy = std::max<std::uint64_t>(copy_working_bytes(loader.source()), 1);
+  const std::size_t batch =
+      std::max<std::size_t>(std::size_t(batch_bytes(options, threads) / per_copy), 1);
+  const std::size_t copies = loader.copies();
+  produce_in_parallel_consume_in_order(
+      (copies + batch - 1) / batch, threads + 1,
+      [&](std::size_t b) {
+        auto placed = std::make_shared<LoadedSoup>();
+        loader.place(b * batch, std::min(batch, copies - b * batch), placed->soup);
+        find_components(*placed, piece);
+        return placed;
+      },
+      [&](const std::shared_ptr<LoadedSoup>& placed) {
+        append_soup(model, *placed, options, spill_folder, state);
+      });
+}
+
+// Appends one piece in input order: the disk it will take is checked first (its copies times
+// its file's triangles), then it is appended whole or in batches.
+void append_piece(IngestedModel& model, LoadedSoup& loaded, const InputPiece& piece,
+                  const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                  const DiskRoom& room, IngestState& state, PreprocessSummary& summary,
+                  std::size_t threads) {
+  if (loaded.loader) {
+    const TriangleSoup& source = loaded.loader->source();
+    const double copies = double(loaded.loader->copies());
+    check_disk_room(
+        room, double(model.triangle_count) + copies * double(source.triangle_count()),
+        double(state.soup_bytes) + copies * double(SoupSpill<TriangleRecord>::soup_bytes(source)),
+        options);
+    append_in_batches(model, loaded, piece, options, spill_folder, state, threads);
+    // After the batches: the report then counts the triangles every placement dropped, and the
+    // tessellation's deflection over every placement.
+    note_file(model, loaded, loaded.loader->report(), summary);
+    return;
   }
+  check_disk_room(room, double(model.triangle_count + loaded.soup.triangle_count()),
+                  double(state.soup_bytes + SoupSpill<TriangleRecord>::soup_bytes(loaded.soup)),
+                  options);
+  note_file(model, loaded, loaded.report, summary);
+  append_soup(model, loaded, options, spill_folder, state);
 }
 
 }  // namespace
 
+DiskRoom measure_disk_room(const std::filesystem::path& spill_folder,
+                           const std::filesystem::path& output, const PreprocessOptions& options) {
+  DiskRoom room;
+  room.spill_folder = spill_folder;
+  room.output_folder = std::filesystem::absolute(output).parent_path();
+  if (options.assumed_free_disk_bytes != 0) {
+    room.spill_free = room.output_free = options.assumed_free_disk_bytes;
+    return room;
+  }
+  std::error_code error;
+  const auto spill = std::filesystem::space(room.spill_folder, error);
+  if (!error) room.spill_free = spill.available;
+  const auto out = std::filesystem::space(room.output_folder, error);
+  if (!error) room.output_free = out.available;
+  struct stat a {
+  }, b{};
+  room.same_device = ::stat(room.spill_folder.c_str(), &a) != 0 ||
+                     ::stat(room.output_folder.c_str(), &b) != 0 || a.st_dev == b.st_dev;
+  return room;
+}
+
 IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
                      const PreprocessOptions& options, const std::filesystem::path& spill_folder,
-                     PreprocessSummary& summary) {
+                     const DiskRoom& room, PreprocessSummary& summary) {
   IngestedModel model;
+  IngestState state;
   // At most 2M centroids, at least 2^16: a site stands for the mean of hundreds of sampled
   // centroids at the default region size. A cap of 4M gave the 10M scene the same regions
   // (26,081 against 26,071), duplication (1.2623 against 1.2630) and flights in memory (six
   // objects, four runs each, within their noise) at twice the coarse mesh's time; 1M began to
   // show in the flights (the tetrahedron's 7 % slower; docs/BENCHMARKS.md).
-  const std::size_t sample_capacity = std::size_t(
+  state.sample_capacity = std::size_t(
       std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 21));
-  model.sample.reserve(std::min<std::size_t>(sample_capacity, 1 << 16));
-  std::mt19937_64 random(0x7e7a9a9e);
+  model.sample.reserve(std::min<std::size_t>(state.sample_capacity, 1 << 16));
 
   // One part file at a time per thread: the ingest never holds the assembly.
   const std::vector<InputPiece> jobs = input_pieces(inputs);
-  // Parsing, edge parity, bounds and centroids run on all threads, a few soups at once; the
+  check_part_count(jobs, options);
+  // Parsing, placement, edge parity and bounds run on all threads, a few pieces at once; the
   // soups are appended in input order on one.
   Progress progress("reading parts", jobs.size(), options.progress, options.on_progress);
-  const std::size_t in_flight = ingest_depth(jobs, options.memory_bytes,
-                                             std::size_t(tbb::this_task_arena::max_concurrency()));
+  const auto threads = std::size_t(tbb::this_task_arena::max_concurrency());
+  std::size_t next_job = 0;
   produce_in_parallel_consume_in_order(
-      jobs.size(), in_flight,
+      jobs.size(), ingest_depth(jobs, options, threads),
       [&](std::size_t j) {
-        return std::make_shared<LoadedSoup>(load_soup(jobs[j], options.tessellation));
+        return std::make_shared<LoadedSoup>(load_soup(jobs[j], options, threads));
       },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         // In input order (ids, part numbers and the sample do not depend on the threads).
-        append_soup(model, *loaded, options, spill_folder, summary);
-        sample_centroids(model, loaded->centroids, sample_capacity, random);
+        append_piece(model, *loaded, jobs[next_job++], options, spill_folder, room, state, summary,
+                     threads);
         progress.advance();
       });
   progress.finish();

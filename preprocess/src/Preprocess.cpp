@@ -35,6 +35,8 @@ class StageClock {
  public:
   StageClock(PreprocessSummary& summary, std::string name)
       : summary_(summary), name_(std::move(name)) {
+    // The peak so far is kept before the reset: the whole run's peak spans the stages.
+    summary_.peak_resident_bytes = std::max(summary_.peak_resident_bytes, peak_resident_bytes());
     reset_peak_resident();
     start_ = Clock::now();
   }
@@ -117,6 +119,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   summary.memory_budget_bytes = options.memory_bytes;
   summary.stale_temporaries_removed = stale;
   summary.resident_at_start_bytes = resident_bytes();
+  reset_peak_resident();  // the run's peak, not the caller's before it
   summary.precision = std::string(to_string(options.precision));
   summary.compression = std::string(to_string(options.compression));
   const std::filesystem::path spill_folder = !options.spill_folder.empty()
@@ -127,8 +130,9 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   IndexWriter writer(output, {.compression = options.compression});
 
   // The stages of docs/ARCHITECTURE.md, in order.
-  IngestedModel model =
-      run_stage(summary, "ingest", [&] { return ingest(inputs, options, spill_folder, summary); });
+  const DiskRoom room = measure_disk_room(spill_folder, output, options);
+  IngestedModel model = run_stage(
+      summary, "ingest", [&] { return ingest(inputs, options, spill_folder, room, summary); });
   const ModelCoarseMesh coarse = run_stage(
       summary, "coarse mesh", [&] { return build_model_coarse_mesh(model, options, summary); });
   const TetMesh& mesh = coarse.mesh;
@@ -158,7 +162,7 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   });
 
   summary.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  summary.peak_resident_bytes = 0;
+  summary.peak_resident_bytes = std::max(summary.peak_resident_bytes, peak_resident_bytes());
   for (const auto& stage : summary.stages)
     summary.peak_resident_bytes = std::max(summary.peak_resident_bytes, stage.peak_resident_bytes);
   return summary;
@@ -213,6 +217,10 @@ std::string PreprocessSummary::to_json() const {
   j["resident_at_start_bytes"] = resident_at_start_bytes;
   j["budget_exceeded_bytes"] =
       peak_resident_bytes > memory_budget_bytes ? peak_resident_bytes - memory_budget_bytes : 0;
+  j["input_allowance_bytes"] = kPreprocessInputAllowance;
+  j["promised_peak_bytes"] = promised_peak_bytes();
+  j["promise_exceeded_bytes"] =
+      peak_resident_bytes > promised_peak_bytes() ? peak_resident_bytes - promised_peak_bytes() : 0;
   auto& stage_list = j["stages"] = nlohmann::ordered_json::array();
   for (const auto& stage : stages)
     stage_list.push_back({{"name", stage.name},
@@ -269,16 +277,22 @@ std::string PreprocessSummary::to_text() const {
                 format_byte_size(peak_resident_bytes).c_str(),
                 format_byte_size(memory_budget_bytes).c_str(), spilled ? " (spilled to disk)" : "");
   text << line;
-  if (peak_resident_bytes > memory_budget_bytes) {
-    // --memory bounds the stages' data; the process itself and the file being read come on top.
-    std::snprintf(
-        line, sizeof line,
-        "budget exceeded by %s: the process held %s before any work (libraries, threads), and "
-        "each input file's soup is held whole while it is read\n",
-        format_byte_size(peak_resident_bytes - memory_budget_bytes).c_str(),
-        format_byte_size(resident_at_start_bytes).c_str());
-    text << line;
-  }
+  // --memory bounds the stages' data; the process itself and the files being read come on top.
+  const bool kept = peak_resident_bytes <= promised_peak_bytes();
+  if (peak_resident_bytes > memory_budget_bytes)
+    text << "budget exceeded by " << format_byte_size(peak_resident_bytes - memory_budget_bytes)
+         << ": ";
+  std::snprintf(line, sizeof line,
+                "the process held %s before any work (libraries, threads); --memory + that + %s "
+                "for the files being read = %s: %s",
+                format_byte_size(resident_at_start_bytes).c_str(),
+                format_byte_size(kPreprocessInputAllowance).c_str(),
+                format_byte_size(promised_peak_bytes()).c_str(), kept ? "kept" : "exceeded by ");
+  text << line;
+  if (!kept)
+    text << format_byte_size(peak_resident_bytes - promised_peak_bytes())
+         << " (a file whose own soup is larger is held whole while it is read)";
+  text << "\n";
   return text.str();
 }
 

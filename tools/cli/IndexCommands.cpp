@@ -443,9 +443,10 @@ void add_index_commands(CLI::App& app) {
   add_memory_option(
       command, pre->memory,
       "Working-memory budget of the stages' data, at least 16M: larger models spill to disk\n"
-      "next to the output. It bounds what the stages hold; the process itself (about 22 MiB)\n"
-      "and each input file's soup while it is read come on top, and the summary says by how\n"
-      "much the peak exceeded the budget",
+      "next to the output. Peak RSS stays within it + what the process held before any work\n"
+      "(libraries, about 48 MiB) + 64 MiB for the files being read (a file placed many times\n"
+      "is placed in batches; one file's own soup is held whole while it is read); the summary\n"
+      "states the three and the peak",
       kLeastPreprocessMemory);
   command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")
       ->capture_default_str()

@@ -136,6 +136,38 @@ std::vector<InputPiece> input_pieces(const std::vector<std::filesystem::path>& i
 TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports = nullptr,
                               const TessellationOptions& tessellation = {});
 
+/// One piece's file read once, its placements appended on demand, a batch at a time: a file
+/// placed 10^6 times is read once and never held placed whole. Placing every copy in order
+/// gives load_input_piece's soup, triangle for triangle.
+class PieceLoader {
+ public:
+  /// Reads the piece's file. @throw as read_mesh; InputError for a file's unknown unit.
+  explicit PieceLoader(const InputPiece& piece, const TessellationOptions& tessellation = {});
+  ~PieceLoader();
+  PieceLoader(PieceLoader&&) noexcept;
+  PieceLoader& operator=(PieceLoader&&) noexcept;
+
+  /// How many times the file is placed (InputPiece::copies()).
+  std::size_t copies() const;
+  /// The file as read (its unit, no placement).
+  const TriangleSoup& source() const;
+  /// True for a mesh file given on its own: its only copy is source() as it is.
+  bool placed_as_read() const;
+  /// Appends copies [first, first + count) to `soup` (one soup part per copy, or per node), as
+  /// load_assembly places them. Safe to call from several threads on different soups.
+  /// @throw InputError as load_assembly (overflow, precision, too many vertices).
+  void place(std::size_t first, std::size_t count, TriangleSoup& soup) const;
+  /// Moves source() out (the loader then places nothing).
+  TriangleSoup take_source();
+  /// The file's report: the reader's, plus the triangles the placements so far dropped and,
+  /// for a tessellated file, its deflection in the top manifest's unit over those placements.
+  ReadReport report() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Loads inputs that are mesh files or manifests (.json), in order, into one soup (parts
 /// appended in order, indices shifted).
 /// @throw as read_mesh, read_manifest and load_assembly.

@@ -37,6 +37,12 @@ std::size_t auto_region_triangles(std::uint64_t triangles);
 /// The least working memory the pipeline works in (PreprocessOptions::memory_bytes).
 inline constexpr std::uint64_t kLeastPreprocessMemory = std::uint64_t(16) << 20;
 
+/// What the preprocess's peak resident memory may exceed --memory and the process's own
+/// resident memory before any work by: the files being read (a file is held once, its placed
+/// copies in batches within the budget) and the allocator's slack. Measured: a 1M-triangle PLY
+/// at --memory 16M peaked 60 MiB above the two (docs/USAGE.md, "Memory").
+inline constexpr std::uint64_t kPreprocessInputAllowance = std::uint64_t(64) << 20;
+
 struct PreprocessOptions {
   /// Target triangles per region (the leaf size of the adaptive split of centroids); 0: auto,
   /// auto_region_triangles(triangles read).
@@ -68,6 +74,9 @@ struct PreprocessOptions {
   TessellationOptions tessellation;
   /// Where spill files go; empty: next to the output.
   std::filesystem::path spill_folder;
+  /// The free bytes assumed of the spill's and the output's folders; 0: what the filesystem says.
+  /// Tests set it to see a model too big for the disk refused (a full disk cannot be made there).
+  std::uint64_t assumed_free_disk_bytes = 0;
   /// Spill the ingested triangles and the binned copies to disk whatever the budget (tests
   /// compare such a run with one that holds them in memory).
   bool force_spill = false;
@@ -129,12 +138,17 @@ struct PreprocessSummary {
   bool spilled = false;                    ///< whether the stages used spill files
   /// OUTPUT.tmp-PID files of processes that no longer exist (killed runs), removed at the start.
   std::uint64_t stale_temporaries_removed = 0;
-  std::uint64_t peak_resident_bytes = 0;   ///< the whole run
+  std::uint64_t peak_resident_bytes = 0;   ///< the whole run (VmHWM, kept across stages)
   /// The process's resident bytes when the run started (libraries, the caller's data): the
   /// budget bounds what the stages hold on top of this and of the input file being read.
   std::uint64_t resident_at_start_bytes = 0;
   double seconds = 0;
   std::vector<StageFigures> stages;
+
+  /// The peak the run promises: --memory + resident_at_start_bytes + kPreprocessInputAllowance.
+  std::uint64_t promised_peak_bytes() const {
+    return memory_budget_bytes + resident_at_start_bytes + kPreprocessInputAllowance;
+  }
 
   /// The summary as JSON text (the --report file).
   std::string to_json() const;

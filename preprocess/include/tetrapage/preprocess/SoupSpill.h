@@ -52,6 +52,31 @@ class SoupSpill {
     pieces_.push_back(std::move(piece));
   }
 
+  /// Appends a soup's triangles as append() does, taking its arrays rather than copying them:
+  /// a file's soup is never held twice, and a spilling model writes it out and frees it.
+  void append(TriangleSoup&& soup, std::uint32_t part_offset) {
+    if (soup.triangle_count() == 0) return;
+    Piece piece;
+    piece.first_id = count_;
+    piece.part_offset = part_offset;
+    piece.vertices = std::move(soup.vertices);
+    piece.triangles = std::move(soup.triangles);
+    piece.part_of = std::move(soup.part_of);
+    count_ += piece.triangles.size();
+    if (file_) {
+      write(piece);
+      return;
+    }
+    held_bytes_ += piece.bytes();
+    pieces_.push_back(std::move(piece));
+  }
+
+  /// The bytes a soup takes once appended.
+  static std::uint64_t soup_bytes(const TriangleSoup& soup) {
+    return soup.vertices.size() * sizeof(Vec3) + soup.triangles.size() * sizeof(TriangleIndices) +
+           soup.part_of.size() * sizeof(std::uint32_t);
+  }
+
   /// The soups held in memory (none once spilled()), one piece per append, in input order:
   /// piece p holds piece_size(p) records of consecutive ids.
   std::size_t piece_count() const { return pieces_.size(); }

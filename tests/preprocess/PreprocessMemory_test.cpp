@@ -1,0 +1,216 @@
+// --memory is a cap: a file placed thousands of times and one large file each stay within the
+// budget + the process's own memory before any work + kPreprocessInputAllowance, measured in
+// a child process; a model whose tables or placed triangles cannot fit is refused up front
+// with the figure; and placing copies in batches stores the same triangles, ids and parts.
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/tools/IndexAudit.h"
+#include "tetrapage/tools/TerrainGenerator.h"
+#include "tetrapage/tools/TetrasGenerator.h"
+
+namespace tetrapage {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path test_folder(const std::string& name) {
+  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "preprocess-memory" / name;
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+// A part of `triangles` random tetrahedra's faces (a component each).
+fs::path make_tetras_part(const fs::path& folder, std::uint64_t triangles) {
+  const fs::path path = folder / "tetras.ply";
+  TetrasOptions options;
+  options.triangles = triangles;
+  MeshWriter writer(path);
+  generate_tetras(options, writer);
+  writer.commit();
+  return path;
+}
+
+// A terrain of about `triangles` (one component).
+fs::path make_terrain(const fs::path& path, std::uint64_t triangles) {
+  TerrainOptions options;
+  options.triangles = triangles;
+  MeshWriter writer(path);
+  generate_terrain(options, writer);
+  writer.commit();
+  return path;
+}
+
+// A manifest placing `file` `outer` x `inner` times (a sub-assembly of `inner` copies, placed
+// `outer` times), each copy in its own unit cube.
+fs::path make_manifest(const fs::path& folder, const fs::path& file, std::size_t outer,
+                       std::size_t inner) {
+  nlohmann::json copies = nlohmann::json::array(), blocks = nlohmann::json::array();
+  for (std::size_t i = 0; i < inner; ++i)
+    copies.push_back({{"translation", {double(i % 100), double(i / 100), 0.0}}});
+  for (std::size_t i = 0; i < outer; ++i)
+    blocks.push_back({{"translation", {0.0, 0.0, double(i)}}});
+  std::ofstream(folder / "block.json")
+      << nlohmann::json{{"parts", {{{"file", file.filename().string()}, {"instances", copies}}}}};
+  const fs::path path = folder / "model.json";
+  std::ofstream(path) << nlohmann::json{
+      {"parts", {{{"name", "block"}, {"manifest", "block.json"}, {"instances", blocks}}}}};
+  return path;
+}
+
+struct ChildRun {
+  int status = -1;
+  std::uint64_t max_rss_bytes = 0;  // the child's ru_maxrss
+  nlohmann::json report;
+};
+
+// Runs `tetrapage preprocess INPUT -o OUTPUT --memory MEMORY --report` in a child process. Its
+// ru_maxrss covers only the run's last stretch (the stages reset VmHWM through clear_refs,
+// which the kernel's ru_maxrss follows), so the report's peak, VmHWM kept across the resets
+// from the start of the run, is the figure checked; ru_maxrss is checked too.
+ChildRun run_preprocess(const fs::path& input, const fs::path& output, const char* memory) {
+  const fs::path report = output.string() + ".json";
+  const pid_t child = fork();
+  if (child == 0) {
+    const int null = ::open("/dev/null", O_WRONLY);
+    ::dup2(null, 1);
+    ::dup2(null, 2);
+    ::execl(TETRAPAGE_CLI, "tetrapage", "preprocess", input.c_str(), "-o", output.c_str(),
+            "--memory", memory, "--report", report.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  ChildRun run;
+  rusage usage{};
+  ::wait4(child, &run.status, 0, &usage);
+  run.max_rss_bytes = std::uint64_t(usage.ru_maxrss) * 1024;
+  std::ifstream in(report);
+  if (in) run.report = nlohmann::json::parse(in);
+  return run;
+}
+
+void expect_within_promise(const ChildRun& run, std::uint64_t memory) {
+  ASSERT_EQ(run.status, 0);
+  const auto peak = run.report.at("peak_rss_bytes").get<std::uint64_t>();
+  const auto start = run.report.at("resident_at_start_bytes").get<std::uint64_t>();
+  const std::uint64_t promise = memory + start + kPreprocessInputAllowance;
+  EXPECT_EQ(run.report.at("promised_peak_bytes").get<std::uint64_t>(), promise);
+  EXPECT_LE(peak, promise) << run.report.dump(2);
+  EXPECT_LE(run.max_rss_bytes, promise);
+  EXPECT_GE(peak, run.max_rss_bytes);
+}
+
+// On 25b82ee the 2,000 copies were placed into one soup: the ingest peaked far above.
+TEST(PreprocessMemory, AFilePlacedThousandsOfTimesStaysWithinTheBudget) {
+  const fs::path folder = test_folder("instances");
+  const fs::path manifest = make_manifest(folder, make_terrain(folder / "part.ply", 1000), 20, 100);
+  const ChildRun run = run_preprocess(manifest, folder / "model.tpi", "16M");
+  expect_within_promise(run, std::uint64_t(16) << 20);
+  EXPECT_EQ(run.report.at("triangles_read").get<std::uint64_t>(),
+            2000 * read_mesh(folder / "part.ply").triangle_count());
+  EXPECT_EQ(run.report.at("parts").get<std::uint64_t>(), 2000u);
+}
+
+// On 25b82ee a 1M-triangle PLY peaked at 137 MiB under 16M (its soup, a second copy while
+// appended, and a centroid a triangle): above 16M + 48 + 64 MiB.
+TEST(PreprocessMemory, AMillionTrianglePlyStaysWithinTheBudget) {
+  const fs::path folder = test_folder("terrain");
+  const fs::path input = make_terrain(folder / "terrain.ply", 1'000'000);
+  const ChildRun run = run_preprocess(input, folder / "terrain.tpi", "16M");
+  expect_within_promise(run, std::uint64_t(16) << 20);
+}
+
+// 10^6 parts' tables alone exceed a quarter of 16M: refused before any file is read.
+TEST(PreprocessMemory, TablesBeyondTheBudgetAreRefusedUpFront) {
+  const fs::path folder = test_folder("tables");
+  const fs::path manifest = make_manifest(folder, make_tetras_part(folder, 4), 1000, 1000);
+  PreprocessOptions options;
+  options.memory_bytes = std::uint64_t(16) << 20;
+  try {
+    preprocess({manifest}, folder / "model.tpi", options);
+    ADD_FAILURE() << "not refused";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("1000000 parts need about 68.7 MiB"), std::string::npos) << message;
+    EXPECT_NE(message.find("--memory 16.0 MiB"), std::string::npos) << message;
+  }
+  EXPECT_FALSE(fs::exists(folder / "model.tpi"));
+}
+
+// A full disk cannot be made here: the free space is injected (assumed_free_disk_bytes). 2,000
+// copies of 968 triangles need about 200 MiB of spill and index under 16M; with 64 MiB free
+// the run is refused once the part's file is read, before any copy is placed.
+TEST(PreprocessMemory, AModelTheDiskCannotHoldIsRefusedWithTheFigure) {
+  const fs::path folder = test_folder("disk");
+  const fs::path manifest = make_manifest(folder, make_terrain(folder / "part.ply", 1000), 20, 100);
+  PreprocessOptions options;
+  options.memory_bytes = std::uint64_t(16) << 20;
+  options.assumed_free_disk_bytes = std::uint64_t(64) << 20;
+  try {
+    preprocess({manifest}, folder / "model.tpi", options);
+    ADD_FAILURE() << "not refused";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("the model places 1.9e+06 triangles, about "), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("has 64.0 MiB free"), std::string::npos) << message;
+  }
+  for (const auto& entry : fs::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename().string().find("spill"), std::string::npos) << entry.path();
+  EXPECT_FALSE(fs::exists(folder / "model.tpi"));
+  // With the room it needs, the same model is written.
+  options.assumed_free_disk_bytes = std::uint64_t(1) << 30;
+  options.memory_bytes = std::uint64_t(64) << 20;
+  EXPECT_NO_THROW(preprocess({manifest}, folder / "model.tpi", options));
+}
+
+// Copies placed in batches (16M: about 10 copies a batch) store the triangles of the soup placed
+// whole (load_inputs), with the same ids and parts: every tet checked against brute force.
+TEST(PreprocessMemory, BatchedCopiesStoreTheSameTrianglesIdsAndParts) {
+  const fs::path folder = test_folder("batches");
+  const fs::path manifest = make_manifest(folder, make_tetras_part(folder, 400), 2, 100);
+  PreprocessOptions options;
+  options.memory_bytes = std::uint64_t(16) << 20;
+  options.force_spill = true;
+  const fs::path output = folder / "model.tpi";
+  const PreprocessSummary summary = preprocess({manifest}, output, options);
+  const TriangleSoup whole = load_inputs({manifest});
+  EXPECT_EQ(summary.triangles_read, whole.triangle_count());
+  EXPECT_EQ(summary.parts, whole.part_count());
+  const IndexReader index(output);
+  const TetMesh mesh = index.read_mesh();
+  std::vector<std::uint32_t> tets(mesh.tet_count());
+  for (std::uint32_t t = 0; t < tets.size(); ++t) tets[t] = t;
+  AuditFindings findings;
+  audit_binning(index, input_pieces({manifest}), tets, findings);
+  EXPECT_EQ(findings.mismatches, 0u);
+  const auto component_part = index.read_table_uint32("component_part");
+  for (std::uint32_t s = 0; s < index.shard_count(); ++s) {
+    const Shard shard = Shard::decode(index.read_shard(s));
+    for (std::uint32_t local = 0; local < shard.triangle_count(); ++local) {
+      const std::uint64_t id = shard.triangle_id(local);
+      ASSERT_LT(id, whole.triangle_count());
+      EXPECT_EQ(component_part.at(shard.component_id(local)), whole.part_of[id]);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tetrapage
