@@ -37,11 +37,14 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
                       std::to_string(bounds.size()) + " values for " + std::to_string(shards) +
                       " shards (6 each)");
   shard_bounds_.resize(shards);
-  for (std::uint32_t s = 0; s < shards; ++s)
+  for (std::uint32_t s = 0; s < shards; ++s) {
+    geometry::Box stored;
     for (int a = 0; a < 3; ++a) {
-      shard_bounds_[s].lo[a] = bounds[6 * s + a];
-      shard_bounds_[s].hi[a] = bounds[6 * s + 3 + a];
+      stored.lo[a] = bounds[6 * s + a];
+      stored.hi[a] = bounds[6 * s + 3 + a];
     }
+    shard_bounds_[s] = geometry::FloatBox::enclosing(stored);
+  }
   shard_bytes_.resize(shards);
   for (std::uint32_t s = 0; s < shards; ++s) {
     // The decoded shard holds its payload's arrays plus the object itself: announce an upper

@@ -154,7 +154,36 @@ class QueryStep {
   std::uint64_t iterations_ = 0;
 };
 
+// What a flight holds beside its shards, from three readings of the resident set: before any
+// work (libraries, threads), once the index and the object are open (the coarse mesh and its
+// tables, the object's BVH and grid), and the peak.
+struct ResidentBesideShards {
+  std::uint64_t at_start = resident_bytes();
+  std::uint64_t opened = 0;
+  std::uint64_t promised(std::uint64_t budget) const { return budget + at_start + kRuntimeOverheadAllowance; }
+  // One line: the peak, what it is made of, and whether the promise held.
+  std::string statement(std::uint64_t peak, std::uint64_t shards, std::uint64_t budget) const {
+    const std::uint64_t tables = opened > at_start ? opened - at_start : 0;
+    const std::uint64_t counted = at_start + tables + shards;
+    std::string text = "memory: peak RSS " + format_byte_size(peak) + " = before any work (libraries, threads) " +
+                       format_byte_size(at_start) + " + index tables and object " + format_byte_size(tables) +
+                       " + shards " + format_byte_size(shards) + " + the rest " +
+                       format_byte_size(peak > counted ? peak - counted : 0) + "; --memory + " +
+                       format_byte_size(at_start) + " + " + format_byte_size(kRuntimeOverheadAllowance) + " = " +
+                       format_byte_size(promised(budget));
+    return text.append(peak <= promised(budget) ? ": kept"
+                                                 : ": exceeded by " + format_byte_size(peak - promised(budget)));
+  }
+  void add_to(nlohmann::json& report, std::uint64_t peak, std::uint64_t budget) const {
+    report["resident_at_start_bytes"] = at_start;
+    report["resident_after_open_bytes"] = opened;
+    report["promised_peak_bytes"] = promised(budget);
+    report["promise_exceeded_bytes"] = peak > promised(budget) ? peak - promised(budget) : 0;
+  }
+};
+
 void run_fly(const FlyArguments& args) {
+  ResidentBesideShards memory;
   if (args.objects.size() != args.paths.size())
     throw UsageError("fly: " + std::to_string(args.objects.size()) + " --object but " +
                      std::to_string(args.paths.size()) + " --path: give one pose file per object");
@@ -176,6 +205,7 @@ void run_fly(const FlyArguments& args) {
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   FlyingObject object(index, model.get());
   object.set_obstacles(load_obstacles(args, index));
+  memory.opened = resident_bytes();
   std::optional<ContactFile> contact_file;
   if (!args.contacts.empty()) contact_file.emplace(args.contacts, *index);
   double preload_seconds = 0;
@@ -249,7 +279,9 @@ void run_fly(const FlyArguments& args) {
     std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; ",
                 double(tets_visited) / steps, double(shards_touched) / steps,
                 double(candidates) / steps, double(triangle_tests) / steps);
-  std::printf("peak RSS %s\n", format_byte_size(peak_resident_bytes()).c_str());
+  const std::uint64_t peak_rss = peak_resident_bytes();
+  std::printf("peak RSS %s\n%s\n", format_byte_size(peak_rss).c_str(),
+              memory.statement(peak_rss, cache.peak_resident_bytes, index_options.memory_budget_bytes).c_str());
   if (const std::string summary = step.summary(poses.size()); !summary.empty()) std::printf("%s\n", summary.c_str());
   if (step.query() == FlyQuery::collide && !args.answers.empty()) write_answers(args.answers, answers);
   step.commit();
@@ -279,7 +311,7 @@ void run_fly(const FlyArguments& args) {
         {"budget_bytes", index_options.memory_budget_bytes},
         {"index_shard_bytes", index->total_shard_bytes()},
         {"peak_resident_shard_bytes", cache.peak_resident_bytes},
-        {"peak_rss_bytes", peak_resident_bytes()},
+        {"peak_rss_bytes", peak_rss},
         {"page_ins", cache.page_ins},
         {"bytes_read", cache.bytes_loaded},
         {"bytes_read_per_step", double(cache.bytes_loaded) / steps},
@@ -296,6 +328,7 @@ void run_fly(const FlyArguments& args) {
       report["prefetch_hits"] = cache.prefetch_hits;
     }
     if (args.preload) report["preload_seconds"] = preload_seconds;
+    memory.add_to(report, peak_rss, index_options.memory_budget_bytes);
     if (step.collision_query()) {
       report["containments"] = containments;
       report["contacts"] = contacts;

@@ -22,8 +22,16 @@
 #include "tetrapage/runtime/ShardCache.h"
 #include "tetrapage/runtime/TetBoxFilter.h"
 #include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/geometry/FloatBox.h"
 
 namespace tetrapage {
+
+/// What a flight's peak resident memory may exceed the shard budget and the process's own
+/// memory before any work (its libraries and threads) by: the coarse mesh and its tables,
+/// read whole at open (the automatic region size keeps the mesh near 100k tets whatever the
+/// model: about 40 MiB at 100M triangles), the object's structures, and the buffers of the
+/// query and the prefetch thread (docs/USAGE.md, "Memory").
+inline constexpr std::uint64_t kRuntimeOverheadAllowance = std::uint64_t(64) << 20;
 
 struct CollisionIndexOptions {
   /// The byte budget of decoded shards held in memory (never exceeded; kDefaultMemoryBudget,
@@ -76,8 +84,9 @@ class CollisionIndex {
   std::uint32_t shard_count() const { return std::uint32_t(shard_bytes_.size()); }
   /// The bytes the cache reserves for a shard (an upper bound of its decoded size).
   std::uint64_t shard_bytes(std::uint32_t shard) const { return shard_bytes_[shard]; }
-  /// A box enclosing the shard's stored triangles (without reading the shard).
-  const geometry::Box& shard_bounds(std::uint32_t shard) const { return shard_bounds_[shard]; }
+  /// A box enclosing the shard's stored triangles (without reading the shard; the stored
+  /// bounds rounded outward to floats).
+  geometry::Box shard_bounds(std::uint32_t shard) const { return shard_bounds_[shard].box(); }
   /// Decoded bytes of all shards (what "everything resident" costs).
   std::uint64_t total_shard_bytes() const { return total_shard_bytes_; }
   /// Loads every shard into the cache (everything resident: the reference a paged run is
@@ -153,7 +162,7 @@ class CollisionIndex {
   TetBoxFilter tet_filter_;
   std::vector<std::uint32_t> tet_shard_;
   std::vector<std::uint64_t> shard_bytes_;
-  std::vector<geometry::Box> shard_bounds_;
+  std::vector<geometry::FloatBox> shard_bounds_;
   std::uint64_t total_shard_bytes_ = 0;
   std::vector<std::uint32_t> component_part_;
   std::vector<std::uint8_t> component_closed_;
