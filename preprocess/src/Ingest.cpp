@@ -79,7 +79,10 @@ std::uint64_t piece_bytes(const MeshReadEstimate& read, std::size_t copies, bool
   if (copies > 1) return std::max(read.reading_bytes, soup);
   const std::uint64_t components = surface_components_bytes(read.vertices, read.triangles);
   const std::uint64_t sample = std::min(24 * read.triangles, kLargestSampleBytes);
-  return std::max({read.reading_bytes, soup + components, soup + sample, manifest ? 2 * soup : 0});
+  // The heap's slack beside the largest: a 1M-triangle binary STL peaked 0.8 MiB above the rest.
+  constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
+  return kSlack + std::max({read.reading_bytes, soup + components, soup + sample,
+                            manifest ? 2 * soup : 0});
 }
 
 PieceEstimate estimate_piece(const InputPiece& piece) {
