@@ -295,9 +295,12 @@ void tessellate_all(std::vector<Prototype>& prototypes, const TessellationOption
 // Refuses, before any is placed, instances whose triangles together exceed the limit.
 void check_placed_triangles(const CadContent& content, const TessellationOptions& options,
                             const std::string& file) {
-  std::uint64_t total = 0;
-  for (const ShapeInstance& instance : content.instances)
+  std::uint64_t total = 0, vertices = 0;
+  for (const ShapeInstance& instance : content.instances) {
     total += content.shapes[instance.shape].triangles.size();
+    vertices += content.shapes[instance.shape].vertices.size();
+  }
+  if (options.before_placing) options.before_placing(vertices, total);
   if (options.max_triangles != 0 && total > options.max_triangles)
     throw InputError(file + ": its " + std::to_string(content.instances.size()) +
                      " placed shapes make " + std::to_string(total) +

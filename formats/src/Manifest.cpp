@@ -769,6 +769,12 @@ void PieceLoader::place(std::size_t first, std::size_t count, TriangleSoup& soup
   }
   // A placement cache of its own: batches may be placed on several threads at once.
   PlacedEntry placed(*impl_->piece.manifest, impl_->piece.entries);
+  // Sized once: grown copy by copy, the arrays would hold up to twice the copies.
+  const TriangleSoup& source = impl_->source;
+  const std::size_t placing = std::min(count, impl_->copies - std::min(first, impl_->copies));
+  soup.vertices.reserve(soup.vertices.size() + placing * source.vertices.size());
+  soup.triangles.reserve(soup.triangles.size() + placing * source.triangles.size());
+  soup.part_of.reserve(soup.part_of.size() + placing * source.triangles.size());
   std::uint64_t dropped = 0;
   double stretch = 0;
   for (std::size_t k = first; k < first + count && k < impl_->copies; ++k) {

@@ -45,8 +45,7 @@ void check_counts_fit(const InputFile& file, std::uint64_t vertex_count, std::ui
 
 }  // namespace
 
-TriangleSoup read_off(InputFile& file, ReadReport& report) {
-  report.encoding = "ascii";
+MeshCounts read_off_counts(InputFile& file) {
   std::string_view line;
   if (!next_data_line(file, line)) throw FormatError(file.name() + ": empty file, expected 'OFF'");
   const std::string_view keyword = next_token(line);
@@ -62,8 +61,9 @@ TriangleSoup read_off(InputFile& file, ReadReport& report) {
   if (line.empty() && !next_data_line(file, line)) {
     throw FormatError(file.name() + ": the file ends before the vertex and face counts");
   }
-  std::uint64_t vertex_count = 0;
-  std::uint64_t face_count = 0;
+  MeshCounts counts;
+  std::uint64_t& vertex_count = counts.vertices;
+  std::uint64_t& face_count = counts.faces;
   {
     const std::string_view vertices_token = next_token(line);
     const std::string_view faces_token = next_token(line);
@@ -77,7 +77,15 @@ TriangleSoup read_off(InputFile& file, ReadReport& report) {
     throw InputError(where_line(file) + std::to_string(vertex_count) +
                      " vertices are more than a soup can index");
   }
+  counts.triangles = face_count;
+  return counts;
+}
 
+TriangleSoup read_off(InputFile& file, ReadReport& report) {
+  report.encoding = "ascii";
+  const MeshCounts counts = read_off_counts(file);
+  const std::uint64_t vertex_count = counts.vertices, face_count = counts.faces;
+  std::string_view line;
   SoupBuilder soup(file.name(), report);
   soup.begin_part(file.path().stem().string());
   soup.reserve(vertex_count, face_count, file.size());

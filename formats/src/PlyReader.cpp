@@ -667,6 +667,32 @@ class AsciiPlyReader {
 
 }  // namespace
 
+MeshCounts read_ply_counts(InputFile& file) {
+  const PlyHeader header = read_header(file);
+  const PlyLayout layout = find_layout(file, header);
+  check_counts_fit(file, header);
+  MeshCounts counts;
+  counts.vertices = layout.vertex->count;
+  counts.faces = layout.face != nullptr ? layout.face->count : 0;
+  counts.triangles = counts.faces;
+  if (header.encoding == PlyEncoding::ascii || counts.faces == 0) return counts;
+  // Binary: the bytes after the fixed-size elements before the faces bound the faces' corners,
+  // hence their triangles (a face of k corners makes k - 2; polygons make more than a face).
+  std::uint64_t before = 0;
+  for (const auto& element : header.elements) {
+    if (&element == layout.face) break;
+    if (element.fixed_size() == 0) return counts;
+    before += element.count * element.fixed_size();
+  }
+  const PlyProperty& list = layout.face->properties[std::size_t(layout.corners)];
+  const std::uint64_t per_face = layout.face->minimal_size(false);
+  const std::uint64_t faces_bytes = file.bytes_left() - std::min(file.bytes_left(), before);
+  if (faces_bytes / counts.faces < per_face) return counts;
+  const std::uint64_t corners = (faces_bytes - counts.faces * per_face) / size_of(list.type);
+  if (corners > 2 * counts.faces) counts.triangles = std::max(counts.faces, corners - 2 * counts.faces);
+  return counts;
+}
+
 TriangleSoup read_ply(InputFile& file, ReadReport& report) {
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);

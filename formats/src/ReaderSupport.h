@@ -160,6 +160,15 @@ T load_scalar(const char* bytes, bool big_endian) {
 /// Largest vertex count a soup can index.
 constexpr std::uint64_t max_vertices = std::numeric_limits<std::uint32_t>::max();
 
+/// The counts a header states, read before any allocation (a face a triangle unless the file
+/// shows more: a binary PLY's face bytes bound its corners).
+struct MeshCounts {
+  std::uint64_t vertices = 0, faces = 0, triangles = 0;
+};
+/// @throw FormatError, InputError as read_ply and read_off do for the same header.
+MeshCounts read_ply_counts(InputFile& file);
+MeshCounts read_off_counts(InputFile& file);
+
 TriangleSoup read_obj(InputFile& file, ReadReport& report);
 TriangleSoup read_stl(InputFile& file, ReadReport& report);
 TriangleSoup read_ply(InputFile& file, ReadReport& report);

@@ -1,5 +1,6 @@
 #include "tetrapage/formats/SurfaceComponents.h"
 
+#include <algorithm>
 #include <bit>
 #include <numeric>
 
@@ -160,6 +161,24 @@ SurfaceComponents find_surface_components(const TriangleSoup& soup) {
   }
   for (std::size_t c = 0; c < parity.size(); ++c) result.components[c].closed = parity[c].closed();
   return result;
+}
+
+std::uint64_t surface_components_bytes(std::uint64_t vertices, std::uint64_t triangles) {
+  // As PositionNodes sizes itself: the distinct positions it expects.
+  const bool indexed = vertices <= 2 * triangles;
+  const std::uint64_t nodes = indexed ? vertices : vertices / 6;
+  std::uint64_t slots = 1 << 12;
+  while (slots < 2 * nodes) slots *= 2;
+  const std::uint64_t components = triangles / 64 + 1;
+  // The union: slots (old and new while growing), node and part per vertex, entries (12 B)
+  // and parents (4 B) at twice their size while growing.
+  const std::uint64_t uniting = 6 * slots + 8 * vertices + 32 * nodes;
+  // The labelling: the same tables settled, a hash (16 B), a flag and a root (4 B) per node,
+  // a component per triangle, and the components with their parities, twice while growing.
+  const std::uint64_t labelling = 4 * slots + 8 * vertices + 16 * nodes + 21 * nodes +
+                                  4 * triangles +
+                                  2 * components * (sizeof(SurfaceComponent) + sizeof(EdgeParity));
+  return std::max(uniting, labelling);
 }
 
 }  // namespace tetrapage

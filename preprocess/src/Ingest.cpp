@@ -17,9 +17,15 @@
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Pose.h"
 #include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/QuotedInput.h"
 
 namespace tetrapage {
 namespace {
+
+// The bytes a part's and a component's entries take in the model's tables, which stay in
+// memory to the end (the index's part tables, the interiors' components).
+constexpr std::uint64_t kPartEntryBytes = 2 * sizeof(std::string) + sizeof(std::uint64_t);
+constexpr std::uint64_t kComponentEntryBytes = sizeof(SurfaceComponent);
 
 // One input piece as its producer left it: its file read, and either placed whole with its
 // surfaces' connected components (its part_of then holds each triangle's component, numbered
@@ -58,6 +64,147 @@ void find_components(LoadedSoup& loaded, const InputPiece& piece) {
   loaded.components = std::move(found.components);
 }
 
+// What reading one piece holds at its peak, beyond the budget's shares (docs/USAGE.md, "Memory"):
+// the reader's peak; its soup beside the component search's tables; its soup beside the sample
+// it fills; a file placed once by a manifest beside its placed copy. Copies placed in batches
+// take their batch from the budget; the file is held beside them.
+struct PieceEstimate {
+  MeshReadEstimate read;
+  std::uint64_t bytes = 0;
+};
+constexpr std::uint64_t kLargestSampleBytes = std::uint64_t(48) << 20;  // 2^21 centroids
+
+std::uint64_t piece_bytes(const MeshReadEstimate& read, std::size_t copies, bool manifest) {
+  const std::uint64_t soup = read.soup_bytes();
+  if (copies > 1) return std::max(read.reading_bytes, soup);
+  const std::uint64_t components = surface_components_bytes(read.vertices, read.triangles);
+  const std::uint64_t sample = std::min(24 * read.triangles, kLargestSampleBytes);
+  // The heap's slack beside the largest: a 1M-triangle binary STL peaked 0.8 MiB above the rest.
+  constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
+  return kSlack + std::max({read.reading_bytes, soup + components, soup + sample,
+                            manifest ? 2 * soup : 0});
+}
+
+PieceEstimate estimate_piece(const InputPiece& piece) {
+  PieceEstimate estimate;
+  estimate.read = estimate_mesh_read(piece.file());
+  estimate.bytes = piece_bytes(estimate.read, piece.copies(), piece.manifest != nullptr);
+  return estimate;
+}
+
+// How many pieces the ingest's pipeline may hold at once. One more than the threads left both
+// threads idle whenever the in-order append waited for a slow file; four times the threads
+// took the 10M ingest from 0.91 to 0.72 s. Bounded so that the pieces in flight, each at the
+// largest piece's estimate, stay within an eighth of the budget: down to one piece at a time
+// when one file alone exceeds it (then nothing else is read beside it).
+std::size_t ingest_depth(std::uint64_t largest, std::uint64_t memory, std::size_t threads) {
+  const std::size_t most = 4 * threads;
+  if (largest == 0) return threads + 1;
+  return std::clamp<std::size_t>(std::size_t(memory / 8 / largest), 1, most);
+}
+
+std::uint64_t largest_estimate(const std::vector<PieceEstimate>& estimates) {
+  std::uint64_t largest = 0;
+  for (const PieceEstimate& estimate : estimates) largest = std::max(largest, estimate.bytes);
+  return largest;
+}
+
+// What the pieces before one place, by their estimates.
+struct PiecesBefore {
+  std::uint64_t soups = 0, triangles = 0, parts = 0;
+};
+
+// What the ingest may hold beside a piece while it is read, at --memory `memory`: the soups
+// before it (held up to a quarter of the budget, then spilled), their sample of centroids,
+// their parts' tables, and the pieces in flight with it.
+std::uint64_t held_beside(const PiecesBefore& before, std::uint64_t largest, std::uint64_t memory,
+                          std::size_t threads) {
+  const std::uint64_t sample = std::min({24 * before.triangles, memory / 8, kLargestSampleBytes});
+  const std::uint64_t in_flight = ingest_depth(largest, memory, threads) > 1 ? memory / 8 : 0;
+  return std::min(before.soups, memory / 4) + sample + before.parts * kPartEntryBytes + in_flight;
+}
+
+// "1,234,567": counts in messages.
+std::string thousands(std::uint64_t value) {
+  std::string digits = std::to_string(value), out;
+  for (std::size_t i = 0; i < digits.size(); ++i) {
+    if (i > 0 && (digits.size() - i) % 3 == 0) out.push_back(',');
+    out.push_back(digits[i]);
+  }
+  return out;
+}
+
+// Refuses, before it is read, a file whose reading needs more than the budget leaves: the
+// budget + the allowance, less what the ingest holds beside it.
+[[noreturn]] void refuse_reading(const std::filesystem::path& file, const MeshReadEstimate& read,
+                                 std::uint64_t bytes, std::uint64_t beside,
+                                 std::uint64_t raise_to, std::uint64_t memory) {
+  std::string message = quoted_input(file.string(), 80);
+  message.append(read.cad ? " makes " : " holds ")
+      .append(read.counted ? "" : "about ")
+      .append(thousands(read.triangles))
+      .append(" triangles");
+  if (read.cad) message.append(" once tessellated");
+  if (!read.counted && !read.cad) {
+    std::error_code error;
+    message.append(" by its size (")
+        .append(format_byte_size(std::filesystem::file_size(file, error)))
+        .append(")");
+  }
+  message.append(": reading it needs about ")
+      .append(format_byte_size(bytes))
+      .append(", above --memory ")
+      .append(format_byte_size(memory))
+      .append(" + ")
+      .append(format_byte_size(kPreprocessInputAllowance));
+  if (beside > 0) message.append(" less ").append(format_byte_size(beside)).append(" held beside it");
+  message.append("; raise --memory to ")
+      .append(format_byte_size(raise_to))
+      .append(" or more, or split the file");
+  throw InputError(message);
+}
+
+// The least --memory, rounded up to 8 MiB, at which `bytes` fit beside what `beside` says the
+// ingest holds at that budget (which grows with it: iterated to its fixed point).
+template <class Beside>
+std::uint64_t memory_admitting(std::uint64_t bytes, std::uint64_t memory, Beside&& beside) {
+  constexpr std::uint64_t kStep = std::uint64_t(8) << 20;
+  for (int round = 0; round < 16; ++round) {
+    const std::uint64_t need = bytes + beside(memory);
+    const std::uint64_t next = need > kPreprocessInputAllowance ? need - kPreprocessInputAllowance : 0;
+    if (next <= memory) break;
+    memory = next;
+  }
+  return std::max((memory + kStep - 1) / kStep * kStep, kLeastPreprocessMemory);
+}
+
+// Up front, before any file is read: every piece whose estimate exceeds the room the budget
+// leaves it is refused with the figure (STEP and IGES once tessellated: load_soup). Returns
+// each piece's room.
+std::vector<std::uint64_t> check_read_room(const std::vector<InputPiece>& jobs,
+                                           const std::vector<PieceEstimate>& estimates,
+                                           const PreprocessOptions& options, std::size_t threads) {
+  const std::uint64_t memory = options.memory_bytes;
+  const std::uint64_t largest = largest_estimate(estimates);
+  std::vector<std::uint64_t> rooms(jobs.size());
+  PiecesBefore before;
+  for (std::size_t j = 0; j < jobs.size(); ++j) {
+    if (j > 0) {
+      before.soups += estimates[j - 1].read.soup_bytes() * jobs[j - 1].copies();
+      before.triangles += estimates[j - 1].read.triangles * jobs[j - 1].copies();
+      before.parts += jobs[j - 1].copies();
+    }
+    const auto beside = [&](std::uint64_t at) { return held_beside(before, largest, at, threads); };
+    const std::uint64_t held = beside(memory);
+    const std::uint64_t total = memory + kPreprocessInputAllowance;
+    rooms[j] = total > held ? total - held : 0;
+    if (estimates[j].bytes <= rooms[j]) continue;
+    refuse_reading(jobs[j].file(), estimates[j].read, estimates[j].bytes, held,
+                   memory_admitting(estimates[j].bytes, memory, beside), memory);
+  }
+  return rooms;
+}
+
 // What one placed copy of `source` takes while its components are found: the soup (24 B a
 // vertex, 16 a triangle) and the component search's tables (about 40 B a vertex, 8 a
 // triangle; SurfaceComponents.cpp).
@@ -71,10 +218,33 @@ std::uint64_t batch_bytes(const PreprocessOptions& options, std::size_t threads)
   return std::max<std::uint64_t>(options.memory_bytes / 16 / (threads + 1), 1);
 }
 
+// A STEP or IGES file's triangles are known once tessellated: refused then, before they are
+// placed (in the reading child), when they need more than `room`.
+TessellationOptions tessellation_within(const InputPiece& piece, const PreprocessOptions& options,
+                                        std::uint64_t room) {
+  TessellationOptions tessellation = options.tessellation;
+  const std::uint64_t memory = options.memory_bytes;
+  const std::uint64_t held = memory + kPreprocessInputAllowance - std::min(room, memory + kPreprocessInputAllowance);
+  tessellation.before_placing = [file = piece.file(), copies = piece.copies(),
+                                 manifest = piece.manifest != nullptr, room, held,
+                                 memory](std::uint64_t vertices, std::uint64_t triangles) {
+    MeshReadEstimate read;
+    read.cad = read.counted = true;
+    read.vertices = vertices;
+    read.triangles = triangles;
+    read.reading_bytes = read.soup_bytes();
+    const std::uint64_t bytes = piece_bytes(read, copies, manifest);
+    if (bytes <= room) return;
+    refuse_reading(file, read, bytes, held,
+                   memory_admitting(bytes, memory, [held](std::uint64_t) { return held; }), memory);
+  };
+  return tessellation;
+}
+
 LoadedSoup load_soup(const InputPiece& piece, const PreprocessOptions& options,
-                     std::size_t threads) {
+                     std::size_t threads, std::uint64_t room) {
   LoadedSoup loaded;
-  auto loader = std::make_unique<PieceLoader>(piece, options.tessellation);
+  auto loader = std::make_unique<PieceLoader>(piece, tessellation_within(piece, options, room));
   loaded.file = piece.input.string();
   loaded.length_unit = piece.manifest ? piece.manifest->units : loader->report().length_unit;
   const std::uint64_t whole = copy_working_bytes(loader->source()) * loader->copies();
@@ -91,27 +261,6 @@ LoadedSoup load_soup(const InputPiece& piece, const PreprocessOptions& options,
   loader.reset();  // the file's soup is not held beside its placed copy
   find_components(loaded, piece);
   return loaded;
-}
-
-// How many pieces the ingest's pipeline may hold at once. One more than the threads left both
-// threads idle whenever the in-order append waited for a slow file; four times the threads
-// took the 10M ingest from 0.91 to 0.72 s. Bounded so that the pieces in flight, taken at 4
-// times their files' bytes (a loaded soup holds double vertices and indices, and the component
-// search's tables; a piece placed in batches holds its file and a batch), stay within an
-// eighth of the budget: down to one piece at a time when one file alone exceeds it.
-std::size_t ingest_depth(const std::vector<InputPiece>& jobs, const PreprocessOptions& options,
-                         std::size_t threads) {
-  std::uint64_t largest = 0;
-  for (const InputPiece& job : jobs) {
-    std::error_code error;
-    const std::uint64_t bytes = std::filesystem::file_size(job.file(), error);
-    if (error) continue;
-    const std::uint64_t copies = std::min<std::uint64_t>(job.copies(), 2);
-    largest = std::max<std::uint64_t>(largest, 4 * bytes * copies);
-  }
-  const std::size_t most = 4 * threads;
-  if (largest == 0) return threads + 1;
-  return std::clamp<std::size_t>(std::size_t(options.memory_bytes / 8 / largest), 1, most);
 }
 
 // The model's unit is the one its inputs state; inputs that state different units cannot be
@@ -140,10 +289,6 @@ void settle_length_unit(IngestedModel& model, const std::string& option) {
   }
 }
 
-// The bytes a part's and a component's entries take in the model's tables, which stay in
-// memory to the end (the index's part tables, the interiors' components).
-constexpr std::uint64_t kPartEntryBytes = 2 * sizeof(std::string) + sizeof(std::uint64_t);
-constexpr std::uint64_t kComponentEntryBytes = sizeof(SurfaceComponent);
 
 // The tables cannot spill: a model whose tables alone exceed the budget is refused (a tetras
 // file of 50,000 parts, 9.4 MiB of tables, is a model the 16 MiB budget works with).
@@ -374,15 +519,19 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
   // One part file at a time per thread: the ingest never holds the assembly.
   const std::vector<InputPiece> jobs = input_pieces(inputs);
   check_part_count(jobs, options);
+  const auto threads = std::size_t(tbb::this_task_arena::max_concurrency());
+  std::vector<PieceEstimate> estimates;
+  estimates.reserve(jobs.size());
+  for (const InputPiece& job : jobs) estimates.push_back(estimate_piece(job));
+  const std::vector<std::uint64_t> rooms = check_read_room(jobs, estimates, options, threads);
   // Parsing, placement, edge parity and bounds run on all threads, a few pieces at once; the
   // soups are appended in input order on one.
   Progress progress("reading parts", jobs.size(), options.progress, options.on_progress);
-  const auto threads = std::size_t(tbb::this_task_arena::max_concurrency());
   std::size_t next_job = 0;
   produce_in_parallel_consume_in_order(
-      jobs.size(), ingest_depth(jobs, options, threads),
+      jobs.size(), ingest_depth(largest_estimate(estimates), options.memory_bytes, threads),
       [&](std::size_t j) {
-        return std::make_shared<LoadedSoup>(load_soup(jobs[j], options, threads));
+        return std::make_shared<LoadedSoup>(load_soup(jobs[j], options, threads, rooms[j]));
       },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         // In input order (ids, part numbers and the sample do not depend on the threads).

@@ -11,6 +11,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -153,6 +156,110 @@ TEST(PreprocessMemory, TablesBeyondTheBudgetAreRefusedUpFront) {
   }
   EXPECT_FALSE(fs::exists(folder / "model.tpi"));
 }
+
+// "raise --memory to 120.0 MiB or more": the figure as a --memory argument ("120M").
+std::string raised_memory(const std::string& message) {
+  const std::string key = "raise --memory to ";
+  const std::size_t at = message.find(key);
+  if (at == std::string::npos) return {};
+  std::size_t used = 0;
+  const double value = std::stod(message.substr(at + key.size()), &used);
+  const bool gib = message.compare(at + key.size() + used, 4, " GiB") == 0;
+  return std::to_string(std::uint64_t(std::ceil(value * (gib ? 1024 : 1)))) + "M";
+}
+
+// A 2M-triangle PLY needs about 130 MiB to read at 16M: refused before it is read, with the
+// figure, leaving no output and no spill; at the --memory the message names, it runs within
+// the promise (the estimate is an upper bound of what reading it takes).
+TEST(PreprocessMemory, AFileTooLargeForTheBudgetIsRefusedBeforeItIsRead) {
+  const fs::path folder = test_folder("refused");
+  const fs::path input = make_terrain(folder / "terrain.ply", 2'000'000);
+  PreprocessOptions options;
+  options.memory_bytes = std::uint64_t(16) << 20;
+  std::string message;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    preprocess({input}, folder / "terrain.tpi", options);
+    ADD_FAILURE() << "not refused";
+  } catch (const InputError& error) {
+    message = error.what();
+  }
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+  EXPECT_NE(message.find("'" + input.string() + "' holds 2,00"), std::string::npos) << message;
+  EXPECT_NE(message.find("above --memory 16.0 MiB + 64.0 MiB"), std::string::npos) << message;
+  for (const auto& entry : fs::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename(), "terrain.ply") << "left behind: " << entry.path();
+  const std::string raised = raised_memory(message);
+  ASSERT_FALSE(raised.empty()) << message;
+  const ChildRun run = run_preprocess(input, folder / "terrain.tpi", raised.c_str());
+  expect_within_promise(run, std::stoull(raised) << 20);
+}
+
+// Writes `soup` as ASCII PLY, binary PLY of float vertices, or ASCII STL (formats MeshWriter
+// does not write).
+void write_as(const TriangleSoup& soup, const fs::path& path, const std::string& kind) {
+  std::ofstream out(path, std::ios::binary);
+  if (kind == "stl-ascii") {
+    out << "solid t\n";
+    for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+      out << "facet normal 0 0 1\nouter loop\n";
+      for (const Vec3& p : soup.corners(t)) out << "vertex " << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+      out << "endloop\nendfacet\n";
+    }
+    out << "endsolid t\n";
+    return;
+  }
+  const bool ascii = kind == "ply-ascii";
+  out << "ply\nformat " << (ascii ? "ascii" : "binary_little_endian") << " 1.0\nelement vertex "
+      << soup.vertices.size() << "\nproperty float x\nproperty float y\nproperty float z\n"
+      << "element face " << soup.triangle_count() << "\nproperty list uchar int vertex_indices\n"
+      << "end_header\n";
+  for (const Vec3& p : soup.vertices) {
+    const float xyz[3] = {float(p[0]), float(p[1]), float(p[2])};
+    if (ascii) out << xyz[0] << ' ' << xyz[1] << ' ' << xyz[2] << '\n';
+    else out.write(reinterpret_cast<const char*>(xyz), sizeof xyz);
+  }
+  for (const TriangleIndices& t : soup.triangles) {
+    if (ascii) {
+      out << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+      continue;
+    }
+    const unsigned char three = 3;
+    out.write(reinterpret_cast<const char*>(&three), 1);
+    out.write(reinterpret_cast<const char*>(t.data()), 12);
+  }
+}
+
+class ReadEstimate : public testing::TestWithParam<std::string> {};
+
+// Each reader's estimate, from the header or the size, is at least what its soup takes.
+TEST_P(ReadEstimate, IsAnUpperBoundOfTheSoup) {
+  const fs::path folder = test_folder("estimate-" + GetParam());
+  const TriangleSoup terrain = read_mesh(make_terrain(folder / "terrain.ply", 20'000));
+  const std::string kind = GetParam();
+  fs::path path = folder / ("t." + kind.substr(0, kind.find('-')));
+  if (kind == "ply-double") path = folder / "terrain.ply";
+  else if (kind.find('-') != std::string::npos) write_as(terrain, path, kind);
+  else make_terrain(path, 20'000);
+  const TriangleSoup soup = read_mesh(path);
+  const std::uint64_t held = soup.vertices.capacity() * sizeof(Vec3) +
+                             soup.triangles.capacity() * sizeof(TriangleIndices) +
+                             soup.part_of.capacity() * sizeof(std::uint32_t);
+  const MeshReadEstimate estimate = estimate_mesh_read(path);
+  EXPECT_GE(estimate.triangles, soup.triangle_count()) << path;
+  EXPECT_GE(estimate.soup_bytes(), held) << path;
+  EXPECT_GE(estimate.reading_bytes, held) << path;
+  EXPECT_LE(estimate.soup_bytes(), 3 * held) << path;
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, ReadEstimate,
+                         testing::Values("ply-ascii", "ply-float", "ply-double", "stl",
+                                         "stl-ascii", "obj", "off"),
+                         [](const testing::TestParamInfo<std::string>& param) {
+                           std::string name = param.param;
+                           std::replace(name.begin(), name.end(), '-', '_');
+                           return name;
+                         });
 
 // A full disk cannot be made here: the free space is injected (assumed_free_disk_bytes). 2,000
 // copies of 968 triangles need about 200 MiB of spill and index under 16M; with 64 MiB free

@@ -445,8 +445,9 @@ void add_index_commands(CLI::App& app) {
       "Working-memory budget of the stages' data, at least 16M: larger models spill to disk\n"
       "next to the output. Peak RSS stays within it + what the process held before any work\n"
       "(libraries, about 48 MiB) + 64 MiB for the files being read (a file placed many times\n"
-      "is placed in batches; one file's own soup is held whole while it is read); the summary\n"
-      "states the three and the peak",
+      "is placed in batches; one file's own soup is held whole while it is read: a file too\n"
+      "large for that is refused before it is read, naming the --memory it needs); the\n"
+      "summary states the three and the peak",
       kLeastPreprocessMemory);
   command->add_option("--threads", pre->threads, "Worker threads (0: all cores)")
       ->capture_default_str()

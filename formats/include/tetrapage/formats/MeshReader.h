@@ -54,6 +54,27 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = n
 ///        (its message is included); InputError as read_mesh.
 TriangleSoup read_mesh_with_assimp(const std::filesystem::path& path, ReadReport* report = nullptr);
 
+/// What reading a mesh file whole will hold, told before reading it from what is cheap to
+/// know: the counts a PLY or OFF header or a binary STL states, else the file's size at the
+/// fewest bytes a triangle took in the files measured (an OBJ, an ASCII STL, a glTF written
+/// with fewer digits or fewer vertices shared holds more). STEP and IGES are known once
+/// tessellated (TessellationOptions::before_placing).
+struct MeshReadEstimate {
+  std::uint64_t vertices = 0;   ///< the soup's vertex entries (an STL's three a triangle)
+  std::uint64_t triangles = 0;  ///< a face a triangle unless the file shows more
+  bool counted = false;         ///< from the file's own counts; else from its size
+  bool cad = false;             ///< STEP or IGES: no estimate here
+  /// The reader's peak heap: its soup and what it holds beside while reading (growing arrays,
+  /// the degenerate filter's shrink, Assimp's scene, the read block).
+  std::uint64_t reading_bytes = 0;
+  /// The soup once read: 24 B a vertex, 12 a triangle and 4 for its part.
+  std::uint64_t soup_bytes() const { return 24 * vertices + 16 * triangles; }
+};
+
+/// Estimates read_mesh's soup and peak for `path`. Never throws: a file whose header cannot be
+/// read is estimated from its size, and its reader then says what is wrong.
+MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept;
+
 /// The position, among the triangles the reader made (the faces in file order, each
 /// fan-triangulated), of the kept triangle `id` of the soup read with `report`: `id` plus the
 /// dropped triangles at or before that position (report.dropped_positions).

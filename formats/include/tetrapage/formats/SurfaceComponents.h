@@ -34,4 +34,10 @@ struct SurfaceComponents {
 /// Finds the components of `soup` (linear time: one hash of each distinct vertex position).
 SurfaceComponents find_surface_components(const TriangleSoup& soup);
 
+/// The bytes find_surface_components allocates at its peak for a soup of `vertices` vertex
+/// entries and `triangles` triangles (the soup not counted): its tables, arrays counted twice
+/// while they grow, distinct positions taken as the vertices of an indexed soup and a sixth of
+/// an STL's corners, and one component per 64 triangles (a file of many tiny solids holds more).
+std::uint64_t surface_components_bytes(std::uint64_t vertices, std::uint64_t triangles);
+
 }  // namespace tetrapage
