@@ -117,6 +117,26 @@ TEST_F(CommandReports, FlyWritesTheFiguresOfWhatItRan) {
   EXPECT_GT(rounded.at("max_rounding_distance").get<double>(), 0.0);
 }
 
+TEST_F(CommandReports, FlyStatesWhatItHoldsBesideTheShardsAndKeepsItsPromise) {
+  // The promise: peak RSS <= --memory + what the process held before any work + 64 MiB.
+  const test::CliResult run = test::run_cli_in(folder_, kFly + " --memory 16M --report r.json");
+  ASSERT_EQ(run.status, 0) << run.err;
+  EXPECT_NE(run.out.find("memory: peak RSS"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find(": kept"), std::string::npos) << run.out;
+  std::ifstream in(folder_ / "r.json");
+  const json report = json::parse(in);
+  const auto at_start = report.at("resident_at_start_bytes").get<std::uint64_t>();
+  const auto opened = report.at("resident_after_open_bytes").get<std::uint64_t>();
+  const auto peak = report.at("peak_rss_bytes").get<std::uint64_t>();
+  EXPECT_GT(at_start, 0u);
+  EXPECT_GE(opened, at_start);
+  EXPECT_GE(peak, opened);
+  EXPECT_EQ(report.at("promised_peak_bytes").get<std::uint64_t>(),
+            (std::uint64_t(16) << 20) + at_start + kRuntimeOverheadAllowance);
+  EXPECT_LE(peak, report.at("promised_peak_bytes").get<std::uint64_t>());
+  EXPECT_EQ(report.at("promise_exceeded_bytes").get<std::uint64_t>(), 0u);
+}
+
 TEST_F(CommandReports, FlyStatesTheObstaclesItWasGiven) {
   {
     const auto index = std::make_shared<const CollisionIndex>(folder_ / "double.tpi");

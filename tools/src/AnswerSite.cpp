@@ -67,18 +67,27 @@ std::string object_part_fields(const AnswerSite& site, const TriangleSoup& mesh)
          csv_field(mesh.part_path(part));
 }
 
+// The site of a pair of triangles, its kind left to the caller; a solid when there is no
+// object triangle (Contact::kNoObjectTriangle, the one convention of contacts and answers).
+AnswerSite pair_site(std::uint32_t environment_part, std::uint32_t dynamic_part,
+                     std::uint64_t environment_triangle, std::uint32_t object_triangle) {
+  AnswerSite site;
+  site.environment_part = environment_part;
+  site.dynamic_part = dynamic_part;
+  site.environment_triangle = environment_triangle;
+  if (object_triangle == Contact::kNoObjectTriangle)
+    site.kind = AnswerSite::Kind::solid;
+  else
+    site.object_triangle = object_triangle;
+  return site;
+}
+
 }  // namespace
 
 AnswerSite contact_site(FlyingObject& object, const Contact& contact) {
-  AnswerSite site;
-  site.environment_part = contact.environment_part;
-  site.dynamic_part = contact.dynamic_part;
-  site.environment_triangle = contact.environment_triangle;
-  if (contact.object_triangle == Contact::kNoObjectTriangle) {
-    site.kind = AnswerSite::Kind::solid;
-    return site;
-  }
-  site.object_triangle = contact.object_triangle;
+  AnswerSite site = pair_site(contact.environment_part, contact.dynamic_part,
+                              contact.environment_triangle, contact.object_triangle);
+  if (site.kind == AnswerSite::Kind::solid) return site;
   const auto [environment, placed] = object.contact_triangles(contact);
   if (geometry::triangles_intersect(environment, placed)) {
     site.kind = AnswerSite::Kind::surface;
@@ -115,17 +124,11 @@ AnswerSite distance_site(const DistanceResult& result) {
   if (result.environment_triangle == DistanceResult::kNoTriangle)
     return containment_site(result.containment, result.containing_part,
                             result.containing_dynamic_part);
-  AnswerSite site;
-  site.environment_part = result.environment_part;
-  site.dynamic_part = result.dynamic_part;
-  site.environment_triangle = result.environment_triangle;
-  if (result.object_triangle == Contact::kNoObjectTriangle) {
-    site.kind = AnswerSite::Kind::solid;
-    return site;
-  }
+  AnswerSite site = pair_site(result.environment_part, result.dynamic_part,
+                              result.environment_triangle, result.object_triangle);
+  if (site.kind == AnswerSite::Kind::solid) return site;
   site.kind = result.separation == Separation::touching ? AnswerSite::Kind::surface
                                                         : AnswerSite::Kind::near;
-  site.object_triangle = result.object_triangle;
   if (has_closest_points(result)) {
     site.on_environment = result.on_environment;
     site.on_object = result.on_object;
