@@ -72,13 +72,15 @@ struct PieceEstimate {
   MeshReadEstimate read;
   std::uint64_t bytes = 0;
 };
-constexpr std::uint64_t kLargestSampleBytes = std::uint64_t(48) << 20;  // 2^21 centroids
+// The reservoir sample holds at most this many centroids (ingest() says why).
+constexpr std::uint64_t kMostSampledCentroids = std::uint64_t(1) << 21;
+constexpr std::uint64_t kLargestSampleBytes = kMostSampledCentroids * sizeof(Vec3);
 
 std::uint64_t piece_bytes(const MeshReadEstimate& read, std::size_t copies, bool manifest) {
   const std::uint64_t soup = read.soup_bytes();
   if (copies > 1) return std::max(read.reading_bytes, soup);
   const std::uint64_t components = surface_components_bytes(read.vertices, read.triangles);
-  const std::uint64_t sample = std::min(24 * read.triangles, kLargestSampleBytes);
+  const std::uint64_t sample = std::min(sizeof(Vec3) * read.triangles, kLargestSampleBytes);
   // The heap's slack beside the largest: a 1M-triangle binary STL peaked 0.8 MiB above the rest.
   constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
   return kSlack + std::max({read.reading_bytes, soup + components, soup + sample,
@@ -119,7 +121,7 @@ struct PiecesBefore {
 // their parts' tables, and the pieces in flight with it.
 std::uint64_t held_beside(const PiecesBefore& before, std::uint64_t largest, std::uint64_t memory,
                           std::size_t threads) {
-  const std::uint64_t sample = std::min({24 * before.triangles, memory / 8, kLargestSampleBytes});
+  const std::uint64_t sample = std::min({sizeof(Vec3) * before.triangles, memory / 8, kLargestSampleBytes});
   const std::uint64_t in_flight = ingest_depth(largest, memory, threads) > 1 ? memory / 8 : 0;
   return std::min(before.soups, memory / 4) + sample + before.parts * kPartEntryBytes + in_flight;
 }
@@ -139,7 +141,8 @@ std::string thousands(std::uint64_t value) {
 [[noreturn]] void refuse_reading(const std::filesystem::path& file, const MeshReadEstimate& read,
                                  std::uint64_t bytes, std::uint64_t beside,
                                  std::uint64_t raise_to, std::uint64_t memory) {
-  std::string message = quoted_input(file.string(), 80);
+  // The whole path (PATH_MAX): cut, it would lose the file's name.
+  std::string message = quoted_input(file.string(), 4096);
   message.append(read.cad ? " makes " : " holds ")
       .append(read.counted ? "" : "about ")
       .append(thousands(read.triangles))
@@ -513,7 +516,7 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
   // objects, four runs each, within their noise) at twice the coarse mesh's time; 1M began to
   // show in the flights (the tetrahedron's 7 % slower; docs/BENCHMARKS.md).
   state.sample_capacity = std::size_t(
-      std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, 1 << 21));
+      std::clamp<std::uint64_t>(options.memory_bytes / (8 * sizeof(Vec3)), 1 << 16, kMostSampledCentroids));
   model.sample.reserve(std::min<std::size_t>(state.sample_capacity, 1 << 16));
 
   // One part file at a time per thread: the ingest never holds the assembly.

@@ -16,7 +16,7 @@ TetBoxFilter::TetBoxFilter(const TetMesh& mesh) {
   bounds_.resize(mesh.tet_count());
   planes_.resize(mesh.tet_count());
   for (std::uint32_t t = 0; t < mesh.tet_count(); ++t) {
-    bounds_[t] = geometry::FloatBox::enclosing(mesh.bounds(t));
+    bounds_[t] = mesh.bounds(t);
     const geometry::Tetrahedron corners = mesh.corners(t);
     double corner_magnitude = 0;
     for (const auto& p : corners)
@@ -38,7 +38,7 @@ TetBoxFilter::TetBoxFilter(const TetMesh& mesh) {
       for (const auto& p : corners)
         lowest = std::min(lowest, double(planes.normal[0][k]) * p[0] + double(planes.normal[1][k]) * p[1] +
                                       double(planes.normal[2][k]) * p[2]);
-      planes.offset[k] = geometry::float_below(lowest - corner_magnitude * kRelativeMargin);
+      planes.offset[k] = lowest - corner_magnitude * kRelativeMargin;
     }
   }
 }

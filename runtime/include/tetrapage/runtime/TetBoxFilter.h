@@ -2,9 +2,7 @@
 /// @file TetBoxFilter.h
 /// What a box search asks of a coarse tet before anything exact: its bounding box, and whether
 /// one of four planes holding the tet leaves the whole box outside. Computed once when an index
-/// opens (64 bytes a tet, and 24 for the box: floats rounded outward, so that the tables of a
-/// 100k-tet mesh stay small beside the shards) so that a search reads no corners and forms no
-/// normals.
+/// opens (80 bytes a tet beyond the box) so that a search reads no corners and forms no normals.
 
 #include <array>
 #include <cmath>
@@ -13,7 +11,6 @@
 
 #include "tetrapage/formats/TetMesh.h"
 #include "tetrapage/runtime/geometry/Box.h"
-#include "tetrapage/runtime/geometry/FloatBox.h"
 
 namespace tetrapage {
 
@@ -24,9 +21,8 @@ class TetBoxFilter {
   explicit TetBoxFilter(const TetMesh& mesh);
 
   std::size_t tet_count() const { return bounds_.size(); }
-  /// A box holding the tet (its bounding box rounded outward to floats; `tet` < tet_count(),
-  /// unchecked).
-  geometry::Box bounds(std::uint32_t tet) const { return bounds_[tet].box(); }
+  /// The tet's bounding box (`tet` < tet_count(), unchecked).
+  const geometry::Box& bounds(std::uint32_t tet) const { return bounds_[tet]; }
   /// False only when the box lies strictly outside one of the tet's face planes (including
   /// every rounding): true for every tet that meets the box. `box` must be finite.
   bool planes_may_meet(std::uint32_t tet, const geometry::Box& box) const {
@@ -51,19 +47,17 @@ class TetBoxFilter {
         const double n = planes.normal[a][k];
         highest += n * centre[a] + std::fabs(n) * half[a];
       }
-      separated |= highest < double(planes.offset[k]) - margin;
+      separated |= highest < planes.offset[k] - margin;
     }
     return !separated;
   }
   /// The bounding boxes overlap and planes_may_meet.
   bool may_meet(std::uint32_t tet, const geometry::Box& box) const {
-    return geometry::boxes_overlap(bounds(tet), box) && planes_may_meet(tet, box);
+    return geometry::boxes_overlap(bounds_[tet], box) && planes_may_meet(tet, box);
   }
   /// The largest coordinate's magnitude, which bounds the planes' rounding.
   static double magnitude(const geometry::Box& box);
-  std::size_t memory_bytes() const {
-    return bounds_.capacity() * sizeof(geometry::FloatBox) + planes_.capacity() * sizeof(Planes);
-  }
+  std::size_t memory_bytes() const { return bounds_.capacity() * sizeof(geometry::Box) + planes_.capacity() * sizeof(Planes); }
 
  private:
   // The roundings: normal . x in double, for |normal|_1 < 2, is off by less than 2^-48 of the
@@ -72,12 +66,12 @@ class TetBoxFilter {
   static constexpr double kRelativeMargin = 0x1p-45;
   // Face k's normal, pointing into the tet and scaled to about unit 1-norm, rounded to float
   // (any direction would do: the offset is taken from the rounded normal), and an offset no
-  // larger than the smallest value of normal . x over the tet's corners (rounded down to float).
+  // larger than the smallest value of normal . x over the tet's corners.
   struct Planes {
     std::array<std::array<float, 4>, 3> normal;  ///< normal[axis][face]
-    std::array<float, 4> offset;
+    std::array<double, 4> offset;
   };
-  std::vector<geometry::FloatBox> bounds_;
+  std::vector<geometry::Box> bounds_;
   std::vector<Planes> planes_;
 };
 
