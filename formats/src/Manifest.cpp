@@ -590,9 +590,10 @@ void check_placement_precision(const std::string& instance, const TriangleSoup& 
 }
 
 /// Appends the parts of `source` placed by placement k of `placed`: one soup part per
-/// instance, or per node for a file of several parts.
-void append_placement(TriangleSoup& assembly, const TriangleSoup& source, PlacedEntry& placed,
-                      std::size_t k, double scale, std::uint64_t& degenerate_dropped) {
+/// instance, or per node for a file of several parts. Returns the placement's largest stretch
+/// (what it scales the tessellation's deflection by).
+double append_placement(TriangleSoup& assembly, const TriangleSoup& source, PlacedEntry& placed,
+                        std::size_t k, double scale, std::uint64_t& degenerate_dropped) {
   const Transform& m = placed.transform(k);
   const std::string path = placed.path(k);
   const ManifestPart& part = placed.part();
@@ -638,6 +639,7 @@ void append_placement(TriangleSoup& assembly, const TriangleSoup& source, Placed
     assembly.triangles.push_back(p);
     assembly.part_of.push_back(part_base + source.part_of[t]);
   }
+  return largest_stretch(m);
 }
 
 /// Reads the file of mesh entry `entries` once and appends all its placements; a
@@ -778,8 +780,7 @@ void PieceLoader::place(std::size_t first, std::size_t count, TriangleSoup& soup
   std::uint64_t dropped = 0;
   double stretch = 0;
   for (std::size_t k = first; k < first + count && k < impl_->copies; ++k) {
-    append_placement(soup, impl_->source, placed, k, impl_->scale, dropped);
-    stretch = std::max(stretch, largest_stretch(placed.transform(k)));
+    stretch = std::max(stretch, append_placement(soup, impl_->source, placed, k, impl_->scale, dropped));
   }
   impl_->dropped += dropped;
   const std::lock_guard lock(impl_->stretch_mutex);

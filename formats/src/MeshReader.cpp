@@ -154,10 +154,9 @@ bool header_counts(const std::filesystem::path& path, MeshFormat format, MeshRea
     } else if (format == MeshFormat::off) {
       counts = detail::read_off_counts(file);
     } else if (format == MeshFormat::stl) {
-      const std::string_view head = file.peek(84);
-      if (head.size() < 84) return false;
-      counts.triangles = counts.faces = detail::load_scalar<std::uint32_t>(head.data() + 80, false);
-      if (file.size() != 84 + 50 * counts.triangles) return false;  // ASCII
+      const std::optional<std::uint64_t> triangles = detail::binary_stl_count(file);
+      if (!triangles) return false;  // ASCII: estimated from its size
+      counts.triangles = counts.faces = *triangles;
       counts.vertices = 3 * counts.triangles;
     } else {
       return false;

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <set>
 #include <span>
 #include <string>
@@ -167,6 +168,9 @@ struct MeshCounts {
 };
 /// @throw FormatError, InputError as read_ply and read_off do for the same header.
 MeshCounts read_ply_counts(InputFile& file);
+/// The triangle count of a binary STL (the file's size is 84 + 50 per triangle), or none for an
+/// ASCII or damaged one.
+std::optional<std::uint64_t> binary_stl_count(InputFile& file);
 MeshCounts read_off_counts(InputFile& file);
 
 TriangleSoup read_obj(InputFile& file, ReadReport& report);

@@ -3,6 +3,7 @@
 // every facet brings its own three vertices.
 
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 #include "ReaderSupport.h"
@@ -115,13 +116,17 @@ TriangleSoup read_ascii_stl(InputFile& file, ReadReport& report) {
 
 }  // namespace
 
-TriangleSoup read_stl(InputFile& file, ReadReport& report) {
+std::optional<std::uint64_t> binary_stl_count(InputFile& file) {
   const std::string_view head = file.peek(header_bytes);
-  if (head.size() == header_bytes) {
-    const std::uint64_t count = load_scalar<std::uint32_t>(head.data() + 80, false);
-    if (file.size() == header_bytes + facet_bytes * count)
-      return read_binary_stl(file, report, count);
-  }
+  if (head.size() != header_bytes) return std::nullopt;
+  const std::uint64_t count = load_scalar<std::uint32_t>(head.data() + 80, false);
+  if (file.size() != header_bytes + facet_bytes * count) return std::nullopt;
+  return count;
+}
+
+TriangleSoup read_stl(InputFile& file, ReadReport& report) {
+  if (const auto count = binary_stl_count(file)) return read_binary_stl(file, report, *count);
+  const std::string_view head = file.peek(header_bytes);
   std::string_view text = head;
   while (!text.empty() && (is_space(text.front()) || text.front() == '\n')) text.remove_prefix(1);
   // ASCII STL never holds a NUL byte; a binary header usually does (zero padding).

@@ -39,6 +39,19 @@ class UnionFind {
   std::vector<std::uint32_t> parent_;
 };
 
+// The distinct positions a soup is expected to hold: about one per vertex entry in an indexed
+// soup, about one per six in a soup whose triangles share no entries (an STL).
+std::uint64_t expected_positions(std::uint64_t vertices, std::uint64_t triangles) {
+  return vertices <= 2 * triangles ? vertices : vertices / 6;
+}
+
+// The hash table's first size for `expected` positions: at most half full.
+std::uint64_t initial_slots(std::uint64_t expected) {
+  std::uint64_t slots = 1 << 12;
+  while (slots < 2 * expected) slots *= 2;
+  return slots;
+}
+
 // The distinct (part, position) pairs of a soup's corners, each a node of the union-find.
 // Open addressing over a power-of-two table at most half full, keyed by a vertex that holds the
 // position (no allocation per vertex: a node-based map tripled the ingest of a 10M file).
@@ -47,11 +60,8 @@ class PositionNodes {
   // Sized for the distinct positions expected: about one per vertex entry in an indexed soup,
   // about one per six in a soup whose triangles share no entries (an STL); it doubles beyond.
   explicit PositionNodes(const TriangleSoup& soup) : soup_(soup) {
-    const bool indexed = soup.vertices.size() <= 2 * soup.triangle_count();
-    const std::size_t expected = indexed ? soup.vertices.size() : soup.vertices.size() / 6;
-    std::size_t slots = 1 << 12;
-    while (slots < 2 * expected) slots *= 2;
-    slots_.assign(slots, kEmpty);
+    const std::uint64_t expected = expected_positions(soup.vertices.size(), soup.triangle_count());
+    slots_.assign(std::size_t(initial_slots(expected)), kEmpty);
     node_of_vertex_.assign(soup.vertices.size(), kEmpty);
     part_of_vertex_.assign(soup.vertices.size(), kEmpty);
   }
@@ -164,11 +174,9 @@ SurfaceComponents find_surface_components(const TriangleSoup& soup) {
 }
 
 std::uint64_t surface_components_bytes(std::uint64_t vertices, std::uint64_t triangles) {
-  // As PositionNodes sizes itself: the distinct positions it expects.
-  const bool indexed = vertices <= 2 * triangles;
-  const std::uint64_t nodes = indexed ? vertices : vertices / 6;
-  std::uint64_t slots = 1 << 12;
-  while (slots < 2 * nodes) slots *= 2;
+  // As PositionNodes sizes itself.
+  const std::uint64_t nodes = expected_positions(vertices, triangles);
+  const std::uint64_t slots = initial_slots(nodes);
   const std::uint64_t components = triangles / 64 + 1;
   // The union: slots (old and new while growing), node and part per vertex, entries (12 B)
   // and parents (4 B) at twice their size while growing.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "tetrapage/runtime/geometry/FloatRounding.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 
 namespace tetrapage {
@@ -38,7 +39,7 @@ TetBoxFilter::TetBoxFilter(const TetMesh& mesh) {
       for (const auto& p : corners)
         lowest = std::min(lowest, double(planes.normal[0][k]) * p[0] + double(planes.normal[1][k]) * p[1] +
                                       double(planes.normal[2][k]) * p[2]);
-      planes.offset[k] = lowest - corner_magnitude * kRelativeMargin;
+      planes.offset[k] = geometry::float_below(lowest - corner_magnitude * kRelativeMargin);
     }
   }
 }

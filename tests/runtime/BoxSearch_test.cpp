@@ -15,6 +15,7 @@
 #include "tetrapage/preprocess/CoarseMesh.h"
 #include "tetrapage/runtime/BoxSearch.h"
 #include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/geometry/FloatBox.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
 
@@ -228,8 +229,7 @@ void check_search(const TetMesh& mesh, const TetBoxFilter& filter, const Box& bo
   if (!missed.empty() || !extra.empty()) ++failures;
 
   // The cheap search (the flying object's region) keeps every tet that meets the box; what it
-  // keeps beyond them has a bounding box that meets it (the filter's, rounded outward to
-  // floats: within a float's rounding of the exact one).
+  // keeps beyond them has a bounding box that meets it.
   const BoxSearchResult near = tets_near_box(mesh, filter, start, box, scratch);
   std::vector<std::uint32_t> near_tets(near.tets.begin(), near.tets.end());
   std::sort(near_tets.begin(), near_tets.end());
@@ -240,18 +240,19 @@ void check_search(const TetMesh& mesh, const TetBoxFilter& filter, const Box& bo
                                    << ": the near search missed " << near_missed.size() << " of "
                                    << expected.size() << " tets meeting it";
   for (const std::uint32_t tet : near_tets)
-    EXPECT_TRUE(geometry::boxes_overlap(filter.bounds(tet), box)) << what << ": near tet " << tet;
+    EXPECT_TRUE(geometry::boxes_overlap(mesh.bounds(tet), box)) << what << ": near tet " << tet;
   EXPECT_EQ(near.exact_tests, 0u);
   if (!near_missed.empty()) ++failures;
 }
 
-TEST(TetBoxFilter, FloatBoundsHoldEachTetWithinAFloatsRounding) {
-  // Tiny, unit and far-from-the-origin meshes, and a box beyond float's range.
+// A shard's stored bounds are kept as floats rounded outward (CollisionIndex::shard_bounds):
+// each holds its box, within a float's rounding, also far from the origin, tiny, beyond
+// float's range, and empty.
+TEST(FloatBox, HoldsItsBoxWithinAFloatsRounding) {
   for (const auto& [exponent, offset] : {std::pair{-30, 0.0}, std::pair{0, 0.0}, std::pair{0, 1e6}}) {
     const TetMesh mesh = random_mesh(300, 11, exponent, offset);
-    const TetBoxFilter filter(mesh);
     for (std::uint32_t t = 0; t < mesh.tet_count(); ++t) {
-      const geometry::Box exact = mesh.bounds(t), held = filter.bounds(t);
+      const geometry::Box exact = mesh.bounds(t), held = geometry::FloatBox::enclosing(exact).box();
       for (int a = 0; a < 3; ++a) {
         ASSERT_LE(held.lo[a], exact.lo[a]) << "tet " << t;
         ASSERT_GE(held.hi[a], exact.hi[a]) << "tet " << t;

@@ -35,9 +35,8 @@ Vec3 representative_point(const geometry::ContactGeometry& meet) {
   return mean;
 }
 
-std::string point_fields(const std::optional<Vec3>& p) {
-  if (!p) return ",,";
-  return number_field((*p)[0]) + ',' + number_field((*p)[1]) + ',' + number_field((*p)[2]);
+std::string optional_point_fields(const std::optional<Vec3>& p) {
+  return p ? point_fields(*p) : std::string(",,");
 }
 
 // part,part_name,part_path,dynamic_part of the environment side.
@@ -162,9 +161,9 @@ std::string site_fields(const AnswerSite& site, const CollisionIndex& index,
   fields += ',';
   fields += site.object_triangle ? std::to_string(*site.object_triangle) : std::string();
   fields += ',';
-  fields += point_fields(site.on_environment);
+  fields += optional_point_fields(site.on_environment);
   fields += ',';
-  fields += point_fields(site.on_object);
+  fields += optional_point_fields(site.on_object);
   return fields;
 }
 

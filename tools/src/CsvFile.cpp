@@ -17,6 +17,15 @@ std::string number_field(double value) {
   return text;
 }
 
+std::string point_fields(const std::array<double, 3>& point) {
+  std::string fields = number_field(point[0]);
+  fields.append(1, ',')
+      .append(number_field(point[1]))
+      .append(1, ',')
+      .append(number_field(point[2]));
+  return fields;
+}
+
 CsvFile::CsvFile(const std::filesystem::path& path, const std::string& header) : out_(path) {
   out_.write(header);
   out_.write("\n", 1);

@@ -24,10 +24,6 @@ std::string header_of(FlyQuery query) {
   throw InputError("fly: --query collide writes its answers as step,collides");
 }
 
-std::string point_fields(const geometry::Point& p) {
-  return number_field(p[0]) + ',' + number_field(p[1]) + ',' + number_field(p[2]);
-}
-
 const char* shape_name(geometry::ContactShape shape) {
   switch (shape) {
     case geometry::ContactShape::point:

@@ -39,9 +39,10 @@ class IndexReader {
   ///        attribute), has another version, or any of the checks fails; the message names
   ///        the file, the object and the value found.
   explicit IndexReader(const std::filesystem::path& path);
-  /// Opens an index held in memory (HDF5's core driver on a copy of `image`), with the same
-  /// checks; `name` stands for the file in messages. For indexes received as bytes, and for
-  /// fuzzing the reader without a file system.
+  /// Opens an index held in memory (HDF5's core driver), with the same checks; `name` stands
+  /// for the file in messages. The reader holds the image twice (its own copy, which shards are
+  /// read from, and HDF5's): for small indexes received as bytes, and for fuzzing the reader
+  /// without a file system.
   /// @throw FormatError as the constructor above.
   IndexReader(std::span<const std::byte> image, const std::string& name);
   ~IndexReader();

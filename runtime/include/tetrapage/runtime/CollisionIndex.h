@@ -29,8 +29,9 @@ namespace tetrapage {
 /// What a flight's peak resident memory may exceed the shard budget and the process's own
 /// memory before any work (its libraries and threads) by: the coarse mesh and its tables,
 /// read whole at open (the automatic region size keeps the mesh near 100k tets whatever the
-/// model: about 40 MiB at 100M triangles), the object's structures, and the buffers of the
-/// query and the prefetch thread (docs/USAGE.md, "Memory").
+/// model), the object's structures, and the buffers of the query and the prefetch thread: 52
+/// to 59 MiB together at 100M triangles (docs/BENCHMARKS.md, "Memory held beside the shards at
+/// 100M").
 inline constexpr std::uint64_t kRuntimeOverheadAllowance = std::uint64_t(64) << 20;
 
 struct CollisionIndexOptions {

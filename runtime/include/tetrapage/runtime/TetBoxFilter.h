@@ -2,7 +2,7 @@
 /// @file TetBoxFilter.h
 /// What a box search asks of a coarse tet before anything exact: its bounding box, and whether
 /// one of four planes holding the tet leaves the whole box outside. Computed once when an index
-/// opens (80 bytes a tet beyond the box) so that a search reads no corners and forms no normals.
+/// opens (64 bytes a tet beyond the box) so that a search reads no corners and forms no normals.
 
 #include <array>
 #include <cmath>
@@ -47,7 +47,7 @@ class TetBoxFilter {
         const double n = planes.normal[a][k];
         highest += n * centre[a] + std::fabs(n) * half[a];
       }
-      separated |= highest < planes.offset[k] - margin;
+      separated |= highest < double(planes.offset[k]) - margin;
     }
     return !separated;
   }
@@ -66,10 +66,12 @@ class TetBoxFilter {
   static constexpr double kRelativeMargin = 0x1p-45;
   // Face k's normal, pointing into the tet and scaled to about unit 1-norm, rounded to float
   // (any direction would do: the offset is taken from the rounded normal), and an offset no
-  // larger than the smallest value of normal . x over the tet's corners.
+  // larger than the smallest value of normal . x over the tet's corners, rounded down to float
+  // (16 B a tet less, no slower; the boxes stay doubles: floats there made flights in memory 2 %
+  // slower).
   struct Planes {
     std::array<std::array<float, 4>, 3> normal;  ///< normal[axis][face]
-    std::array<double, 4> offset;
+    std::array<float, 4> offset;
   };
   std::vector<geometry::Box> bounds_;
   std::vector<Planes> planes_;

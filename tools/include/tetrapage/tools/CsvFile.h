@@ -3,6 +3,7 @@
 /// A CSV output written under a temporary name and renamed into place by commit(): a run that
 /// fails leaves no partial file behind.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -15,6 +16,8 @@ namespace tetrapage {
 std::string csv_field(const std::string& text);
 /// A number with all its digits (%.17g: reads back to the same double).
 std::string number_field(double value);
+/// A point as three number fields, "x,y,z".
+std::string point_fields(const std::array<double, 3>& point);
 
 class CsvFile {
  public:
