@@ -113,8 +113,8 @@ endfunction()
 
 # What the static libraries call outside themselves, for C++ programs that link them: HDF5's
 # own library (its shared library brings what it needs; the compiler wrapper's list is for
-# static HDF5 links), TBB, Assimp, the OpenCASCADE toolkits, liblz4, GMP (CGAL's exact number
-# types) and MPFR, which CGAL's target links with it. Cflags: tetrapage's public headers
+# static HDF5 links), TBB, liblz4, GMP (CGAL's exact number types), MPFR, which CGAL's target
+# links with it, and libdl (the CAD module, with OpenCASCADE and Assimp, is loaded at run time). Cflags: tetrapage's public headers
 # include the standard library only.
 set(hdf5_library "${HDF5_C_LIBRARIES}")
 list(FILTER hdf5_library INCLUDE REGEX "/libhdf5[^/]*\\.(so|a)")
@@ -122,9 +122,12 @@ list(FILTER hdf5_library EXCLUDE REGEX "/libhdf5_hl[^/]*$")
 if(NOT hdf5_library)
   set(hdf5_library "${HDF5_C_LIBRARIES}")
 endif()
-tetrapage_pc_link_flags(TETRAPAGE_PC_CXX_DEPENDENCIES ${hdf5_library} TBB::tbb assimp::assimp
-                        ${TETRAPAGE_OCCT_LIBRARIES} ${LZ4_LIBRARY} ${MPFR_LIBRARIES}
-                        ${GMP_LIBRARIES} ${CMAKE_THREAD_LIBS_INIT})
+set(dl_flag "")
+if(CMAKE_DL_LIBS)
+  set(dl_flag "-l${CMAKE_DL_LIBS}")
+endif()
+tetrapage_pc_link_flags(TETRAPAGE_PC_CXX_DEPENDENCIES ${hdf5_library} TBB::tbb ${LZ4_LIBRARY}
+                        ${MPFR_LIBRARIES} ${GMP_LIBRARIES} ${CMAKE_THREAD_LIBS_INIT} ${dl_flag})
 foreach(pc tetrapage tetrapage-cpp)
   configure_file(${PROJECT_SOURCE_DIR}/cmake/${pc}.pc.in ${PROJECT_BINARY_DIR}/pkgconfig/${pc}.pc @ONLY)
   install(FILES ${PROJECT_BINARY_DIR}/pkgconfig/${pc}.pc DESTINATION ${TETRAPAGE_INSTALL_PKGCONFIGDIR})

@@ -3,7 +3,6 @@
 
 #include "tetrapage/formats/MeshReader.h"
 
-#include <assimp/cimport.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <algorithm>
@@ -13,6 +12,7 @@
 
 #include "PathSupport.h"
 #include "tetrapage/formats/DeterminantFilter.h"
+#include "CadModule.h"
 #include "ReaderSupport.h"
 
 namespace tetrapage {
@@ -33,7 +33,7 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path) {
   // Before Assimp, whose IFC importer claims .stp and refuses every other STEP schema.
   if (extension == ".iges" || extension == ".igs") return MeshFormat::iges;
   if (is_cad_path(path)) return MeshFormat::step;
-  if (extension.size() > 1 && aiIsExtensionSupported(extension.c_str()) == AI_TRUE)
+  if (extension.size() > 1 && detail::cad_module(path).assimp_imports(extension))
     return MeshFormat::assimp_other;
   throw InputError("'" + path.string() + "': no mesh reader for the extension '" + extension +
                    "' (readable: .obj, .stl, .ply, .off, .gltf, .glb, STEP (.step, .stp), IGES "

@@ -21,6 +21,8 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Quaternion.hxx>
+#include <cstdlib>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -327,6 +329,75 @@ TEST(CadReader, DamagedFilesAreRefusedNamingTheFile) {
   TessellationOptions bad;
   bad.deflection = 0;
   EXPECT_THROW(read_cad(screw, bad), InputError);
+}
+
+}  // namespace
+}  // namespace tetrapage
+
+namespace tetrapage {
+namespace {
+
+// Whether tetrapage's CAD module is mapped into this process.
+bool cad_module_mapped() {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line))
+    if (line.find("/tetrapage_cad.so") != std::string::npos) return true;
+  return false;
+}
+
+const char kTetrahedronPly[] =
+    "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\n"
+    "property double z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n"
+    "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
+// The CAD module (OpenCASCADE, Assimp) is loaded by the first file that needs it, never by a
+// program that reads only our own formats. Each case runs in a new process (the death test's
+// "threadsafe" style executes the test binary again), where nothing has loaded it yet.
+TEST(CadModule, IsLoadedOnlyWhenAFileNeedsIt) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto folder = test::scratch_folder("cad-module-loaded");
+  const auto ply = folder / "tetrahedron.ply";
+  test::write_file(ply, kTetrahedronPly);
+  EXPECT_EXIT(
+      {
+        if (cad_module_mapped()) std::_Exit(1);
+        if (read_mesh(ply).triangles.size() != 4 || cad_module_mapped()) std::_Exit(2);
+        if (read_mesh(kOcctData / "step" / "screw.step").triangles.empty() || !cad_module_mapped())
+          std::_Exit(3);
+        std::_Exit(0);
+      },
+      ::testing::ExitedWithCode(0), "");
+}
+
+// A module that cannot be loaded is an error naming the file that needed it, where the module
+// was looked for and why it failed; never a crash, and our own formats still read.
+TEST(CadModule, OneThatCannotBeLoadedIsAnErrorNamingTheFileAndThePlace) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  const auto folder = test::scratch_folder("cad-module-missing");
+  const auto ply = folder / "tetrahedron.ply";
+  test::write_file(ply, kTetrahedronPly);
+  const auto screw = kOcctData / "step" / "screw.step";
+  for (const auto& [module, why] : {std::pair{folder / "absent.so", std::string("not found")},
+                                    std::pair{ply, std::string("invalid ELF header")}}) {
+    EXPECT_EXIT(
+        {
+          ::setenv("TETRAPAGE_CAD_MODULE", module.c_str(), 1);
+          try {
+            read_mesh(screw);
+          } catch (const IoError& error) {
+            const std::string message = error.what();
+            if (message.find("'" + screw.string() + "'") == std::string::npos ||
+                message.find(module.string()) == std::string::npos ||
+                message.find(why) == std::string::npos)
+              std::_Exit(2);
+            std::_Exit(read_mesh(ply).triangles.size() == 4 ? 0 : 3);
+          }
+          std::_Exit(1);
+        },
+        ::testing::ExitedWithCode(0), "")
+        << module;
+  }
 }
 
 }  // namespace

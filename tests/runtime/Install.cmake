@@ -24,7 +24,7 @@ if(STEP STREQUAL "prefix")
                     ${LIBDIR}/cmake/tetrapage/tetrapageCTargets.cmake
                     ${LIBDIR}/pkgconfig/tetrapage.pc ${LIBDIR}/pkgconfig/tetrapage-cpp.pc
                     ${LIBDIR}/libtetrapage.so ${LIBDIR}/libtetrapage_runtime.a
-                    ${LIBDIR}/libtetrapage_formats.a
+                    ${LIBDIR}/libtetrapage_formats.a ${LIBDIR}/tetrapage/tetrapage_cad.so
                     include/tetrapage/tetrapage.h include/tetrapage/version.h
                     include/tetrapage/runtime/FlyingObject.h include/tetrapage/formats/Error.h
                     bin/tetrapage)

@@ -44,14 +44,17 @@ std::string other_format_named(const std::filesystem::path& path) {
   for (const char* image :
        {".png", ".jpg", ".jpeg", ".bmp", ".gif", ".tif", ".tiff", ".ppm", ".svg"})
     if (extension == image) return "an image";
+  // The index's own extension: no mesh reader (nor the CAD module, which knows Assimp's
+  // extensions) needs asking.
+  if (extension == ".tpi") return {};
   if (extension == ".csv") return "a CSV table";
   if (extension == ".json") return "a JSON file (a manifest or a report)";
   if (extension.size() > 1) {
     try {
       mesh_format_from_path(path);
       return "a mesh";
-    } catch (const InputError&) {
-      // no reader claims it: free for an index
+    } catch (const Error&) {
+      // no reader claims it (or the CAD module that would cannot be loaded): free for an index
     }
   }
   return {};
