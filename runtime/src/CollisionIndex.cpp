@@ -67,7 +67,10 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   reader_.set_spin_before_sleep(std::min(options_.spin_before_sleep, std::chrono::microseconds(100)));
   if (options_.shard_arena) {
     const std::uint64_t most = std::min(options_.memory_budget_bytes, total_shard_bytes_);
-    arena_ = std::make_unique<ShardArena>(std::size_t(most + most / 8));
+    // Room for an eighth of fragmentation between size classes; populated ahead only within
+    // the budget, so that pages past it are resident only when a shard needs them.
+    arena_ = std::make_unique<ShardArena>(std::size_t(most + most / 8), std::size_t(8) << 20,
+                                          std::pmr::new_delete_resource(), std::size_t(most));
   }
   const IndexReader* reader = &reader_;
   std::pmr::memory_resource* memory = arena_.get();

@@ -46,8 +46,11 @@ constexpr std::size_t kClassCount =
 }  // namespace
 
 ShardArena::ShardArena(std::size_t capacity_bytes, std::size_t populate_ahead_bytes,
-                       std::pmr::memory_resource* upstream)
-    : upstream_(upstream), ahead_(populate_ahead_bytes), free_heads_(kClassCount, nullptr) {
+                       std::pmr::memory_resource* upstream, std::size_t populate_limit_bytes)
+    : upstream_(upstream),
+      ahead_(populate_ahead_bytes),
+      populate_limit_(populate_limit_bytes),
+      free_heads_(kClassCount, nullptr) {
 #if defined(__SANITIZE_ADDRESS__)
   // AddressSanitizer sees blocks recycled here as live: leave every shard to malloc so that
   // it still catches a shard used after its eviction.
@@ -132,7 +135,7 @@ void ShardArena::do_deallocate(void* p, std::size_t bytes, std::size_t alignment
 }
 
 std::size_t ShardArena::populate_target() const {
-  return std::min(capacity_, frontier_.load(std::memory_order_relaxed) + ahead_);
+  return std::min({capacity_, populate_limit_, frontier_.load(std::memory_order_relaxed) + ahead_});
 }
 
 void ShardArena::populate(std::stop_token stop) {

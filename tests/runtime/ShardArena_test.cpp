@@ -158,6 +158,46 @@ TEST(ShardArena, PopulatesAheadOfItsFrontier) {
   for (void* p : blocks) arena.deallocate(p, 10000, 8);
 }
 
+// Past its limit (the shard budget) the range is never populated ahead: a page there becomes
+// resident only when a block uses it. Resident pages counted by mincore().
+TEST(ShardArena, PopulatesNoFurtherThanItsLimit) {
+  if (kArenaOff) GTEST_SKIP() << "the arena is off under AddressSanitizer";
+  if (!kernel_populates())
+    GTEST_SKIP() << "this kernel cannot populate ahead (MADV_POPULATE_WRITE)";
+  const std::size_t limit = std::size_t(5) << 20, ahead = std::size_t(3) << 20;
+  ShardArena arena(std::size_t(16) << 20, ahead, std::pmr::new_delete_resource(), limit);
+  std::vector<void*> blocks;
+  const auto resident_pages = [&] {
+    auto* base = static_cast<unsigned char*>(blocks.front());
+    std::vector<unsigned char> pages(arena.capacity() / 4096);
+    EXPECT_EQ(::mincore(base, arena.capacity(), pages.data()), 0);
+    std::size_t count = 0;
+    for (const unsigned char page : pages) count += page & 1;
+    return count;
+  };
+  const auto settle = [&] {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (arena.populated_bytes() < std::min(limit, arena.frontier_bytes() + ahead / 2) &&
+           std::chrono::steady_clock::now() < deadline)
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  };
+  // Frontier at 4 MiB: populated up to the limit, not to 4 + 3 MiB.
+  while (arena.frontier_bytes() < (std::size_t(4) << 20)) blocks.push_back(arena.allocate(65536, 64));
+  settle();
+  EXPECT_LE(arena.populated_bytes(), limit + 4096);
+  EXPECT_LE(resident_pages() * 4096, limit + 4096);
+  EXPECT_GE(resident_pages() * 4096, std::size_t(4) << 20);
+  // Frontier at 9 MiB: past the limit only the pages blocks were written to are resident.
+  while (arena.frontier_bytes() < (std::size_t(9) << 20)) {
+    blocks.push_back(arena.allocate(65536, 64));
+    std::memset(blocks.back(), 1, 65536);
+  }
+  settle();
+  EXPECT_LE(resident_pages() * 4096, arena.frontier_bytes() + 4096);
+  for (void* p : blocks) arena.deallocate(p, 65536, 64);
+}
+
 TEST(ShardArena, NoRangeLeavesEverythingUpstream) {
   CountingResource upstream;
   {

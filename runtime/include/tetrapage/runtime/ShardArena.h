@@ -30,11 +30,14 @@ class ShardArena final : public std::pmr::memory_resource {
  public:
   /// Reserves `capacity_bytes` of address space (rounded up to 2 MiB; nothing is resident
   /// until populated or used) and starts the populating thread, which keeps
-  /// `populate_ahead_bytes` past the frontier faulted in. A capacity of 0, or one the system
-  /// will not map, leaves every request to upstream.
+  /// `populate_ahead_bytes` past the frontier faulted in, but never past the first
+  /// `populate_limit_bytes` of the range (a memory budget: what lies past it is faulted in only
+  /// when a block there is used). A capacity of 0, or one the system will not map, leaves every
+  /// request to upstream.
   explicit ShardArena(std::size_t capacity_bytes,
                       std::size_t populate_ahead_bytes = std::size_t(8) << 20,
-                      std::pmr::memory_resource* upstream = std::pmr::new_delete_resource());
+                      std::pmr::memory_resource* upstream = std::pmr::new_delete_resource(),
+                      std::size_t populate_limit_bytes = SIZE_MAX);
   /// Precondition: every block from the arena has been deallocated.
   ~ShardArena() override;
   ShardArena(const ShardArena&) = delete;
@@ -71,6 +74,7 @@ class ShardArena final : public std::pmr::memory_resource {
   std::byte* base_ = nullptr;
   std::size_t capacity_ = 0;
   const std::size_t ahead_;
+  const std::size_t populate_limit_;
 
   std::mutex mutex_;               // guards the free lists and the frontier's advance
   std::vector<void*> free_heads_;  // per size class: a freed block, which links to the next
