@@ -12,6 +12,8 @@
 
 #include "PathSupport.h"
 #include "tetrapage/formats/DeterminantFilter.h"
+#include "tetrapage/formats/FileChecks.h"
+#include "tetrapage/formats/Manifest.h"
 #include "CadModule.h"
 #include "ReaderSupport.h"
 
@@ -237,6 +239,29 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report,
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return soup;
+}
+
+void load_readers_for(std::span<const std::filesystem::path> inputs) {
+  for (const std::filesystem::path& input : inputs) {
+    std::vector<std::filesystem::path> files;
+    try {
+      files = files_read_from(input);
+    } catch (const Error&) {
+      continue;  // the read names what is wrong with it
+    }
+    for (const std::filesystem::path& file : files) {
+      if (is_manifest_path(file)) continue;
+      MeshFormat format{};
+      try {
+        format = mesh_format_from_path(file);
+      } catch (const InputError&) {
+        continue;
+      }
+      if (format != MeshFormat::obj && format != MeshFormat::stl && format != MeshFormat::ply &&
+          format != MeshFormat::off)
+        detail::cad_module(file);
+    }
+  }
 }
 
 TriangleSoup read_mesh_with_assimp(const std::filesystem::path& path, ReadReport* report) {

@@ -23,6 +23,7 @@
 #include "tetrapage/formats/IndexHeader.h"
 #include "tetrapage/formats/IndexWriter.h"
 #include "tetrapage/formats/MemoryUsage.h"
+#include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/TemporaryFiles.h"
 
 namespace tetrapage {
@@ -118,6 +119,8 @@ PreprocessSummary preprocess(const std::vector<std::filesystem::path>& inputs,
   summary.output = output;
   summary.memory_budget_bytes = options.memory_bytes;
   summary.stale_temporaries_removed = stale;
+  // The readers' libraries (the CAD module) are the process's own, as the others are.
+  load_readers_for(inputs);
   summary.resident_at_start_bytes = resident_bytes();
   reset_peak_resident();  // the run's peak, not the caller's before it
   summary.precision = std::string(to_string(options.precision));

@@ -183,6 +183,8 @@ struct ResidentBesideShards {
 };
 
 void run_fly(const FlyArguments& args) {
+  // The object's reader's libraries (the CAD module) are the process's own, as the others are.
+  load_readers_for(args.objects);
   ResidentBesideShards memory;
   if (args.objects.size() != args.paths.size())
     throw UsageError("fly: " + std::to_string(args.objects.size()) + " --object but " +

@@ -5,6 +5,7 @@
 /// formats Assimp knows go through Assimp, which Debian builds in single precision.
 
 #include <filesystem>
+#include <span>
 
 #include "tetrapage/formats/CadReader.h"
 #include "tetrapage/formats/TriangleSoup.h"
@@ -53,6 +54,14 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = n
 /// @throw IoError if the file cannot be opened; FormatError if Assimp cannot import it
 ///        (its message is included); InputError as read_mesh.
 TriangleSoup read_mesh_with_assimp(const std::filesystem::path& path, ReadReport* report = nullptr);
+
+/// Loads now the libraries that reading `inputs` will load: the CAD module (OpenCASCADE and
+/// Assimp) for STEP, IGES and the formats Assimp imports, named directly or inside manifests. A
+/// memory reading taken after it counts their pages as the process's own (about 30 MiB), as
+/// `fly` and `preprocess` state their promises. Inputs that cannot be listed or have no reader
+/// are left to the read that follows, which names what is wrong.
+/// @throw IoError when the module is needed and cannot be loaded.
+void load_readers_for(std::span<const std::filesystem::path> inputs);
 
 /// What reading a mesh file whole will hold, told before reading it from what is cheap to
 /// know: the counts a PLY or OFF header or a binary STL states, else the file's size at the
