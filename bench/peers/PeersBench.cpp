@@ -24,6 +24,7 @@
 
 #include <oneapi/tbb/global_control.h>
 
+#include "tetrapage/bench/BenchMachine.h"
 #include "tetrapage/bench/CgalCollider.h"
 #include "tetrapage/bench/EmbreePeerCollider.h"
 #include "tetrapage/bench/FclCollider.h"
@@ -179,6 +180,27 @@ std::string fixed(double value, int decimals) {
 }
 std::string mib(double bytes) { return fixed(bytes / double(1 << 20), 1); }
 
+// The machine and every timed build, before the table: a figure is read against both.
+void print_machine_and_builds(const json& machine, const json& builds) {
+  std::printf("- machine: %s, %lld logical cores, %s memory, %s; load average (1, 5, 15 min) %s at start, %s "
+              "at end\n",
+              machine["processor"].get<std::string>().c_str(), machine["logical_cores"].get<long long>(),
+              machine["memory"].get<std::string>().c_str(), machine["kernel"].get<std::string>().c_str(),
+              machine["load_average"].get<std::string>().c_str(),
+              machine["load_average_at_end"].get<std::string>().c_str());
+  for (const auto& build : builds) {
+    std::string what = build["code"].get<std::string>();
+    if (build.contains("compiler"))
+      what += ": " + build["compiler"].get<std::string>() + ", " + build["build_type"].get<std::string>() + " (" +
+              build["flags"].get<std::string>() + "), " + build["built_by"].get<std::string>();
+    else
+      what += " " + build["version"].get<std::string>() + ": " + build["package"].get<std::string>() + ", built by " +
+              build["built_by"].get<std::string>() + ": " + build["flags"].get<std::string>();
+    std::printf("- build of %s\n", what.c_str());
+  }
+  std::printf("\n");
+}
+
 void run_all(const Arguments& args) {
   check_writable(args.report);
   std::vector<std::string> colliders = args.colliders;
@@ -197,6 +219,7 @@ void run_all(const Arguments& args) {
   if (!args.memory.empty()) (void)parse_byte_size(args.memory);  // a bad size fails now, not in a child
 
   const std::size_t steps = read_poses(args.flight).size();
+  json machine = bench::machine_description();
   std::optional<std::vector<std::uint8_t>> oracle;
   std::string oracle_source;
   if (!args.answers.empty()) {
@@ -255,6 +278,9 @@ void run_all(const Arguments& args) {
               args.flight.string().c_str(), args.object.string().c_str(), args.scene.string().c_str(),
               args.warmup ? "one untimed pass before the timed one (paged runs: none, cold)"
                           : "no warm-up pass: each collider is timed from its first pose after its build");
+  machine["load_average_at_end"] = bench::load_average();
+  const json builds = bench::build_description();
+  print_machine_and_builds(machine, builds);
   std::printf("| collider | question | build s | build RSS MiB | structures MiB | peak RSS MiB | steps/s | p50 us | "
               "p95 us | p99 us | max us | collisions | FN / FP vs oracle | FN / FP vs exact, same question |\n");
   std::printf("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
@@ -346,6 +372,8 @@ void run_all(const Arguments& args) {
                                {"steps", steps},
                                {"warmup_pass", args.warmup},
                                {"inside_only_poses", inside_only},
+                               {"machine", machine},
+                               {"builds", builds},
                                {"runs", runs},
                                {"ratios", ratios}});
 }

@@ -258,6 +258,8 @@ commit=$(git -C "$SCRIPTS" rev-parse --short HEAD 2> /dev/null || echo unknown)
     "$(awk '/^MemTotal/ {printf "%.1f GiB", $2 / 2^20}' /proc/meminfo)"
   echo "- commit: $commit; binaries: $TETRAPAGE, $BENCH"
   echo "- load average (1, 5, 15 min) at start: $load_start; at end: $load_end"
+  first_report=$(ls "$OUT"/runs/*-1.json | head -1)
+  json "$first_report" '"\n".join("- build of %s: %s" % (b["code"], (b["compiler"] + ", " + b["build_type"] + " (" + b["flags"] + ")") if "compiler" in b else (b["version"] + ", " + b["package"] + ", built by " + b["built_by"] + ": " + b["flags"])) for b in d["builds"])'
   echo "- $STEPS-pose billiard flights (seed 1) with the oracle's answers; $REPEATS passes over every cell," \
     "figures are medians over the passes; colliders $COLLIDERS, each single-threaded in a process of its own," \
     "the in-memory colliders timed on a second pass over the flight (warm); tetrapage-paged under 10 % of the index" \
