@@ -254,11 +254,10 @@ commit=$(git -C "$SCRIPTS" rev-parse --short HEAD 2> /dev/null || echo unknown)
   echo
   echo "\`bench/scripts/peers_foreign.sh\` (\`make bench-peers\`), $(date -u '+%Y-%m-%d %H:%M UTC'), $((SECONDS - start_seconds)) s."
   echo
-  echo "- machine: $(grep -m1 '^model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $(nproc) cores," \
-    "$(awk '/^MemTotal/ {printf "%.1f GiB", $2 / 2^20}' /proc/meminfo)"
-  echo "- commit: $commit; binaries: $TETRAPAGE, $BENCH"
-  echo "- load average (1, 5, 15 min) at start: $load_start; at end: $load_end"
   first_report=$(ls "$OUT"/runs/*-1.json | head -1)
+  json "$first_report" '"- machine: {processor}, {logical_cores} logical cores, {memory}, {kernel}".format(**d["machine"])'
+  echo "- commit: $commit; binaries: $TETRAPAGE, $BENCH"
+  echo "- load average (1, 5, 15 min) at the run's start: $load_start; at its end: $load_end"
   json "$first_report" '"\n".join("- build of %s: %s" % (b["code"], (b["compiler"] + ", " + b["build_type"] + " (" + b["flags"] + ")") if "compiler" in b else (b["version"] + ", " + b["package"] + ", built by " + b["built_by"] + ": " + b["flags"])) for b in d["builds"])'
   echo "- $STEPS-pose billiard flights (seed 1) with the oracle's answers; $REPEATS passes over every cell," \
     "figures are medians over the passes; colliders $COLLIDERS, each single-threaded in a process of its own," \
