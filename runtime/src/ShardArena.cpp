@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <bit>
 #include <cerrno>
+#include <cstdint>
 #include <functional>
+#include <utility>
 
 #ifndef MADV_POPULATE_WRITE
 #define MADV_POPULATE_WRITE 23  // Linux 5.14's value, for headers older than the kernel
@@ -15,7 +17,10 @@ namespace tetrapage {
 
 namespace {
 
-constexpr std::size_t kSmallestBlock = 512;  // smaller requests are a shard's few tiny arrays
+// Requests up to this size take blocks in steps of 64 bytes (a shard's many tiny arrays: kept
+// in the range too, so that the range holds everything a shard is counted for).
+constexpr std::size_t kSmallestBlock = 512;
+constexpr std::size_t kSmallClasses = kSmallestBlock / 64;
 constexpr std::size_t kLargestBlock = std::size_t(4) << 20;
 constexpr std::size_t kBlockAlignment = 64;
 constexpr std::size_t kClassesPerDoubling = 8;
@@ -25,22 +30,36 @@ constexpr std::size_t kPageBytes = 4096;  // a divisor of every page size Linux 
 // delays the process's own mmap and brk calls until it returns.
 constexpr std::size_t kPopulateStep = std::size_t(256) << 10;
 
-// The class of a request of `bytes` in (kSmallestBlock, kLargestBlock], and its block size:
-// with 2^(p-1) < bytes <= 2^p, blocks of 9/8 .. 16/8 of 2^(p-1) in steps of 2^(p-4) (a
-// multiple of 64 from p = 10 on).
+// The class of a request of `bytes` in (0, kLargestBlock], and its block size: up to 512
+// bytes, multiples of 64; above, with 2^(p-1) < bytes <= 2^p, blocks of 9/8 .. 16/8 of 2^(p-1)
+// in steps of 2^(p-4) (a multiple of 64 from p = 10 on).
 std::size_t size_class(std::size_t bytes, std::size_t& block) {
+  if (bytes <= kSmallestBlock) {
+    block = std::max<std::size_t>(64, (bytes + 63) / 64 * 64);
+    return block / 64 - 1;
+  }
   const unsigned p = unsigned(std::bit_width(bytes - 1));
   const std::size_t step = std::size_t(1) << (p - 4);
   const std::size_t steps = (bytes + step - 1) / step;  // 9 .. 16
   block = steps * step;
-  return (p - 10) * kClassesPerDoubling + (steps - 9);
+  return kSmallClasses + (p - 10) * kClassesPerDoubling + (steps - 9);
+}
+
+// The whole pages of a free block that may go back to the system: all but the first, which
+// holds the block's link in its free list, and the partial pages at either end.
+std::pair<std::byte*, std::size_t> inner_pages(void* p, std::size_t block) {
+  const auto at = reinterpret_cast<std::uintptr_t>(p);
+  const std::uintptr_t from = (at + sizeof(void*) + kPageBytes - 1) / kPageBytes * kPageBytes;
+  const std::uintptr_t to = (at + block) / kPageBytes * kPageBytes;
+  if (to <= from) return {nullptr, 0};
+  return {reinterpret_cast<std::byte*>(from), std::size_t(to - from)};
 }
 
 bool in_classes(std::size_t bytes, std::size_t alignment) {
-  return bytes > kSmallestBlock && bytes <= kLargestBlock && alignment <= kBlockAlignment;
+  return bytes > 0 && bytes <= kLargestBlock && alignment <= kBlockAlignment;
 }
 
-constexpr std::size_t kClassCount =
+constexpr std::size_t kClassCount = kSmallClasses +
     (std::bit_width(kLargestBlock - 1) - std::bit_width(kSmallestBlock) + 1) * kClassesPerDoubling;
 
 }  // namespace
@@ -50,7 +69,8 @@ ShardArena::ShardArena(std::size_t capacity_bytes, std::size_t populate_ahead_by
     : upstream_(upstream),
       ahead_(populate_ahead_bytes),
       populate_limit_(populate_limit_bytes),
-      free_heads_(kClassCount, nullptr) {
+      free_heads_(kClassCount, nullptr),
+      given_back_heads_(kClassCount, nullptr) {
 #if defined(__SANITIZE_ADDRESS__)
   // AddressSanitizer sees blocks recycled here as live: leave every shard to malloc so that
   // it still catches a shard used after its eviction.
@@ -102,6 +122,11 @@ void* ShardArena::do_allocate(std::size_t bytes, std::size_t alignment) {
       if (void* head = free_heads_[c]) {
         free_heads_[c] = *static_cast<void**>(head);
         p = head;
+      } else if (void* given_back = given_back_heads_[c]) {
+        // Its pages fault in again as they are written: only once the range is over its limit.
+        given_back_heads_[c] = *static_cast<void**>(given_back);
+        given_back_.fetch_sub(inner_pages(given_back, block).second, std::memory_order_relaxed);
+        p = given_back;
       } else if (const std::size_t at = frontier_.load(std::memory_order_relaxed);
                  block <= capacity_ - at) {
         p = base_ + at;
@@ -129,9 +154,25 @@ void ShardArena::do_deallocate(void* p, std::size_t bytes, std::size_t alignment
   if (!owns(p)) return upstream_->deallocate(p, bytes, alignment);
   std::size_t block = 0;
   const std::size_t c = size_class(bytes, block);
+  // Over the limit, a freed block's pages go back to the system, before the block is listed
+  // (no other thread can take it yet): the range then holds about the limit resident however
+  // the size classes mix, where free blocks of one class would otherwise keep their pages.
+  std::size_t returned = 0;
+  if (resident_bytes() > populate_limit_) {
+    const auto [pages, length] = inner_pages(p, block);
+    if (length > 0 && ::madvise(pages, length, MADV_DONTNEED) == 0) returned = length;
+  }
   const std::lock_guard lock(mutex_);
-  *static_cast<void**>(p) = free_heads_[c];
-  free_heads_[c] = p;
+  std::vector<void*>& heads = returned > 0 ? given_back_heads_ : free_heads_;
+  *static_cast<void**>(p) = heads[c];
+  heads[c] = p;
+  given_back_.fetch_add(returned, std::memory_order_relaxed);
+}
+
+std::size_t ShardArena::resident_bytes() const {
+  const std::size_t touched = std::max(frontier_.load(std::memory_order_relaxed),
+                                       populated_.load(std::memory_order_relaxed));
+  return touched - std::min(touched, given_back_.load(std::memory_order_relaxed));
 }
 
 std::size_t ShardArena::populate_target() const {

@@ -316,8 +316,9 @@ TEST(FlyingObject, ClearanceContactsOfPrunedObjectsEqualBruteForce) {
   expect_clearance_contacts_equal_brute_force(tetrahedron);
 }
 
-// Real shards decoded into an arena: the same shards, their large arrays in the arena, and
-// their bytes counted as the arena's blocks (at least what they hold, at most an eighth more).
+// Real shards decoded into an arena: the same shards, their arrays in the arena, and their bytes
+// counted as the arena's blocks (at least what they hold, at most an eighth more, or a 64-byte
+// step for each of a shard's 13 arrays).
 TEST(FlyingObject, ShardsDecodeIntoTheArenaAlike) {
   const World world = make_world(Kind::scene, 30000, 500, 50, 11, 200);
   const IndexReader reader(world.index_path);
@@ -334,7 +335,7 @@ TEST(FlyingObject, ShardsDecodeIntoTheArenaAlike) {
       ASSERT_EQ(kept.triangle_id(t), plain.triangle_id(t)) << "shard " << s;
     }
     EXPECT_GE(kept.memory_bytes(), plain.memory_bytes()) << "shard " << s;
-    EXPECT_LE(8 * kept.memory_bytes(), 9 * plain.memory_bytes()) << "shard " << s;
+    EXPECT_LE(8 * kept.memory_bytes(), 9 * plain.memory_bytes() + 8 * 13 * 64) << "shard " << s;
     plain_bytes += plain.memory_bytes();
     kept_bytes += kept.memory_bytes();
   }

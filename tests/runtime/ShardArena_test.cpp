@@ -42,7 +42,9 @@ TEST(ShardArena, BlockSizesWasteAtMostAnEighth) {
   for (std::size_t bytes = 1; bytes <= (std::size_t(5) << 20); bytes += 1 + bytes / 64) {
     const std::size_t block = ShardArena::block_bytes(bytes);
     ASSERT_GE(block, bytes) << bytes;
-    if (bytes > 512 && bytes <= (std::size_t(4) << 20)) {
+    if (bytes <= 512) {
+      EXPECT_EQ(block, std::max<std::size_t>(64, (bytes + 63) / 64 * 64)) << bytes;
+    } else if (bytes <= (std::size_t(4) << 20)) {
       EXPECT_LE(8 * block, 9 * bytes + 8 * 64) << bytes;  // an eighth, or one 64-byte step
       EXPECT_EQ(block % 64, 0u) << bytes;
     } else {
@@ -85,7 +87,7 @@ TEST(ShardArena, ConcurrentBlocksNeverOverlapAndAllComeBack) {
     for (auto& thread : threads) thread.join();
     if (!kArenaOff) {
       EXPECT_GT(arena.arena_blocks(), 0u);
-      EXPECT_GT(arena.upstream_blocks(), 0u);  // small requests, and the range used up
+      EXPECT_GT(arena.upstream_blocks(), 0u);  // the range used up
       EXPECT_LE(arena.frontier_bytes(), arena.capacity());
     }
   }
@@ -109,11 +111,11 @@ TEST(ShardArena, FreedBlocksAreReusedByTheirClass) {
   EXPECT_GT(arena.frontier_bytes(), frontier);
   arena.deallocate(b, 9500, 8);
   arena.deallocate(c, 20000, 8);
-  // Tiny, huge and over-aligned requests go upstream.
+  // Tiny requests take 64-byte steps of the range; huge and over-aligned ones go upstream.
   void* tiny = arena.allocate(100, 8);
   void* huge = arena.allocate(std::size_t(5) << 20, 8);
   void* aligned = arena.allocate(4096, 4096);
-  EXPECT_FALSE(arena.owns(tiny));
+  EXPECT_TRUE(arena.owns(tiny));
   EXPECT_FALSE(arena.owns(huge));
   EXPECT_FALSE(arena.owns(aligned));
   arena.deallocate(tiny, 100, 8);
@@ -196,6 +198,53 @@ TEST(ShardArena, PopulatesNoFurtherThanItsLimit) {
   settle();
   EXPECT_LE(resident_pages() * 4096, arena.frontier_bytes() + 4096);
   for (void* p : blocks) arena.deallocate(p, 65536, 64);
+}
+
+// Blocks of one size fill the limit and are freed; blocks of another size then take the range
+// past it. Freed past the limit, those give their pages back: the range stays near its limit
+// resident, and a block taken again from them holds what is written to it.
+TEST(ShardArena, FreedBlocksGiveTheirPagesBackPastTheLimit) {
+  if (kArenaOff) GTEST_SKIP() << "the arena is off under AddressSanitizer";
+  const std::size_t limit = std::size_t(4) << 20, small = 65536, large = 100000;
+  ShardArena arena(std::size_t(16) << 20, 0, std::pmr::new_delete_resource(), limit);
+  const auto resident = [&](void* first) {
+    std::vector<unsigned char> pages(arena.capacity() / 4096);
+    EXPECT_EQ(::mincore(first, arena.capacity(), pages.data()), 0);
+    std::size_t count = 0;
+    for (const unsigned char page : pages) count += page & 1;
+    return count * 4096;
+  };
+  const auto fill = [&](std::size_t bytes, std::size_t total, unsigned char pattern) {
+    std::vector<void*> blocks;
+    for (std::size_t sum = 0; sum < total; sum += bytes) {
+      blocks.push_back(arena.allocate(bytes, 64));
+      std::memset(blocks.back(), pattern, bytes);
+    }
+    return blocks;
+  };
+  std::vector<void*> smalls = fill(small, limit, 1);
+  void* const first = smalls.front();
+  for (void* p : smalls) arena.deallocate(p, small, 64);
+  // Under the limit, freed blocks keep their pages for the next block of their size.
+  EXPECT_GE(resident(first), limit);
+  std::vector<void*> larges = fill(large, limit, 2);
+  EXPECT_GE(resident(first), 2 * limit - 4096);
+  for (void* p : larges) arena.deallocate(p, large, 64);
+  // Each block keeps the page holding its link and the page it shares with the next.
+  const std::size_t kept = larges.size() * 2 * 4096;
+  EXPECT_LE(resident(first), limit + kept) << "frontier " << arena.frontier_bytes();
+  EXPECT_LE(resident(first), arena.resident_bytes());
+  EXPECT_LE(arena.resident_bytes(), limit + kept);
+  // Taken again, the blocks that gave their pages back read what is written to them.
+  const std::size_t frontier = arena.frontier_bytes();
+  larges = fill(large, limit, 3);
+  for (void* p : larges) {
+    const auto* bytes = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < large; i += 4093) ASSERT_EQ(bytes[i], 3) << i;
+  }
+  EXPECT_EQ(arena.frontier_bytes(), frontier) << "the blocks were reused";
+  for (void* p : larges) arena.deallocate(p, large, 64);
+  EXPECT_LE(resident(first), limit + kept);
 }
 
 TEST(ShardArena, NoRangeLeavesEverythingUpstream) {

@@ -9,9 +9,11 @@
 /// arena reserves one range of address space, keeps the next few MiB past its frontier
 /// populated from a background thread (madvise MADV_POPULATE_WRITE), and recycles freed blocks
 /// by size class (eight classes per doubling, so a block wastes at most an eighth), as a
-/// database's buffer pool keeps its frames.
+/// database's buffer pool keeps its frames. Once the range holds more than its limit
+/// resident (free blocks of one class cannot serve another), freed blocks give their pages
+/// back to the system, so that it holds about the limit whatever the mix of sizes.
 ///
-/// Requests outside the classes (under 512 bytes, over 4 MiB, alignment over 64), and any when
+/// Requests outside the classes (over 4 MiB, alignment over 64), and any when
 /// the range is used up, go to the upstream resource. Thread-safe.
 
 #include <atomic>
@@ -50,6 +52,9 @@ class ShardArena final : public std::pmr::memory_resource {
   std::size_t capacity() const { return capacity_; }
   /// Bytes of the range handed out at least once (freed blocks are kept for reuse).
   std::size_t frontier_bytes() const { return frontier_.load(std::memory_order_relaxed); }
+  /// Bytes of the range that may be resident: handed out or populated, less the pages freed
+  /// blocks gave back.
+  std::size_t resident_bytes() const;
   /// Bytes of the range faulted in by the populating thread.
   std::size_t populated_bytes() const { return populated_.load(std::memory_order_acquire); }
   /// False when the kernel cannot populate ahead (before Linux 5.14): pages then fault on
@@ -78,6 +83,8 @@ class ShardArena final : public std::pmr::memory_resource {
 
   std::mutex mutex_;               // guards the free lists and the frontier's advance
   std::vector<void*> free_heads_;  // per size class: a freed block, which links to the next
+  std::vector<void*> given_back_heads_;  // the same, for blocks whose pages went back
+  std::atomic<std::size_t> given_back_{0};  // bytes of those pages
   std::atomic<std::size_t> frontier_{0};
   std::atomic<std::uint64_t> arena_blocks_{0}, upstream_blocks_{0};
 
