@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 
 namespace tetrapage {
 
@@ -57,7 +58,6 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   const std::uint32_t listed_parts =
       component_part_.empty() ? 0 : *std::max_element(component_part_.begin(), component_part_.end()) + 1;
   parts_ = IndexParts::read(reader_, listed_parts);
-  read_shard_id_ranges(where);
   stores_input_coordinates_ = header().precision != "float";
   read_interiors(where);
   ShardCacheOptions cache_options;
@@ -163,19 +163,25 @@ void CollisionIndex::read_interiors(const std::string& where) {
   interior_offsets_ = std::move(offsets);
 }
 
-void CollisionIndex::read_shard_id_ranges(const std::string& where) {
-  if (!reader_.has_table(schema::table::shard_id_ranges)) return;  // an index from before the table
-  shard_id_ranges_ = reader_.read_table_uint64(schema::table::shard_id_ranges);
-  if (shard_id_ranges_.size() != 2 * std::size_t(shard_count()))
-    throw FormatError(where + schema::table_path(schema::table::shard_id_ranges) + " has " +
-                      std::to_string(shard_id_ranges_.size()) + " values for " + std::to_string(shard_count()) +
-                      " shards (2 each)");
+const std::vector<std::uint64_t>& CollisionIndex::shard_id_ranges() const {
+  // Read on first use: only id lookups need them, and they are 16 bytes a shard.
+  std::call_once(shard_id_ranges_read_, [this] {
+    if (!reader_.has_table(schema::table::shard_id_ranges)) return;  // an index from before the table
+    std::vector<std::uint64_t> ranges = reader_.read_table_uint64(schema::table::shard_id_ranges);
+    if (ranges.size() != 2 * std::size_t(shard_count()))
+      throw FormatError(reader_.path().string() + ": " + schema::table_path(schema::table::shard_id_ranges) +
+                        " has " + std::to_string(ranges.size()) + " values for " +
+                        std::to_string(shard_count()) + " shards (2 each)");
+    shard_id_ranges_ = std::move(ranges);
+  });
+  return shard_id_ranges_;
 }
 
 std::optional<CollisionIndex::StoredTriangle> CollisionIndex::stored_triangle(std::uint64_t id) const {
   if (id >= header().input_triangles) return std::nullopt;
+  const std::vector<std::uint64_t>& ranges = shard_id_ranges();
   for (std::uint32_t shard = 0; shard < shard_count(); ++shard) {
-    if (!shard_id_ranges_.empty() && (id < shard_id_ranges_[2 * shard] || id > shard_id_ranges_[2 * shard + 1]))
+    if (!ranges.empty() && (id < ranges[2 * shard] || id > ranges[2 * shard + 1]))
       continue;
     const auto pin = cache_->acquire(shard);
     for (std::uint32_t local = 0; local < pin->triangle_count(); ++local)

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <vector>
@@ -97,6 +98,8 @@ class CollisionIndex {
   void preload(const std::function<void(std::uint32_t)>& progress = {}) const;
 
   ShardCache<Shard>& cache() const { return *cache_; }
+  /// The memory the shards are decoded into; null under `shard_arena = false`.
+  const ShardArena* shard_arena() const { return arena_.get(); }
 
   /// The connected components of the parts' surfaces (SurfaceComponents.h): the ids that
   /// Shard::component_id returns. A component's part, whether it is closed, and its box.
@@ -153,7 +156,9 @@ class CollisionIndex {
   void check_budget_fits_shards() const;
   void read_components(const std::string& where);
   void read_interiors(const std::string& where);
-  void read_shard_id_ranges(const std::string& where);
+  // Each shard's smallest and largest triangle id (2 per shard), or empty for an index from
+  // before the table. @throw FormatError for a table of the wrong length.
+  const std::vector<std::uint64_t>& shard_id_ranges() const;
 
   IndexReader reader_;
   CollisionIndexOptions options_;
@@ -169,7 +174,8 @@ class CollisionIndex {
   std::vector<std::uint8_t> component_closed_;
   std::vector<geometry::Box> component_bounds_;
   IndexParts parts_;
-  std::vector<std::uint64_t> shard_id_ranges_;  // 2 per shard, or empty
+  mutable std::once_flag shard_id_ranges_read_;
+  mutable std::vector<std::uint64_t> shard_id_ranges_;  // read on first use
   std::vector<geometry::Point> reference_points_;
   std::vector<std::uint64_t> interior_offsets_;
   std::vector<std::uint32_t> interior_components_;
