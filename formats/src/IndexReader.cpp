@@ -860,6 +860,9 @@ struct IndexReader::Impl {
   template <class T>
   std::vector<T> read_table(std::string_view name) const {
     detail::enter_hdf5();
+    // A table read lazily (CollisionIndex's id ranges) may meet a prefetching thread's page-in:
+    // HDF5 is not thread-safe.
+    const std::lock_guard lock(chunk_read_mutex());
     if (!std::binary_search(tables.begin(), tables.end(), name))
       format_error("table '/tables/" + std::string(name) + "' is missing");
     const auto expected = expected_lengths.find(name);

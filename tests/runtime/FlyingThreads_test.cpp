@@ -62,8 +62,9 @@ std::vector<Pose> random_walk(std::size_t steps, std::uint64_t seed) {
   return poses;
 }
 
-TEST(FlyingThreads, SeveralObjectsAgreeWithOneUnderASharedBudget) {
-  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / "flying-threads";
+// The index of tetrahedra(1500, 3) in `name`/tetrahedra.tpi, exact, in regions of 150 triangles.
+fs::path tetrahedra_index(const std::string& name) {
+  const fs::path folder = fs::path(TETRAPAGE_TEST_TMP) / name;
   fs::remove_all(folder);
   fs::create_directories(folder);
   write_mesh(folder / "tetrahedra.ply", tetrahedra(1500, 3));
@@ -71,6 +72,11 @@ TEST(FlyingThreads, SeveralObjectsAgreeWithOneUnderASharedBudget) {
   options.region_triangles = 150;
   options.precision = StoredPrecision::float64;
   preprocess({folder / "tetrahedra.ply"}, folder / "tetrahedra.tpi", options);
+  return folder;
+}
+
+TEST(FlyingThreads, SeveralObjectsAgreeWithOneUnderASharedBudget) {
+  const fs::path folder = tetrahedra_index("flying-threads");
 
   const TriangleSoup object = octahedron(0.04);
   const std::vector<Pose> poses = random_walk(600, 5);
@@ -116,6 +122,37 @@ TEST(FlyingThreads, SeveralObjectsAgreeWithOneUnderASharedBudget) {
   for (auto& thread : threads) thread.join();
   for (int t = 0; t < kThreads; ++t) EXPECT_EQ(answers[t], alone) << "thread " << t;
   EXPECT_LE(index->cache().peak_resident_bytes(), shared.memory_budget_bytes);
+}
+
+// The shards' id ranges are read on the first id lookup, here while another thread pages shards
+// in under a small budget (HDF5 is not thread-safe): every lookup finds the triangle written.
+TEST(FlyingThreads, IdLookupsWhileAnotherThreadPagesIn) {
+  const fs::path folder = tetrahedra_index("flying-threads-lookups");
+  const TriangleSoup soup = tetrahedra(1500, 3);
+  CollisionIndexOptions paged;
+  paged.memory_budget_bytes = CollisionIndex(folder / "tetrahedra.tpi").total_shard_bytes() / 6;
+  auto index = std::make_shared<const CollisionIndex>(folder / "tetrahedra.tpi", paged);
+  std::thread flier([&] {
+    FlyingObject flying(index, octahedron(0.04));
+    for (const Pose& pose : random_walk(600, 5)) {
+      for (int attempt = 0;; ++attempt) {
+        try {
+          flying.query(pose);
+          break;
+        } catch (const InputError&) {
+          if (attempt == 3) throw;  // the budget was momentarily full of the lookups' pins
+        }
+      }
+    }
+  });
+  std::mt19937_64 random(7);
+  for (int k = 0; k < 200; ++k) {
+    const std::uint64_t id = random() % soup.triangle_count();
+    const auto stored = index->stored_triangle(id);
+    ASSERT_TRUE(stored) << id;
+    EXPECT_EQ(stored->corners, soup.corners(id)) << id;
+  }
+  flier.join();
 }
 
 }  // namespace
