@@ -56,7 +56,7 @@ bool SearchedRegion::search(const geometry::Box& box, const std::optional<Vec3>&
     // A shard's triangles that meet a step's box there meet it inside the shard's tet, or
     // inside another tet of the region (whose shard holds them too): a step needs the shard
     // only when its box meets both the tet's box and the stored bounds.
-    const geometry::Box& tet_box = index.tet_filter().bounds(tet);
+    const geometry::Box tet_box = index.tet_filter().bounds(tet);
     const geometry::Box& stored = index.shard_bounds(shard);
     geometry::Box reach;
     for (int a = 0; a < 3; ++a) {

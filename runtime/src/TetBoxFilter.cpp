@@ -17,7 +17,7 @@ TetBoxFilter::TetBoxFilter(const TetMesh& mesh) {
   bounds_.resize(mesh.tet_count());
   planes_.resize(mesh.tet_count());
   for (std::uint32_t t = 0; t < mesh.tet_count(); ++t) {
-    bounds_[t] = mesh.bounds(t);
+    bounds_[t] = geometry::FloatBox::enclosing(mesh.bounds(t));
     const geometry::Tetrahedron corners = mesh.corners(t);
     double corner_magnitude = 0;
     for (const auto& p : corners)

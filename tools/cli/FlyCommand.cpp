@@ -206,12 +206,14 @@ void run_fly(const FlyArguments& args) {
   query_options.max_contacts = args.max_contacts;
   const CollisionIndexOptions index_options = fly_index_options(args);
 
-  const TriangleSoup object_mesh = load_object(args, args.objects[0]);
+  TriangleSoup object_mesh = load_object(args, args.objects[0]);
   const std::vector<Pose> poses = read_poses(args.paths[0]);
   AnswerCheck check(args.check, poses.size(), "fly");
   const auto open_start = std::chrono::steady_clock::now();
-  // The object's structures do not need the index: build them while it opens.
-  auto model = std::async(std::launch::async, [&] { return std::make_shared<const ObjectModel>(object_mesh); });
+  // The object's structures do not need the index: build them while it opens (the model keeps
+  // the mesh: no second copy).
+  auto model = std::async(std::launch::async,
+                          [&] { return std::make_shared<const ObjectModel>(std::move(object_mesh)); });
   auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   FlyingObject object(index, model.get());
   object.set_obstacles(load_obstacles(args, index));
