@@ -198,12 +198,17 @@ BoxSearchResult search(const TetMesh& mesh, const TetBoxFilter* filter, std::uin
   found.clear();
   BoxSearchResult result;
   if (geometry::inverted(box)) return result;
-  // The exact search has no filter: it computes the boxes.
-  const auto bounds = [&](std::uint32_t tet) { return filter == nullptr ? mesh.bounds(tet) : filter->bounds(tet); };
+  // The exact search has no filter: it computes the boxes. The filter's are floats, compared
+  // with the box rounded outward to floats once.
+  const geometry::FloatBox float_box = geometry::FloatBox::enclosing(box);
+  const auto bounds_overlap = [&](std::uint32_t tet) {
+    if constexpr (kExact) return geometry::boxes_overlap(mesh.bounds(tet), box);
+    else return filter->bounds_overlap(tet, float_box);
+  };
   const double box_magnitude = TetBoxFilter::magnitude(box);
   const auto meets = [&](std::uint32_t tet) {
     if constexpr (kExact) return geometry::tetrahedron_intersects_box(mesh.corners(tet), box);
-    else return geometry::boxes_overlap(bounds(tet), box) && filter->planes_may_meet(tet, box, box_magnitude);
+    else return bounds_overlap(tet) && filter->planes_may_meet(tet, box, box_magnitude);
   };
   if (!meets(start_tet))
     throw InputError("box search: start tet " + std::to_string(start_tet) +
@@ -228,7 +233,7 @@ BoxSearchResult search(const TetMesh& mesh, const TetBoxFilter* filter, std::uin
       if (next == TetMesh::no_neighbour || stamps[next] == stamp) continue;
       stamps[next] = stamp;
       ++result.tets_visited;
-      if (!geometry::boxes_overlap(bounds(next), box)) continue;
+      if (!bounds_overlap(next)) continue;
       if constexpr (kExact) {
         ++result.exact_tests;
         if (!geometry::tetrahedron_intersects_box(mesh.corners(next), box)) continue;

@@ -229,7 +229,7 @@ void check_search(const TetMesh& mesh, const TetBoxFilter& filter, const Box& bo
   if (!missed.empty() || !extra.empty()) ++failures;
 
   // The cheap search (the flying object's region) keeps every tet that meets the box; what it
-  // keeps beyond them has a bounding box, rounded outward to floats, that meets it.
+  // keeps beyond them has a bounding box that meets it, both rounded outward to floats.
   const BoxSearchResult near = tets_near_box(mesh, filter, start, box, scratch);
   std::vector<std::uint32_t> near_tets(near.tets.begin(), near.tets.end());
   std::sort(near_tets.begin(), near_tets.end());
@@ -240,7 +240,8 @@ void check_search(const TetMesh& mesh, const TetBoxFilter& filter, const Box& bo
                                    << ": the near search missed " << near_missed.size() << " of "
                                    << expected.size() << " tets meeting it";
   for (const std::uint32_t tet : near_tets)
-    EXPECT_TRUE(geometry::boxes_overlap(geometry::FloatBox::enclosing(mesh.bounds(tet)).box(), box))
+    EXPECT_TRUE(geometry::boxes_overlap(geometry::FloatBox::enclosing(mesh.bounds(tet)).box(),
+                                        geometry::FloatBox::enclosing(box).box()))
         << what << ": near tet " << tet;
   EXPECT_EQ(near.exact_tests, 0u);
   if (!near_missed.empty()) ++failures;

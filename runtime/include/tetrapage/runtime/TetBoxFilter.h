@@ -26,6 +26,13 @@ class TetBoxFilter {
   /// A box holding the tet (its bounding box rounded outward to floats; `tet` < tet_count(),
   /// unchecked).
   geometry::Box bounds(std::uint32_t tet) const { return bounds_[tet].box(); }
+  /// Whether the tet's box meets `query` (a box rounded outward to floats, once for a search
+  /// that asks many tets: no conversion per tet).
+  bool bounds_overlap(std::uint32_t tet, const geometry::FloatBox& query) const {
+    const geometry::FloatBox& b = bounds_[tet];
+    return b.lo[0] <= query.hi[0] && query.lo[0] <= b.hi[0] && b.lo[1] <= query.hi[1] &&
+           query.lo[1] <= b.hi[1] && b.lo[2] <= query.hi[2] && query.lo[2] <= b.hi[2];
+  }
   /// False only when the box lies strictly outside one of the tet's face planes (including
   /// every rounding): true for every tet that meets the box. `box` must be finite.
   bool planes_may_meet(std::uint32_t tet, const geometry::Box& box) const {
