@@ -85,8 +85,17 @@ TEST_F(CommandReports, FlyWritesTheFiguresOfWhatItRan) {
               false, "fly");
   expect_keys(plain,
               {"collisions", "containments", "contacts", "steps_outside_model", "per_step",
-               "prefetch_loads", "prefetch_hits", "prefetch_ahead", "budget_bytes"},
+               "near_steps", "per_near_step", "prefetch_loads", "prefetch_hits", "prefetch_ahead",
+               "budget_bytes"},
               true, "fly");
+  // Only near steps touch shards: the per-step and per-near-step shard counts agree.
+  const auto near_steps = plain.at("near_steps").get<std::uint64_t>();
+  EXPECT_GT(near_steps, 0u);
+  EXPECT_LE(near_steps, plain.at("steps").get<std::uint64_t>());
+  EXPECT_NEAR(plain.at("per_near_step").at("shards_touched").get<double>() * double(near_steps),
+              plain.at("per_step").at("shards_touched").get<double>() *
+                  plain.at("steps").get<double>(),
+              1e-6 * plain.at("steps").get<double>());
   EXPECT_EQ(plain.at("budget_bytes").get<std::uint64_t>(), kDefaultMemoryBudget)
       << "the default --memory";
   EXPECT_GT(plain.at("collisions").get<std::uint64_t>(), 0u);
@@ -106,8 +115,10 @@ TEST_F(CommandReports, FlyWritesTheFiguresOfWhatItRan) {
   // Distance answers through its own result: no collision-query counters, its own figures.
   const json distance = report_of(kFly + " --query distance --max-distance 0.01");
   expect_keys(distance, {"query_answers"}, true, "fly --query distance");
-  expect_keys(distance, {"containments", "contacts", "steps_outside_model", "per_step"}, false,
-              "fly --query distance");
+  expect_keys(distance,
+              {"containments", "contacts", "steps_outside_model", "per_step", "near_steps",
+               "per_near_step"},
+              false, "fly --query distance");
   const json& answers = distance.at("query_answers");
   EXPECT_EQ(answers.at("touching").get<std::uint64_t>() + answers.at("apart").get<std::uint64_t>() +
                 answers.at("farther").get<std::uint64_t>(),

@@ -190,6 +190,51 @@ struct ResidentBesideShards {
   }
 };
 
+// What a flight's steps did, summed: per step, and per near step (one that touched a shard:
+// the object's box met a shard's reach and its own-frame box, so phase I ran over the shard).
+struct StepTotals {
+  std::uint64_t steps = 0, near_steps = 0;
+  std::uint64_t tets_visited = 0, shards_touched = 0, candidates = 0, triangle_tests = 0;
+  std::uint64_t near_candidates = 0, near_triangle_tests = 0;  // dynamic obstacles give others
+
+  void add(const StepCounters& counters) {
+    ++steps;
+    tets_visited += counters.tets_visited;
+    shards_touched += counters.shards_touched;
+    candidates += counters.candidates;
+    triangle_tests += counters.triangle_tests;
+    if (counters.shards_touched == 0) return;
+    ++near_steps;
+    near_candidates += counters.candidates;
+    near_triangle_tests += counters.triangle_tests;
+  }
+  std::string statement() const {
+    const double all = double(std::max<std::uint64_t>(steps, 1));
+    const double near = double(std::max<std::uint64_t>(near_steps, 1));
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; "
+                  "near steps (a shard touched) %.1f %%: %.1f shards, %.1f candidates, %.1f triangle tests each",
+                  double(tets_visited) / all, double(shards_touched) / all, double(candidates) / all,
+                  double(triangle_tests) / all, 100.0 * double(near_steps) / all,
+                  double(shards_touched) / near, double(near_candidates) / near,
+                  double(near_triangle_tests) / near);
+    return text;
+  }
+  void add_to(nlohmann::json& report) const {
+    const double all = double(std::max<std::uint64_t>(steps, 1));
+    const double near = double(std::max<std::uint64_t>(near_steps, 1));
+    report["per_step"] = {{"tets_visited", double(tets_visited) / all},
+                          {"shards_touched", double(shards_touched) / all},
+                          {"candidates", double(candidates) / all},
+                          {"triangle_tests", double(triangle_tests) / all}};
+    report["near_steps"] = near_steps;
+    report["per_near_step"] = {{"shards_touched", double(shards_touched) / near},
+                               {"candidates", double(near_candidates) / near},
+                               {"triangle_tests", double(near_triangle_tests) / near}};
+  }
+};
+
 void run_fly(const FlyArguments& args) {
   // The object's reader's libraries (the CAD module) are the process's own, as the others are.
   load_readers_for(args.objects);
@@ -239,7 +284,7 @@ void run_fly(const FlyArguments& args) {
   std::vector<std::uint8_t> answers(poses.size());
   std::vector<double> seconds(poses.size());
   std::uint64_t collisions = 0, outside = 0, contacts = 0, containments = 0;
-  std::uint64_t candidates = 0, triangle_tests = 0, tets_visited = 0, shards_touched = 0;
+  StepTotals totals;
   Progress progress("flying", poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) {
     const auto start = std::chrono::steady_clock::now();
@@ -251,10 +296,7 @@ void run_fly(const FlyArguments& args) {
     containments += result.containment != Containment::none ? 1 : 0;
     contacts += result.contacts.size();
     outside += result.outside_model ? 1 : 0;
-    candidates += result.counters.candidates;
-    triangle_tests += result.counters.triangle_tests;
-    tets_visited += result.counters.tets_visited;
-    shards_touched += result.counters.shards_touched;
+    totals.add(result.counters);
     check.record(i, answers[i]);
     if (contact_file) contact_file->write_step(i, object, result);
     progress.advance();
@@ -287,10 +329,7 @@ void run_fly(const FlyArguments& args) {
               format_byte_size(cache.peak_resident_bytes).c_str(), format_byte_size(index_options.memory_budget_bytes).c_str(),
               format_byte_size(index->total_shard_bytes()).c_str(), (unsigned long long)cache.page_ins,
               format_byte_size(cache.bytes_loaded).c_str(), hit_rate, cache.page_in_p50_us, cache.page_in_p99_us);
-  if (step.collision_query())
-    std::printf("per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; ",
-                double(tets_visited) / steps, double(shards_touched) / steps,
-                double(candidates) / steps, double(triangle_tests) / steps);
+  if (step.collision_query()) std::printf("%s\n", totals.statement().c_str());
   const std::uint64_t peak_rss = peak_resident_bytes();
   std::printf("peak RSS %s\n%s\n", format_byte_size(peak_rss).c_str(),
               memory.statement(peak_rss, cache.peak_resident_bytes, index_options.memory_budget_bytes).c_str());
@@ -345,10 +384,7 @@ void run_fly(const FlyArguments& args) {
       report["containments"] = containments;
       report["contacts"] = contacts;
       report["steps_outside_model"] = outside;
-      report["per_step"] = {{"tets_visited", double(tets_visited) / steps},
-                            {"shards_touched", double(shards_touched) / steps},
-                            {"candidates", double(candidates) / steps},
-                            {"triangle_tests", double(triangle_tests) / steps}};
+      totals.add_to(report);
     } else {
       report["query_answers"] = step.report();
     }
