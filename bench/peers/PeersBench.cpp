@@ -326,11 +326,17 @@ void run_all(const Arguments& args) {
     const auto& phase = f["phase_seconds"];
     const double phases = std::max(1e-12, phase["locate"].get<double>() + phase["search"].get<double>() +
                                               phase["shards"].get<double>() + phase["tests"].get<double>());
+    const auto& per_near_step = f["per_near_step"];
     std::printf("  per step: searched %.1f %% of steps, %.1f tets visited, %.2f shards, %.1f candidates, %.1f "
-                "triangle tests; time in locate %.0f %%, search %.0f %%, shards %.0f %%, tests %.0f %%\n",
+                "triangle tests; near steps (a shard touched) %.1f %%: %.1f shards each; time in locate %.0f %%, "
+                "search %.0f %%, shards %.0f %%, tests %.0f %%\n",
                 100 * per_step["searched"].get<double>(), per_step["tets_visited"].get<double>(),
                 per_step["shards_touched"].get<double>(), per_step["candidates"].get<double>(),
-                per_step["triangle_tests"].get<double>(), 100 * phase["locate"].get<double>() / phases,
+                per_step["triangle_tests"].get<double>(),
+                // Only near steps touch shards: their share is the ratio of the two shard counts.
+                100 * per_step["shards_touched"].get<double>() /
+                    std::max(1e-12, per_near_step["shards_touched"].get<double>()),
+                per_near_step["shards_touched"].get<double>(), 100 * phase["locate"].get<double>() / phases,
                 100 * phase["search"].get<double>() / phases, 100 * phase["shards"].get<double>() / phases,
                 100 * phase["tests"].get<double>() / phases);
   }

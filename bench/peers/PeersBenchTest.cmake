@@ -72,6 +72,13 @@ foreach(i RANGE ${last})
     message(FATAL_ERROR "${name} (${question}) disagrees with the oracle on ${fn_oracle} / ${fp_oracle} poses "
                         "(FN / FP); only the ${expected_fn} poses with the object inside an obstacle are explained")
   endif()
+  if(name MATCHES "^tetrapage")
+    # The runtime's runs say how many shards a near step touched (issue 36 reads it).
+    string(JSON near_shards GET "${report}" runs ${i} figures per_near_step shards_touched)
+    if(NOT near_shards GREATER 0)
+      message(FATAL_ERROR "${name} reports ${near_shards} shards a near step")
+    endif()
+  endif()
   if(name STREQUAL "cgal")
     string(JSON collisions GET "${report}" runs ${i} collisions)
     if(NOT collisions EQUAL oracle_collisions)

@@ -24,6 +24,7 @@
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/LatencySummary.h"
 #include "tetrapage/tools/QueryAnswerFile.h"
+#include "tetrapage/tools/StepTotals.h"
 
 namespace tetrapage::cli {
 
@@ -187,51 +188,6 @@ struct ResidentBesideShards {
     report["resident_after_open_bytes"] = opened;
     report["promised_peak_bytes"] = promised(budget);
     report["promise_exceeded_bytes"] = peak > promised(budget) ? peak - promised(budget) : 0;
-  }
-};
-
-// What a flight's steps did, summed: per step, and per near step (one that touched a shard:
-// the object's box met a shard's reach and its own-frame box, so phase I ran over the shard).
-struct StepTotals {
-  std::uint64_t steps = 0, near_steps = 0;
-  std::uint64_t tets_visited = 0, shards_touched = 0, candidates = 0, triangle_tests = 0;
-  std::uint64_t near_candidates = 0, near_triangle_tests = 0;  // dynamic obstacles give others
-
-  void add(const StepCounters& counters) {
-    ++steps;
-    tets_visited += counters.tets_visited;
-    shards_touched += counters.shards_touched;
-    candidates += counters.candidates;
-    triangle_tests += counters.triangle_tests;
-    if (counters.shards_touched == 0) return;
-    ++near_steps;
-    near_candidates += counters.candidates;
-    near_triangle_tests += counters.triangle_tests;
-  }
-  std::string statement() const {
-    const double all = double(std::max<std::uint64_t>(steps, 1));
-    const double near = double(std::max<std::uint64_t>(near_steps, 1));
-    char text[320];
-    std::snprintf(text, sizeof text,
-                  "per step: %.1f tets visited, %.2f shards, %.1f candidates, %.1f triangle tests; "
-                  "near steps (a shard touched) %.1f %%: %.1f shards, %.1f candidates, %.1f triangle tests each",
-                  double(tets_visited) / all, double(shards_touched) / all, double(candidates) / all,
-                  double(triangle_tests) / all, 100.0 * double(near_steps) / all,
-                  double(shards_touched) / near, double(near_candidates) / near,
-                  double(near_triangle_tests) / near);
-    return text;
-  }
-  void add_to(nlohmann::json& report) const {
-    const double all = double(std::max<std::uint64_t>(steps, 1));
-    const double near = double(std::max<std::uint64_t>(near_steps, 1));
-    report["per_step"] = {{"tets_visited", double(tets_visited) / all},
-                          {"shards_touched", double(shards_touched) / all},
-                          {"candidates", double(candidates) / all},
-                          {"triangle_tests", double(triangle_tests) / all}};
-    report["near_steps"] = near_steps;
-    report["per_near_step"] = {{"shards_touched", double(shards_touched) / near},
-                               {"candidates", double(near_candidates) / near},
-                               {"triangle_tests", double(near_triangle_tests) / near}};
   }
 };
 

@@ -40,12 +40,7 @@ std::string TetrapageCollider::description() const {
 bool TetrapageCollider::collides(const Pose& pose) {
   object_.query(pose, query_options_, result_);
   const StepCounters& c = result_.counters;
-  ++steps_;
-  searched_steps_ += c.searched ? 1 : 0;
-  tets_visited_ += c.tets_visited;
-  shards_touched_ += c.shards_touched;
-  candidates_ += c.candidates;
-  triangle_tests_ += c.triangle_tests;
+  totals_.add(c);
   locate_seconds_ += c.locate_seconds;
   search_seconds_ += c.search_seconds;
   shard_seconds_ += c.shard_seconds;
@@ -58,8 +53,7 @@ std::uint64_t TetrapageCollider::structure_bytes() const { return index_->cache(
 nlohmann::json TetrapageCollider::figures() const {
   const ShardCacheCounters cache = index_->cache().counters();
   const double lookups = double(cache.hits + cache.misses);
-  const double steps = double(std::max<std::uint64_t>(1, steps_));
-  return {{"budget_bytes", index_->options().memory_budget_bytes},
+  nlohmann::json report = {{"budget_bytes", index_->options().memory_budget_bytes},
           {"index_shard_bytes", index_->total_shard_bytes()},
           {"shards", index_->shard_count()},
           {"preload_page_ins", preload_page_ins_},
@@ -69,13 +63,10 @@ nlohmann::json TetrapageCollider::figures() const {
           {"peak_resident_shard_bytes", cache.peak_resident_bytes},
           {"page_in_latency_us", {{"p50", cache.page_in_p50_us}, {"p99", cache.page_in_p99_us},
                                   {"max", cache.page_in_max_us}}},
-          {"per_step", {{"searched", double(searched_steps_) / steps},
-                        {"tets_visited", double(tets_visited_) / steps},
-                        {"shards_touched", double(shards_touched_) / steps},
-                        {"candidates", double(candidates_) / steps},
-                        {"triangle_tests", double(triangle_tests_) / steps}}},
           {"phase_seconds", {{"locate", locate_seconds_}, {"search", search_seconds_}, {"shards", shard_seconds_},
                              {"tests", test_seconds_}}}};
+  totals_.add_to(report);
+  return report;
 }
 
 }  // namespace tetrapage

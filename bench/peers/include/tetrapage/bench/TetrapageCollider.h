@@ -13,6 +13,7 @@
 #include "tetrapage/bench/PeerCollider.h"
 #include "tetrapage/formats/TriangleSoup.h"
 #include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/tools/StepTotals.h"
 
 namespace tetrapage {
 
@@ -46,9 +47,7 @@ class TetrapageCollider final : public PeerCollider {
   QueryOptions query_options_;  // exact, first hit
   QueryResult result_;
   std::uint64_t preload_page_ins_ = 0;
-  // The runtime's per-step counters, summed over the steps answered (they explain the time).
-  std::uint64_t steps_ = 0, searched_steps_ = 0, tets_visited_ = 0, shards_touched_ = 0, candidates_ = 0,
-                triangle_tests_ = 0;
+  StepTotals totals_;  // the runtime's step counters, summed (they explain the time)
   double locate_seconds_ = 0, search_seconds_ = 0, shard_seconds_ = 0, test_seconds_ = 0;
 };
 
