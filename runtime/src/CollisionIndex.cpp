@@ -67,9 +67,10 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
   reader_.set_spin_before_sleep(std::min(options_.spin_before_sleep, std::chrono::microseconds(100)));
   if (options_.shard_arena) {
     const std::uint64_t most = std::min(options_.memory_budget_bytes, total_shard_bytes_);
-    // Room for an eighth of fragmentation between size classes; populated ahead only within
-    // the budget, so that pages past it are resident only when a shard needs them.
-    arena_ = std::make_unique<ShardArena>(std::size_t(most + most / 8), std::size_t(8) << 20,
+    // Address space for twice the budget (free blocks of one size class cannot serve another);
+    // resident, about the budget: populated ahead only within it, and freed blocks give their
+    // pages back past it.
+    arena_ = std::make_unique<ShardArena>(std::size_t(2 * most), std::size_t(8) << 20,
                                           std::pmr::new_delete_resource(), std::size_t(most));
   }
   const IndexReader* reader = &reader_;
@@ -81,8 +82,13 @@ CollisionIndex::CollisionIndex(const std::filesystem::path& path, CollisionIndex
         // The checksums guard the payload's boxes on disk: a page-in checks its structure only.
         thread_local std::vector<std::byte> payload;
         reader->read_shard(shard, payload);
-        auto decoded = std::make_shared<const Shard>(
-            Shard::decode(payload, "shard " + std::to_string(shard), DecodeChecks::structure, memory));
+        Shard decoded_shard =
+            Shard::decode(payload, "shard " + std::to_string(shard), DecodeChecks::structure, memory);
+        // The shard object and its count in the arena too: the arena then holds all a
+        // resident shard is counted for.
+        auto decoded = memory != nullptr ? std::allocate_shared<const Shard>(
+                                               std::pmr::polymorphic_allocator<Shard>(memory), std::move(decoded_shard))
+                                         : std::make_shared<const Shard>(std::move(decoded_shard));
         if (payload.capacity() > (std::size_t(1) << 20)) std::vector<std::byte>().swap(payload);  // a rare large shard
         return decoded;
       },

@@ -19,8 +19,8 @@ namespace {
 
 // Requests up to this size take blocks in steps of 64 bytes (a shard's many tiny arrays: kept
 // in the range too, so that the range holds everything a shard is counted for).
-constexpr std::size_t kSmallestBlock = 512;
-constexpr std::size_t kSmallClasses = kSmallestBlock / 64;
+constexpr std::size_t kLargestSmallBlock = 512;
+constexpr std::size_t kSmallClasses = kLargestSmallBlock / 64;
 constexpr std::size_t kLargestBlock = std::size_t(4) << 20;
 constexpr std::size_t kBlockAlignment = 64;
 constexpr std::size_t kClassesPerDoubling = 8;
@@ -34,7 +34,7 @@ constexpr std::size_t kPopulateStep = std::size_t(256) << 10;
 // bytes, multiples of 64; above, with 2^(p-1) < bytes <= 2^p, blocks of 9/8 .. 16/8 of 2^(p-1)
 // in steps of 2^(p-4) (a multiple of 64 from p = 10 on).
 std::size_t size_class(std::size_t bytes, std::size_t& block) {
-  if (bytes <= kSmallestBlock) {
+  if (bytes <= kLargestSmallBlock) {
     block = std::max<std::size_t>(64, (bytes + 63) / 64 * 64);
     return block / 64 - 1;
   }
@@ -60,7 +60,7 @@ bool in_classes(std::size_t bytes, std::size_t alignment) {
 }
 
 constexpr std::size_t kClassCount = kSmallClasses +
-    (std::bit_width(kLargestBlock - 1) - std::bit_width(kSmallestBlock) + 1) * kClassesPerDoubling;
+    (std::bit_width(kLargestBlock - 1) - std::bit_width(kLargestSmallBlock) + 1) * kClassesPerDoubling;
 
 }  // namespace
 
@@ -147,18 +147,23 @@ void* ShardArena::do_allocate(std::size_t bytes, std::size_t alignment) {
     }
   }
   upstream_blocks_.fetch_add(1, std::memory_order_relaxed);
+  upstream_bytes_.fetch_add(bytes, std::memory_order_relaxed);
   return upstream_->allocate(bytes, alignment);
 }
 
 void ShardArena::do_deallocate(void* p, std::size_t bytes, std::size_t alignment) {
-  if (!owns(p)) return upstream_->deallocate(p, bytes, alignment);
+  if (!owns(p)) {
+    upstream_bytes_.fetch_sub(bytes, std::memory_order_relaxed);
+    return upstream_->deallocate(p, bytes, alignment);
+  }
   std::size_t block = 0;
   const std::size_t c = size_class(bytes, block);
   // Over the limit, a freed block's pages go back to the system, before the block is listed
-  // (no other thread can take it yet): the range then holds about the limit resident however
-  // the size classes mix, where free blocks of one class would otherwise keep their pages.
+  // (no other thread can take it yet): the range and the blocks upstream then hold about the
+  // limit however the size classes mix, where free blocks of one class would otherwise keep
+  // their pages.
   std::size_t returned = 0;
-  if (resident_bytes() > populate_limit_) {
+  if (resident_bytes() + upstream_bytes_.load(std::memory_order_relaxed) > populate_limit_) {
     const auto [pages, length] = inner_pages(p, block);
     if (length > 0 && ::madvise(pages, length, MADV_DONTNEED) == 0) returned = length;
   }

@@ -162,6 +162,16 @@ TEST(ShardArena, PopulatesAheadOfItsFrontier) {
 
 // Past its limit (the shard budget) the range is never populated ahead: a page there becomes
 // resident only when a block uses it. Resident pages counted by mincore().
+// Bytes of the arena's range resident from `first` (its first block, at the range's start) on,
+// by mincore.
+std::size_t resident_bytes_from(void* first, const ShardArena& arena) {
+  std::vector<unsigned char> pages(arena.capacity() / 4096);
+  EXPECT_EQ(::mincore(first, arena.capacity(), pages.data()), 0);
+  std::size_t count = 0;
+  for (const unsigned char page : pages) count += page & 1;
+  return count * 4096;
+}
+
 TEST(ShardArena, PopulatesNoFurtherThanItsLimit) {
   if (kArenaOff) GTEST_SKIP() << "the arena is off under AddressSanitizer";
   if (!kernel_populates())
@@ -169,14 +179,7 @@ TEST(ShardArena, PopulatesNoFurtherThanItsLimit) {
   const std::size_t limit = std::size_t(5) << 20, ahead = std::size_t(3) << 20;
   ShardArena arena(std::size_t(16) << 20, ahead, std::pmr::new_delete_resource(), limit);
   std::vector<void*> blocks;
-  const auto resident_pages = [&] {
-    auto* base = static_cast<unsigned char*>(blocks.front());
-    std::vector<unsigned char> pages(arena.capacity() / 4096);
-    EXPECT_EQ(::mincore(base, arena.capacity(), pages.data()), 0);
-    std::size_t count = 0;
-    for (const unsigned char page : pages) count += page & 1;
-    return count;
-  };
+  const auto resident_pages = [&] { return resident_bytes_from(blocks.front(), arena) / 4096; };
   const auto settle = [&] {
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
     while (arena.populated_bytes() < std::min(limit, arena.frontier_bytes() + ahead / 2) &&
@@ -207,13 +210,7 @@ TEST(ShardArena, FreedBlocksGiveTheirPagesBackPastTheLimit) {
   if (kArenaOff) GTEST_SKIP() << "the arena is off under AddressSanitizer";
   const std::size_t limit = std::size_t(4) << 20, small = 65536, large = 100000;
   ShardArena arena(std::size_t(16) << 20, 0, std::pmr::new_delete_resource(), limit);
-  const auto resident = [&](void* first) {
-    std::vector<unsigned char> pages(arena.capacity() / 4096);
-    EXPECT_EQ(::mincore(first, arena.capacity(), pages.data()), 0);
-    std::size_t count = 0;
-    for (const unsigned char page : pages) count += page & 1;
-    return count * 4096;
-  };
+  const auto resident = [&](void* first) { return resident_bytes_from(first, arena); };
   const auto fill = [&](std::size_t bytes, std::size_t total, unsigned char pattern) {
     std::vector<void*> blocks;
     for (std::size_t sum = 0; sum < total; sum += bytes) {
@@ -245,6 +242,26 @@ TEST(ShardArena, FreedBlocksGiveTheirPagesBackPastTheLimit) {
   EXPECT_EQ(arena.frontier_bytes(), frontier) << "the blocks were reused";
   for (void* p : larges) arena.deallocate(p, large, 64);
   EXPECT_LE(resident(first), limit + kept);
+}
+
+// Blocks served upstream (here one over the largest class) count against the limit too: with
+// one of them live, every block freed in the range gives its pages back.
+TEST(ShardArena, BlocksUpstreamCountAgainstTheLimit) {
+  if (kArenaOff) GTEST_SKIP() << "the arena is off under AddressSanitizer";
+  const std::size_t limit = std::size_t(4) << 20, block = 65536, huge = std::size_t(5) << 20;
+  ShardArena arena(std::size_t(16) << 20, 0, std::pmr::new_delete_resource(), limit);
+  void* upstream = arena.allocate(huge, 64);
+  ASSERT_FALSE(arena.owns(upstream));
+  std::vector<void*> blocks;
+  for (std::size_t sum = 0; sum < limit / 2; sum += block) {
+    blocks.push_back(arena.allocate(block, 64));
+    std::memset(blocks.back(), 1, block);
+  }
+  void* const first = blocks.front();
+  EXPECT_GE(resident_bytes_from(first, arena), limit / 2);
+  for (void* p : blocks) arena.deallocate(p, block, 64);
+  EXPECT_LE(resident_bytes_from(first, arena), blocks.size() * 2 * 4096);
+  arena.deallocate(upstream, huge, 64);
 }
 
 TEST(ShardArena, NoRangeLeavesEverythingUpstream) {

@@ -9,9 +9,10 @@
 /// arena reserves one range of address space, keeps the next few MiB past its frontier
 /// populated from a background thread (madvise MADV_POPULATE_WRITE), and recycles freed blocks
 /// by size class (eight classes per doubling, so a block wastes at most an eighth), as a
-/// database's buffer pool keeps its frames. Once the range holds more than its limit
-/// resident (free blocks of one class cannot serve another), freed blocks give their pages
-/// back to the system, so that it holds about the limit whatever the mix of sizes.
+/// database's buffer pool keeps its frames. Once the range's resident pages and the blocks
+/// served upstream hold more than the limit (free blocks of one class cannot serve another),
+/// freed blocks give their pages back to the system, so that the arena holds about the limit
+/// whatever the mix of sizes.
 ///
 /// Requests outside the classes (over 4 MiB, alignment over 64), and any when
 /// the range is used up, go to the upstream resource. Thread-safe.
@@ -87,6 +88,7 @@ class ShardArena final : public std::pmr::memory_resource {
   std::atomic<std::size_t> given_back_{0};  // bytes of those pages
   std::atomic<std::size_t> frontier_{0};
   std::atomic<std::uint64_t> arena_blocks_{0}, upstream_blocks_{0};
+  std::atomic<std::size_t> upstream_bytes_{0};  // live blocks served upstream
 
   std::mutex populate_mutex_;
   std::condition_variable_any populate_cv_;

@@ -29,9 +29,7 @@ class TetBoxFilter {
   /// Whether the tet's box meets `query` (a box rounded outward to floats, once for a search
   /// that asks many tets: no conversion per tet).
   bool bounds_overlap(std::uint32_t tet, const geometry::FloatBox& query) const {
-    const geometry::FloatBox& b = bounds_[tet];
-    return b.lo[0] <= query.hi[0] && query.lo[0] <= b.hi[0] && b.lo[1] <= query.hi[1] &&
-           query.lo[1] <= b.hi[1] && b.lo[2] <= query.hi[2] && query.lo[2] <= b.hi[2];
+    return geometry::boxes_overlap(bounds_[tet], query);
   }
   /// False only when the box lies strictly outside one of the tet's face planes (including
   /// every rounding): true for every tet that meets the box. `box` must be finite.

@@ -34,4 +34,11 @@ struct FloatBox {
   }
 };
 
+/// Whether two float boxes meet (closed: touching counts), as boxes_overlap for doubles; both
+/// nonempty.
+inline bool boxes_overlap(const FloatBox& a, const FloatBox& b) {
+  return a.lo[0] <= b.hi[0] && b.lo[0] <= a.hi[0] && a.lo[1] <= b.hi[1] && b.lo[1] <= a.hi[1] &&
+         a.lo[2] <= b.hi[2] && b.lo[2] <= a.hi[2];
+}
+
 }  // namespace tetrapage::geometry
