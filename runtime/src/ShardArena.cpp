@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <cstdint>
 #include <functional>
+#include <new>
 #include <utility>
 
 #ifndef MADV_POPULATE_WRITE
@@ -45,11 +46,23 @@ std::size_t size_class(std::size_t bytes, std::size_t& block) {
   return kSmallClasses + (p - 10) * kClassesPerDoubling + (steps - 9);
 }
 
-// The whole pages of a free block that may go back to the system: all but the first, which
-// holds the block's link in its free list, and the partial pages at either end.
+// The block size of class `c` (size_class's inverse).
+std::size_t class_block_bytes(std::size_t c) {
+  if (c < kSmallClasses) return (c + 1) * 64;
+  const std::size_t k = c - kSmallClasses;
+  const std::size_t p = 10 + k / kClassesPerDoubling, steps = 9 + k % kClassesPerDoubling;
+  return steps << (p - 4);
+}
+
+// Free blocks this size and more give their pages back to keep the range within its limit as
+// other classes grow (smaller ones hold too few whole pages to be worth the call).
+constexpr std::size_t kGivesBackWhenFree = std::size_t(16) << 10;
+
+// The whole pages of a free block that may go back to the system: all but the partial pages at
+// either end (its link in a free list is then kept outside it).
 std::pair<std::byte*, std::size_t> inner_pages(void* p, std::size_t block) {
   const auto at = reinterpret_cast<std::uintptr_t>(p);
-  const std::uintptr_t from = (at + sizeof(void*) + kPageBytes - 1) / kPageBytes * kPageBytes;
+  const std::uintptr_t from = (at + kPageBytes - 1) / kPageBytes * kPageBytes;
   const std::uintptr_t to = (at + block) / kPageBytes * kPageBytes;
   if (to <= from) return {nullptr, 0};
   return {reinterpret_cast<std::byte*>(from), std::size_t(to - from)};
@@ -70,7 +83,7 @@ ShardArena::ShardArena(std::size_t capacity_bytes, std::size_t populate_ahead_by
       ahead_(populate_ahead_bytes),
       populate_limit_(populate_limit_bytes),
       free_heads_(kClassCount, nullptr),
-      given_back_heads_(kClassCount, nullptr) {
+      given_back_blocks_(kClassCount) {
 #if defined(__SANITIZE_ADDRESS__)
   // AddressSanitizer sees blocks recycled here as live: leave every shard to malloc so that
   // it still catches a shard used after its eviction.
@@ -122,13 +135,15 @@ void* ShardArena::do_allocate(std::size_t bytes, std::size_t alignment) {
       if (void* head = free_heads_[c]) {
         free_heads_[c] = *static_cast<void**>(head);
         p = head;
-      } else if (void* given_back = given_back_heads_[c]) {
+      } else if (std::vector<void*>& given_back = given_back_blocks_[c]; !given_back.empty()) {
         // Its pages fault in again as they are written: only once the range is over its limit.
-        given_back_heads_[c] = *static_cast<void**>(given_back);
-        given_back_.fetch_sub(inner_pages(given_back, block).second, std::memory_order_relaxed);
-        p = given_back;
+        give_back_free_blocks(block);
+        p = given_back.back();
+        given_back.pop_back();
+        given_back_.fetch_sub(inner_pages(p, block).second, std::memory_order_relaxed);
       } else if (const std::size_t at = frontier_.load(std::memory_order_relaxed);
                  block <= capacity_ - at) {
+        give_back_free_blocks(block);
         p = base_ + at;
         frontier_.store(at + block, std::memory_order_relaxed);
         // Wake the populating thread when the frontier has eaten into its lead.
@@ -168,10 +183,43 @@ void ShardArena::do_deallocate(void* p, std::size_t bytes, std::size_t alignment
     if (length > 0 && ::madvise(pages, length, MADV_DONTNEED) == 0) returned = length;
   }
   const std::lock_guard lock(mutex_);
-  std::vector<void*>& heads = returned > 0 ? given_back_heads_ : free_heads_;
-  *static_cast<void**>(p) = heads[c];
-  heads[c] = p;
-  given_back_.fetch_add(returned, std::memory_order_relaxed);
+  if (returned > 0) {
+    // Listed outside the block: writing a link into it would fault a page back in.
+    try {
+      given_back_blocks_[c].push_back(p);
+      given_back_.fetch_add(returned, std::memory_order_relaxed);
+      return;
+    } catch (const std::bad_alloc&) {
+      // Listed as a free block instead (its first page faults in again for the link).
+    }
+  }
+  *static_cast<void**>(p) = free_heads_[c];
+  free_heads_[c] = p;
+}
+
+void ShardArena::give_back_free_blocks(std::size_t incoming) {
+  if (populate_limit_ == SIZE_MAX) return;
+  const auto over = [&] {
+    return resident_bytes() + upstream_bytes_.load(std::memory_order_relaxed) + incoming >
+           populate_limit_;
+  };
+  // Largest first: the fewest calls for the most pages.
+  for (std::size_t c = free_heads_.size(); c-- > 0 && over();) {
+    const std::size_t block = class_block_bytes(c);
+    if (block < kGivesBackWhenFree) break;
+    while (free_heads_[c] != nullptr && over()) {
+      void* p = free_heads_[c];
+      const auto [pages, length] = inner_pages(p, block);
+      given_back_blocks_[c].push_back(p);        // may throw: before anything changes
+      free_heads_[c] = *static_cast<void**>(p);  // read before its page goes
+      if (::madvise(pages, length, MADV_DONTNEED) != 0) {
+        given_back_blocks_[c].pop_back();
+        free_heads_[c] = p;
+        return;
+      }
+      given_back_.fetch_add(length, std::memory_order_relaxed);
+    }
+  }
 }
 
 std::size_t ShardArena::resident_bytes() const {

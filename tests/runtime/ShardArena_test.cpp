@@ -204,8 +204,8 @@ TEST(ShardArena, PopulatesNoFurtherThanItsLimit) {
 }
 
 // Blocks of one size fill the limit and are freed; blocks of another size then take the range
-// past it. Freed past the limit, those give their pages back: the range stays near its limit
-// resident, and a block taken again from them holds what is written to it.
+// past it. The free blocks, and those freed past the limit, give their pages back: the range
+// stays near its limit resident, and a block taken again from them holds what is written to it.
 TEST(ShardArena, FreedBlocksGiveTheirPagesBackPastTheLimit) {
   if (kArenaOff) GTEST_SKIP() << "the arena is off under AddressSanitizer";
   const std::size_t limit = std::size_t(4) << 20, small = 65536, large = 100000;
@@ -224,10 +224,15 @@ TEST(ShardArena, FreedBlocksGiveTheirPagesBackPastTheLimit) {
   for (void* p : smalls) arena.deallocate(p, small, 64);
   // Under the limit, freed blocks keep their pages for the next block of their size.
   EXPECT_GE(resident(first), limit);
+  // Blocks of another size past the limit: the free blocks give their pages back first, so
+  // that the range holds the limit (or the live blocks, when they hold more) and one block.
   std::vector<void*> larges = fill(large, limit, 2);
-  EXPECT_GE(resident(first), 2 * limit - 4096);
+  const std::size_t live = larges.size() * ShardArena::block_bytes(large);
+  EXPECT_GT(arena.frontier_bytes(), limit + live - ShardArena::block_bytes(large));
+  EXPECT_LE(resident(first), std::max(limit, live) + ShardArena::block_bytes(large));
+  EXPECT_LE(arena.resident_bytes(), std::max(limit, live) + ShardArena::block_bytes(large));
   for (void* p : larges) arena.deallocate(p, large, 64);
-  // Each block keeps the page holding its link and the page it shares with the next.
+  // Each block keeps the partial pages at its two ends (its link in the list is outside it).
   const std::size_t kept = larges.size() * 2 * 4096;
   EXPECT_LE(resident(first), limit + kept) << "frontier " << arena.frontier_bytes();
   EXPECT_LE(resident(first), arena.resident_bytes());

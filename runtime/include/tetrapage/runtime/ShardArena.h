@@ -73,6 +73,9 @@ class ShardArena final : public std::pmr::memory_resource {
   bool do_is_equal(const std::pmr::memory_resource& other) const noexcept override {
     return this == &other;
   }
+  // Over the limit, free blocks of other classes give their pages back before `incoming`
+  // more bytes become resident. Called with mutex_ held.
+  void give_back_free_blocks(std::size_t incoming);
   void populate(std::stop_token stop);
   std::size_t populate_target() const;
 
@@ -84,7 +87,7 @@ class ShardArena final : public std::pmr::memory_resource {
 
   std::mutex mutex_;               // guards the free lists and the frontier's advance
   std::vector<void*> free_heads_;  // per size class: a freed block, which links to the next
-  std::vector<void*> given_back_heads_;  // the same, for blocks whose pages went back
+  std::vector<std::vector<void*>> given_back_blocks_;  // per class: blocks whose pages went back
   std::atomic<std::size_t> given_back_{0};  // bytes of those pages
   std::atomic<std::size_t> frontier_{0};
   std::atomic<std::uint64_t> arena_blocks_{0}, upstream_blocks_{0};
