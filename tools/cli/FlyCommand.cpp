@@ -335,6 +335,11 @@ void run_fly(const FlyArguments& args) {
       report["prefetch_hits"] = cache.prefetch_hits;
     }
     if (args.preload) report["preload_seconds"] = preload_seconds;
+    if (const ShardArena* arena = index->shard_arena())
+      report["shard_arena_blocks"] = {{"frontier_bytes", arena->frontier_bytes()},
+                                      {"resident_bytes", arena->resident_bytes()},
+                                      {"from_range", arena->arena_blocks()},
+                                      {"from_malloc", arena->upstream_blocks()}};
     memory.add_to(report, peak_rss, index_options.memory_budget_bytes);
     if (step.collision_query()) {
       report["containments"] = containments;
