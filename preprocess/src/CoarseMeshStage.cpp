@@ -19,7 +19,18 @@ ModelCoarseMesh build_model_coarse_mesh(IngestedModel& model, const PreprocessOp
   sampling.leaf_triangles =
       std::max<std::size_t>(1, std::size_t(std::llround(double(summary.region_triangles) * share)));
   // Reorders the sample (the buckets' estimate takes any every-stride-th of it).
-  const std::vector<Vec3> sites = sample_sites(model.sample, model.bounds, sampling);
+  std::vector<Vec3> sites = sample_sites(model.sample, model.bounds, sampling);
+  // A flat leaf takes two sites: at the automatic size of a large model, leaves grow until the
+  // sites are about as many as one a leaf would give, so that the mesh stays near 100k tets
+  // (its tables stay beside the shards at run time: 104k against 177k tets at 100M).
+  const std::size_t leaf_sites = sites.size() - 8;
+  if (options.region_triangles == 0 && leaf_sites > kAutoRegionSites &&
+      summary.region_triangles > auto_region_triangles(0)) {
+    const double grow = double(leaf_sites) / double(kAutoRegionSites);
+    sampling.leaf_triangles = std::size_t(std::ceil(double(sampling.leaf_triangles) * grow));
+    summary.region_triangles = std::size_t(std::ceil(double(summary.region_triangles) * grow));
+    sites = sample_sites(model.sample, model.bounds, sampling);
+  }
   summary.sites = sites.size();
   ModelCoarseMesh coarse{build_coarse_mesh(sites), enlarged_bounds(model.bounds, sampling.margin)};
   summary.regions = coarse.mesh.tet_count();

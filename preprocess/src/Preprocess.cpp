@@ -97,7 +97,7 @@ ShardChoice parse_shard_choice(const std::string& text) {
 }
 
 std::size_t auto_region_triangles(std::uint64_t triangles) {
-  constexpr std::uint64_t kMinimum = 4096, kLeaves = 12'000;  // 12,000 leaves: about 100k tets
+  constexpr std::uint64_t kMinimum = 4096, kLeaves = kAutoRegionSites;
   return std::size_t(std::max(kMinimum, (triangles + kLeaves - 1) / kLeaves));
 }
 

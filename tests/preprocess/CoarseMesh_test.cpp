@@ -33,16 +33,17 @@ std::vector<Vec3> clustered_centroids(std::uint64_t seed, std::size_t count) {
   return points;
 }
 
-TEST(SampleSites, OneSitePerLeafPlusTheBoxCorners) {
+TEST(SampleSites, OneOrTwoSitesPerLeafPlusTheBoxCorners) {
   auto centroids = clustered_centroids(3, 20000);
   BoundingBox bounds;
   for (const auto& c : centroids) bounds.extend(c);
   SamplingOptions options;
   options.leaf_triangles = 500;
   const auto sites = sample_sites(centroids, bounds, options);
-  // A median split halves until a leaf holds at most 500: between 20000/500 and 2x that leaves.
+  // A median split halves until a leaf holds at most 500: between 20000/500 and 2x that leaves,
+  // each one site, or two when flat.
   EXPECT_GE(sites.size(), 40u + 8u);
-  EXPECT_LE(sites.size(), 64u + 8u);
+  EXPECT_LE(sites.size(), 2 * 64u + 8u);
   const BoundingBox box = enlarged_bounds(bounds, options.margin);
   for (const auto& s : sites)
     for (int a = 0; a < 3; ++a) {
@@ -52,15 +53,45 @@ TEST(SampleSites, OneSitePerLeafPlusTheBoxCorners) {
   EXPECT_THROW(sample_sites({}, bounds, options), InputError);
 }
 
+// A terrain-like sample (a gently curved sheet): each leaf is flat, and gets one site above and
+// one below its surface, symmetric about its mean, inside the mesh's box; a leaf with volume
+// (the clusters above) keeps its mean.
+TEST(SampleSites, FlatLeavesGetASiteEachSideOfTheirSurface) {
+  Random random(7);
+  std::vector<Vec3> centroids;
+  for (int i = 0; i < 20000; ++i) {
+    const double x = random.uniform(), y = random.uniform();
+    centroids.push_back({x, y, 0.5 + 0.02 * std::sin(6 * x) * std::cos(5 * y)});
+  }
+  BoundingBox bounds;
+  for (const auto& c : centroids) bounds.extend(c);
+  SamplingOptions options;
+  options.leaf_triangles = 500;
+  const auto sites = sample_sites(centroids, bounds, options);
+  const BoundingBox box = enlarged_bounds(bounds, options.margin);
+  ASSERT_EQ((sites.size() - 8) % 2, 0u);
+  ASSERT_GE(sites.size() - 8, 2u * 40);
+  for (std::size_t i = 0; i + 8 < sites.size(); i += 2) {
+    const Vec3 &above = sites[i], &below = sites[i + 1];
+    EXPECT_EQ(above[0], below[0]);
+    EXPECT_EQ(above[1], below[1]);
+    EXPECT_GT(above[2], 0.52) << "site " << i;
+    EXPECT_LT(below[2], 0.48) << "site " << i;
+    EXPECT_LE(above[2], box.hi[2]);
+    EXPECT_GE(below[2], box.lo[2]);
+  }
+  // Clustered centroids with volume: one site per leaf, as many as the split's leaves.
+  auto clustered = clustered_centroids(3, 20000);
+  std::vector<Vec3> one;
+  append_leaf_sites(std::span<const Vec3>(clustered).subspan(0, 100), box, one);
+  EXPECT_EQ(one.size(), 1u);
+}
+
 /// The sampler's median split, serial and depth first: the reference for the parallel one.
 void split_serially(std::vector<Vec3>& points, std::size_t begin, std::size_t end, std::size_t leaf,
-                    std::vector<Vec3>& sites) {
+                    const BoundingBox& bounds, std::vector<Vec3>& sites) {
   if (end - begin <= leaf) {
-    Vec3 mean{0, 0, 0};
-    for (std::size_t i = begin; i < end; ++i)
-      for (int a = 0; a < 3; ++a) mean[a] += points[i][a];
-    for (auto& m : mean) m /= double(end - begin);
-    sites.push_back(mean);
+    append_leaf_sites(std::span<const Vec3>(points).subspan(begin, end - begin), bounds, sites);
     return;
   }
   BoundingBox box;
@@ -74,8 +105,8 @@ void split_serially(std::vector<Vec3>& points, std::size_t begin, std::size_t en
   const std::size_t middle = begin + (end - begin) / 2;
   std::nth_element(points.begin() + long(begin), points.begin() + long(middle), points.begin() + long(end),
                    [axis](const Vec3& a, const Vec3& b) { return a[axis] < b[axis]; });
-  split_serially(points, begin, middle, leaf, sites);
-  split_serially(points, middle, end, leaf, sites);
+  split_serially(points, begin, middle, leaf, bounds, sites);
+  split_serially(points, middle, end, leaf, bounds, sites);
 }
 
 TEST(SampleSites, TheSameSitesInTheSameOrderAsTheSerialSplit) {
@@ -88,7 +119,8 @@ TEST(SampleSites, TheSameSitesInTheSameOrderAsTheSerialSplit) {
   SamplingOptions options;
   options.leaf_triangles = 700;
   std::vector<Vec3> points = centroids, expected;
-  split_serially(points, 0, points.size(), options.leaf_triangles, expected);
+  split_serially(points, 0, points.size(), options.leaf_triangles,
+                 enlarged_bounds(bounds, options.margin), expected);
   const auto sites = sample_sites(centroids, bounds, options);
   ASSERT_EQ(sites.size(), expected.size() + 8);
   EXPECT_TRUE(std::equal(expected.begin(), expected.end(), sites.begin()));

@@ -19,7 +19,14 @@ struct SamplingOptions {
   double margin = 0.05;
 };
 
-/// Sites for the coarse mesh: the mean centroid of each leaf of a median split of the
+/// The sites of one leaf of the split: its mean centroid, or, when its centroids are flat
+/// (their box's thinnest side under half its largest), two sites either side of the
+/// mean along that side, twice the largest side away (clamped to `bounds`), so that the tets
+/// straddle the surface rather than lie along it.
+void append_leaf_sites(std::span<const Vec3> leaf, const BoundingBox& bounds,
+                       std::vector<Vec3>& sites);
+
+/// Sites for the coarse mesh: each leaf's sites (append_leaf_sites) of a median split of the
 /// centroids (split along the longest side until a leaf holds at most leaf_triangles), plus
 /// the eight corners of the enlarged bounding box. The split reorders `centroids` in place
 /// (they are the preprocess's sample, up to 96 MB: a copy was a serial twentieth of a second).

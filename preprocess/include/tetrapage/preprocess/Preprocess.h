@@ -33,6 +33,8 @@ ShardChoice parse_shard_choice(const std::string& text);
 /// read whole at open, and open to first answer must stay in milliseconds whatever the model
 /// (docs/BENCHMARKS.md, "Region size").
 std::size_t auto_region_triangles(std::uint64_t triangles);
+/// The sites the automatic region size aims at, at most, for a large model: about 100k tets.
+inline constexpr std::size_t kAutoRegionSites = 12'000;
 
 /// The least working memory the pipeline works in (PreprocessOptions::memory_bytes).
 inline constexpr std::uint64_t kLeastPreprocessMemory = std::uint64_t(16) << 20;
