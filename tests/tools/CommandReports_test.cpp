@@ -46,7 +46,10 @@ class CommandReports : public ::testing::Test {
           "--region-triangles 200 "
           "--report preprocess-double.json",
           "preprocess environment.obj -o float.tpi --precision float --interiors off --threads 1 "
-          "--region-triangles 200 --report preprocess-float.json"}) {
+          "--region-triangles 200 --report preprocess-float.json",
+          // One closed solid with tets inside it (the tetras' tiny solids may hold none).
+          "preprocess object.ply -o solid.tpi --threads 1 --region-triangles 50 "
+          "--report preprocess-solid.json"}) {
       const test::CliResult run = test::run_cli_in(folder_, command);
       ASSERT_EQ(run.status, 0) << command << ": " << run.err;
     }
@@ -231,7 +234,10 @@ TEST_F(CommandReports, PreprocessAndInspectStateStorageAndInteriorsFiguresWhereT
   expect_keys(stored, {"max_rounding_distance", "float_shards"}, false,
               "preprocess --precision double");
   expect_keys(stored, {"interior_tets", "interior_undecided"}, true, "preprocess (interiors on)");
-  EXPECT_GT(stored.at("interior_tets").get<std::uint64_t>(), 0u);
+  std::ifstream solid_in(folder_ / "preprocess-solid.json");
+  const json solid = json::parse(solid_in);
+  EXPECT_GT(solid.at("interior_tets").get<std::uint64_t>(), 0u);
+  EXPECT_LT(solid.at("interior_tets").get<std::uint64_t>(), solid.at("regions").get<std::uint64_t>());
   expect_keys(rounded, {"max_rounding_distance", "float_shards"}, true,
               "preprocess --precision float");
   expect_keys(rounded, {"interior_tets", "interior_undecided"}, false,
