@@ -1,6 +1,7 @@
 // The reference oracle against brute force over every triangle pair (CGAL's exact
 // construction kernel, no tree), and the billiard flight's promises.
 
+#include <iterator>
 #include <gtest/gtest.h>
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
@@ -264,6 +265,34 @@ TEST(BilliardFlight, DefaultStepsScaleWithTheModel) {
   for (const double length :
        step_lengths("given.csv", "env-mm.ply", "object-mm.ply", "--displacement 2.5"))
     EXPECT_NEAR(length, 2.5, 1e-9);
+  std::filesystem::remove_all(folder);
+}
+
+// An object named by a manifest flies as its mesh does (a manifest is read everywhere a mesh
+// is): the same seed gives the same flight and the same answers.
+TEST(BilliardFlight, AnObjectGivenByAManifestFliesAsItsMesh) {
+  const std::filesystem::path folder =
+      std::filesystem::path(TETRAPAGE_TEST_TMP) / ("flight-manifest-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(folder);
+  write_mesh(folder / "env.ply", boxes_environment(3, 12));
+  write_mesh(folder / "object.ply", tetra_object(0.02));
+  std::ofstream(folder / "object.json") << R"({"parts": [{"file": "object.ply"}]})";
+  const auto flight = [&](const std::string& object, const std::string& name) {
+    std::string out;
+    EXPECT_EQ(test::run_cli("generate flight --env " + (folder / "env.ply").string() + " --object " +
+                                (folder / object).string() + " --steps 200 --seed 4 -o " +
+                                (folder / (name + ".csv")).string() + " --answers " +
+                                (folder / (name + "-answers.csv")).string(),
+                            out),
+              0)
+        << out;
+    std::ifstream poses(folder / (name + ".csv")), answers(folder / (name + "-answers.csv"));
+    return std::string(std::istreambuf_iterator<char>(poses), {}) +
+           std::string(std::istreambuf_iterator<char>(answers), {});
+  };
+  const std::string from_mesh = flight("object.ply", "mesh");
+  EXPECT_GT(from_mesh.size(), 200u * 20);
+  EXPECT_EQ(flight("object.json", "manifest"), from_mesh);
   std::filesystem::remove_all(folder);
 }
 

@@ -60,7 +60,7 @@ void run_generate_flight(const FlightArguments& args) {
     environment = load_inputs({args.environment}, &reports, reading);
     reading.finish();
   }
-  const TriangleSoup object = read_mesh(args.object);
+  const TriangleSoup object = load_inputs({args.object});  // a mesh, STEP file or manifest
   const double read_seconds = seconds_since(start);
 
   const auto build_start = std::chrono::steady_clock::now();
@@ -152,7 +152,8 @@ void add_generate_flight_command(CLI::App& generate) {
           "(for models too large for the in-core oracle, ~150 B a triangle)")
       ->check(existing_file_check());
   add_memory_option(command, args->memory, "With --index: the runtime's budget of decoded shards");
-  command->add_option("--object", args->object, "Flying object mesh (its own frame, model units)")
+  command->add_option("--object", args->object, "Flying object: a mesh, a STEP or IGES file, or a manifest (.json); its own frame, the "
+                      "environment's units")
       ->required()
       ->check(existing_file_check());
   command->add_option("--steps", args->options.steps, "Number of poses written")

@@ -8,6 +8,7 @@
 #include "Commands.h"
 #include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/runtime/FlyingObject.h"
@@ -85,7 +86,7 @@ void run_render(const RenderArguments& args) {
   const auto index = std::make_shared<const CollisionIndex>(args.index, index_options);
   nlohmann::json flight;  // the replay's figures (--color page-ins)
   if (replay) {
-    FlyingObject object(index, read_mesh(args.object));
+    FlyingObject object(index, load_inputs({args.object}));
     Progress progress("replaying the flight", poses.size());
     std::uint64_t collisions = 0;
     for (const auto& pose : poses) {
@@ -156,7 +157,7 @@ void add_render_command(CLI::App& app) {
   command->add_option("--color", args->colour, "kind, regions or page-ins")
       ->check(CLI::IsMember({"kind", "regions", "page-ins"}))
       ->capture_default_str();
-  command->add_option("--object", args->object, "Flying object (for --color page-ins)")
+  command->add_option("--object", args->object, "Flying object for --color page-ins: a mesh, a STEP or IGES file, or a manifest (.json)")
       ->check(existing_file_check());
   add_memory_option(
       command, args->memory,

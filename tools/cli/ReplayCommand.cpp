@@ -36,7 +36,7 @@ void run_replay(const ReplayArguments& args) {
   check_outputs_writable({args.answers, args.report}, {args.environment, args.object, args.path, args.check});
   const bool embree = args.reference == "embree";
   const TriangleSoup environment = load_inputs({args.environment});
-  const TriangleSoup object = read_mesh(args.object);
+  const TriangleSoup object = load_inputs({args.object});  // a mesh, STEP file or manifest
   const std::vector<Pose> poses = read_poses(args.path);
   AnswerCheck check(args.check, poses.size(), embree ? "embree" : "reference");
 
@@ -131,7 +131,7 @@ void add_replay_command(CLI::App& app) {
   command->add_option("environment", args->environment, "Environment: mesh file or manifest")
       ->required()
       ->check(existing_file_check());
-  command->add_option("--object", args->object, "Flying object mesh")
+  command->add_option("--object", args->object, "Flying object: a mesh, a STEP or IGES file, or a manifest (.json)")
       ->required()
       ->check(existing_file_check());
   command->add_option("--path", args->path, "Pose file (CSV tx,ty,tz,qw,qx,qy,qz)")
