@@ -114,7 +114,7 @@ std::vector<Vec3> sample_sites(std::span<Vec3> centroids, const BoundingBox& bou
   const BoundingBox box = enlarged_bounds(bounds, options.margin);
   split(centroids, 0, centroids.size(), std::max<std::size_t>(1, options.leaf_triangles), box,
         sites);
-  for (int i = 0; i < 8; ++i)
+  for (std::size_t i = 0; i < kBoxCornerSites; ++i)
     sites.push_back({(i & 1) ? box.hi[0] : box.lo[0], (i & 2) ? box.hi[1] : box.lo[1],
                      (i & 4) ? box.hi[2] : box.lo[2]});
   return sites;

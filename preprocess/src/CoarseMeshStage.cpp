@@ -23,9 +23,9 @@ ModelCoarseMesh build_model_coarse_mesh(IngestedModel& model, const PreprocessOp
   // A flat leaf takes two sites: at the automatic size of a large model, leaves grow until the
   // sites are about as many as one a leaf would give, so that the mesh stays near 100k tets
   // (its tables stay beside the shards at run time: 104k against 177k tets at 100M).
-  const std::size_t leaf_sites = sites.size() - 8;
-  if (options.region_triangles == 0 && leaf_sites > kAutoRegionSites &&
-      summary.region_triangles > auto_region_triangles(0)) {
+  const std::size_t leaf_sites = sites.size() - kBoxCornerSites;
+  const bool large_model = summary.region_triangles > auto_region_triangles(0);  // past 49M
+  if (options.region_triangles == 0 && large_model && leaf_sites > kAutoRegionSites) {
     const double grow = double(leaf_sites) / double(kAutoRegionSites);
     sampling.leaf_triangles = std::size_t(std::ceil(double(sampling.leaf_triangles) * grow));
     summary.region_triangles = std::size_t(std::ceil(double(summary.region_triangles) * grow));

@@ -26,6 +26,9 @@ struct SamplingOptions {
 void append_leaf_sites(std::span<const Vec3> leaf, const BoundingBox& bounds,
                        std::vector<Vec3>& sites);
 
+/// The sites sample_sites appends after the leaves': the enlarged box's corners.
+inline constexpr std::size_t kBoxCornerSites = 8;
+
 /// Sites for the coarse mesh: each leaf's sites (append_leaf_sites) of a median split of the
 /// centroids (split along the longest side until a leaf holds at most leaf_triangles), plus
 /// the eight corners of the enlarged bounding box. The split reorders `centroids` in place
