@@ -60,30 +60,77 @@ bool is_degenerate_triangle(const Vec3& a, const Vec3& b, const Vec3& c) {
 
 namespace detail {
 
+bool SoupBuilder::drop_if_degenerate(std::size_t t, std::uint64_t position) {
+  const auto& tri = soup_.triangles[t];
+  const auto vertex = [&](std::uint32_t v) -> const Vec3& { return soup_.vertices[v - vertex_base_]; };
+  const bool repeated = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
+  if (!repeated && !is_degenerate_triangle(vertex(tri[0]), vertex(tri[1]), vertex(tri[2])))
+    return false;
+  ++report_.degenerate_dropped;
+  report_.dropped_positions.push_back(position);
+  return true;
+}
+
+void SoupBuilder::throw_no_triangle_left() const {
+  if (report_.triangles_read == 0) throw InputError(file_name_ + ": the mesh has no triangle");
+  throw InputError(file_name_ + ": no triangle left after dropping " +
+                   std::to_string(report_.degenerate_dropped) + " degenerate triangles");
+}
+
+void SoupBuilder::hand_over_chunk() {
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  TriangleSoup chunk;
+  chunk.triangles.reserve(soup_.triangles.size());
+  chunk.part_of.reserve(soup_.triangles.size());
+  if (chunk_vertex_.size() < soup_.vertices.size()) chunk_vertex_.resize(soup_.vertices.size(), kNone);
+  for (std::size_t t = 0; t < soup_.triangles.size(); ++t) {
+    if (drop_if_degenerate(t, triangles_before_ + t)) continue;
+    TriangleIndices local{};
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t& number = chunk_vertex_[soup_.triangles[t][k] - vertex_base_];
+      if (number == kNone) {
+        number = std::uint32_t(chunk.vertices.size());
+        chunk.vertices.push_back(soup_.vertices[soup_.triangles[t][k] - vertex_base_]);
+      }
+      local[k] = number;
+    }
+    chunk.triangles.push_back(local);
+    chunk.part_of.push_back(soup_.part_of[t]);
+  }
+  for (const auto& tri : soup_.triangles)
+    for (const std::uint32_t v : tri) chunk_vertex_[v - vertex_base_] = kNone;
+  triangles_before_ += soup_.triangles.size();
+  kept_before_ += chunk.triangles.size();
+  soup_.triangles.clear();
+  soup_.part_of.clear();
+  if (vertices_unshared_) {
+    vertex_base_ += soup_.vertices.size();
+    soup_.vertices.clear();
+  }
+  if (!chunk.triangles.empty()) chunks_->take(std::move(chunk));
+}
+
 TriangleSoup SoupBuilder::finish() {
+  if (chunks_ != nullptr) {
+    hand_over_chunk();
+    if (kept_before_ == 0) throw_no_triangle_left();
+    TriangleSoup parts;
+    parts.part_names = std::move(soup_.part_names);
+    parts.part_paths = std::move(soup_.part_paths);
+    return parts;
+  }
   auto& triangles = soup_.triangles;
   auto& part_of = soup_.part_of;
   std::size_t kept = 0;
   for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const auto& tri = triangles[t];
-    const bool repeated = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
-    if (repeated || is_degenerate_triangle(soup_.vertices[tri[0]], soup_.vertices[tri[1]],
-                                           soup_.vertices[tri[2]])) {
-      ++report_.degenerate_dropped;
-      report_.dropped_positions.push_back(t);
-      continue;
-    }
-    triangles[kept] = tri;
+    if (drop_if_degenerate(t, t)) continue;
+    triangles[kept] = triangles[t];
     part_of[kept] = part_of[t];
     ++kept;
   }
   triangles.resize(kept);
   part_of.resize(kept);
-  if (kept == 0) {
-    if (report_.triangles_read == 0) throw InputError(file_name_ + ": the mesh has no triangle");
-    throw InputError(file_name_ + ": no triangle left after dropping " +
-                     std::to_string(report_.degenerate_dropped) + " degenerate triangles");
-  }
+  if (kept == 0) throw_no_triangle_left();
   triangles.shrink_to_fit();
   part_of.shrink_to_fit();
   soup_.vertices.shrink_to_fit();
@@ -104,12 +151,14 @@ std::uint64_t triangle_position(const ReadReport& report, std::uint64_t id) {
 
 namespace {
 
-TriangleSoup read_with(TriangleSoup (*reader)(detail::InputFile&, ReadReport&),
-                       const std::filesystem::path& path, const char* format, ReadReport& report) {
+using OwnReader = TriangleSoup (*)(detail::InputFile&, ReadReport&, const SoupChunks*);
+
+TriangleSoup read_with(OwnReader reader, const std::filesystem::path& path, const char* format,
+                       ReadReport& report, const SoupChunks* chunks = nullptr) {
   detail::InputFile file(path);
   report.bytes = file.size();
   report.format = format;
-  return reader(file, report);
+  return reader(file, report, chunks);
 }
 
 std::uint64_t file_size_or_zero(const std::filesystem::path& path) {
@@ -165,6 +214,7 @@ bool header_counts(const std::filesystem::path& path, MeshFormat format, MeshRea
     }
     out.vertices = counts.vertices;
     out.triangles = counts.triangles;
+    out.chunked = !counts.part_table;
     // Arrays reserved from the counts; polygons grow the triangles' (old and new while
     // growing), else the degenerate filter's shrink copies them.
     out.reading_bytes = out.soup_bytes() + (counts.triangles > counts.faces ? 16 : 12) * counts.triangles;
@@ -198,6 +248,13 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
     out.reading_bytes = 2 * out.soup_bytes();
   }
   out.reading_bytes += kReadBlockBytes;
+  if (format == MeshFormat::obj || format == MeshFormat::stl || format == MeshFormat::ply ||
+      format == MeshFormat::off) {
+    if (!out.counted) out.chunked = true;  // an OBJ or an ASCII STL
+    // The vertex table and a chunk number per vertex (an STL: a chunk's); an OBJ's grows.
+    const std::uint64_t table = format == MeshFormat::stl ? 0 : 28 * out.vertices;
+    out.chunked_bytes = kReadBlockBytes + (format == MeshFormat::obj ? 2 * table : table);
+  }
   const bool assimp = format == MeshFormat::gltf || format == MeshFormat::glb ||
                       format == MeshFormat::assimp_other;
   // Assimp's scene beside the soup: float vertices, faces and their index arrays, the file's
@@ -239,6 +296,39 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report,
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return soup;
+}
+
+TriangleSoup read_mesh_in_chunks(const std::filesystem::path& path, ReadReport* report,
+                                 const SoupChunks& chunks, const TessellationOptions& tessellation) {
+  const auto start = std::chrono::steady_clock::now();
+  ReadReport local;
+  ReadReport& out = report != nullptr ? *report : local;
+  out = ReadReport{};
+  out.path = path.string();
+  TriangleSoup parts;
+  switch (mesh_format_from_path(path)) {
+    case MeshFormat::obj:
+      parts = read_with(detail::read_obj, path, "obj", out, &chunks);
+      break;
+    case MeshFormat::stl:
+      parts = read_with(detail::read_stl, path, "stl", out, &chunks);
+      break;
+    case MeshFormat::ply:
+      parts = read_with(detail::read_ply, path, "ply", out, &chunks);
+      break;
+    case MeshFormat::off:
+      parts = read_with(detail::read_off, path, "off", out, &chunks);
+      break;
+    default: {
+      TriangleSoup whole = read_mesh(path, &out, tessellation);
+      parts.part_names = std::move(whole.part_names);
+      parts.part_paths = std::move(whole.part_paths);
+      chunks.take(std::move(whole));
+      return parts;
+    }
+  }
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return parts;
 }
 
 void load_readers_for(std::span<const std::filesystem::path> inputs) {

@@ -75,9 +75,9 @@ std::string_view part_name(std::string_view rest) {
 
 }  // namespace
 
-TriangleSoup read_obj(InputFile& file, ReadReport& report) {
+TriangleSoup read_obj(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
   report.encoding = "ascii";
-  SoupBuilder soup(file.name(), report);
+  SoupBuilder soup(file.name(), report, chunks);
   ObjParts parts(soup, file.path().stem().string());
   std::vector<std::uint32_t> corners;
   std::string_view line;

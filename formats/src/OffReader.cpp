@@ -81,12 +81,12 @@ MeshCounts read_off_counts(InputFile& file) {
   return counts;
 }
 
-TriangleSoup read_off(InputFile& file, ReadReport& report) {
+TriangleSoup read_off(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
   report.encoding = "ascii";
   const MeshCounts counts = read_off_counts(file);
   const std::uint64_t vertex_count = counts.vertices, face_count = counts.faces;
   std::string_view line;
-  SoupBuilder soup(file.name(), report);
+  SoupBuilder soup(file.name(), report, chunks);
   soup.begin_part(file.path().stem().string());
   soup.reserve(vertex_count, face_count, file.size());
   for (std::uint64_t v = 0; v < vertex_count; ++v) {

@@ -675,6 +675,7 @@ MeshCounts read_ply_counts(InputFile& file) {
   counts.vertices = layout.vertex->count;
   counts.faces = layout.face != nullptr ? layout.face->count : 0;
   counts.triangles = counts.faces;
+  counts.part_table = layout.parts != nullptr;
   if (header.encoding == PlyEncoding::ascii || counts.faces == 0) return counts;
   // Binary: the bytes after the fixed-size elements before the faces bound the faces' corners,
   // hence their triangles (a face of k corners makes k - 2; polygons make more than a face).
@@ -693,11 +694,12 @@ MeshCounts read_ply_counts(InputFile& file) {
   return counts;
 }
 
-TriangleSoup read_ply(InputFile& file, ReadReport& report) {
+TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);
   check_counts_fit(file, header);
-  SoupBuilder soup(file.name(), report);
+  // The part table follows the faces: a file with one is read whole, then handed over.
+  SoupBuilder soup(file.name(), report, layout.parts == nullptr ? chunks : nullptr);
   if (layout.parts == nullptr) soup.begin_part(file.path().stem().string());
   PlyPartTable parts(file, soup, layout.parts != nullptr);
   soup.reserve(layout.vertex->count, layout.face != nullptr ? layout.face->count : 0, file.size());
@@ -712,7 +714,13 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report) {
     for (const auto& element : header.elements) reader.read_element(element);
   }
   parts.apply(layout.face != nullptr ? layout.face->count : 0);
-  return soup.finish();
+  if (chunks == nullptr || layout.parts == nullptr) return soup.finish();
+  TriangleSoup whole = soup.finish();
+  TriangleSoup names;
+  names.part_names = std::move(whole.part_names);
+  names.part_paths = std::move(whole.part_paths);
+  chunks->take(std::move(whole));
+  return names;
 }
 
 }  // namespace tetrapage::detail

@@ -13,10 +13,12 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "InputFile.h"
 #include "TextNumbers.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/TriangleSoup.h"
 
 namespace tetrapage::detail {
@@ -50,8 +52,14 @@ inline bool is_finite(const Vec3& p) {
 /// the degenerate triangles and counts them in the report.
 class SoupBuilder {
  public:
-  SoupBuilder(std::string file_name, ReadReport& report)
-      : file_name_(std::move(file_name)), report_(report) {}
+  /// With `chunks`, the kept triangles go to chunks->take a chunk at a time (finish() then
+  /// returns the parts alone): the builder holds the vertex table and one chunk.
+  SoupBuilder(std::string file_name, ReadReport& report, const SoupChunks* chunks = nullptr)
+      : file_name_(std::move(file_name)), report_(report), chunks_(chunks) {}
+
+  /// No later triangle uses a vertex added before it (an STL): a chunk's vertices are let go
+  /// with it.
+  void vertices_unshared() { vertices_unshared_ = true; }
 
   /// Starts a part; later triangles go to it. An empty path is the name. A path already
   /// used gets "#2", "#3", ... appended (a soup's paths are unique). Returns the part's id.
@@ -77,13 +85,17 @@ class SoupBuilder {
   /// Reserves for the counts a header announces. A header may lie: no format stores a vertex
   /// in fewer than 3 bytes or a face in fewer than 4, so the file size caps the reservation.
   void reserve(std::uint64_t vertices, std::uint64_t triangles, std::uint64_t file_bytes) {
+    if (chunks_ != nullptr) {
+      if (vertices_unshared_) vertices = 0;
+      triangles = std::min<std::uint64_t>(triangles, chunks_->triangles);
+    }
     soup_.vertices.reserve(static_cast<std::size_t>(std::min(vertices, file_bytes / 3)));
     const auto faces = static_cast<std::size_t>(std::min(triangles, file_bytes / 4));
     soup_.triangles.reserve(faces);
     soup_.part_of.reserve(faces);
   }
 
-  std::uint64_t vertex_count() const { return soup_.vertices.size(); }
+  std::uint64_t vertex_count() const { return vertex_base_ + soup_.vertices.size(); }
   void add_vertex(const Vec3& p) { soup_.vertices.push_back(p); }
 
   /// Indices are global (into every vertex added so far) and already range-checked.
@@ -91,6 +103,7 @@ class SoupBuilder {
     soup_.triangles.push_back({a, b, c});
     soup_.part_of.push_back(part_);
     ++report_.triangles_read;
+    if (chunks_ != nullptr && soup_.triangles.size() >= chunks_->triangles) hand_over_chunk();
   }
   /// A face of any size, fan-triangulated around its first corner (fewer than 3 corners: the
   /// caller rejects it first).
@@ -100,16 +113,30 @@ class SoupBuilder {
       add_triangle(corners[0], corners[i], corners[i + 1]);
   }
 
-  /// Drops degenerate triangles and returns the soup.
+  /// Drops degenerate triangles and returns the soup (in chunks: the last chunk handed over,
+  /// the parts alone).
   /// @throw InputError if no triangle is left.
   TriangleSoup finish();
 
  private:
+  // True (and counted in the report) when triangle `t` of the soup, the file's triangle at
+  // `position`, repeats a corner or has collinear corners.
+  bool drop_if_degenerate(std::size_t t, std::uint64_t position);
+  // The kept triangles added since the last chunk, with the vertices they use, to chunks_.
+  void hand_over_chunk();
+  [[noreturn]] void throw_no_triangle_left() const;
+
   std::string file_name_;
   ReadReport& report_;
+  const SoupChunks* chunks_ = nullptr;
   TriangleSoup soup_;
   std::uint32_t part_ = 0;
   std::set<std::string> used_paths_;
+  bool vertices_unshared_ = false;
+  std::uint64_t vertex_base_ = 0;        // vertices let go with earlier chunks
+  std::uint64_t triangles_before_ = 0;   // the file's triangles handed over (or dropped) before
+  std::uint64_t kept_before_ = 0;        // triangles kept in chunks handed over
+  std::vector<std::uint32_t> chunk_vertex_;  // a vertex's number in the chunk being made
 };
 
 /// Whitespace-separated tokens of a text file, with the line they came from; a token never
@@ -165,6 +192,7 @@ constexpr std::uint64_t max_vertices = std::numeric_limits<std::uint32_t>::max()
 /// shows more: a binary PLY's face bytes bound its corners).
 struct MeshCounts {
   std::uint64_t vertices = 0, faces = 0, triangles = 0;
+  bool part_table = false;  ///< a PLY's part table (after the faces: read whole)
 };
 /// @throw FormatError, InputError as read_ply and read_off do for the same header.
 MeshCounts read_ply_counts(InputFile& file);
@@ -173,10 +201,11 @@ MeshCounts read_ply_counts(InputFile& file);
 std::optional<std::uint64_t> binary_stl_count(InputFile& file);
 MeshCounts read_off_counts(InputFile& file);
 
-TriangleSoup read_obj(InputFile& file, ReadReport& report);
-TriangleSoup read_stl(InputFile& file, ReadReport& report);
-TriangleSoup read_ply(InputFile& file, ReadReport& report);
-TriangleSoup read_off(InputFile& file, ReadReport& report);
+/// The readers of our own: with `chunks`, the triangles go there (SoupBuilder).
+TriangleSoup read_obj(InputFile& file, ReadReport& report, const SoupChunks* chunks = nullptr);
+TriangleSoup read_stl(InputFile& file, ReadReport& report, const SoupChunks* chunks = nullptr);
+TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chunks = nullptr);
+TriangleSoup read_off(InputFile& file, ReadReport& report, const SoupChunks* chunks = nullptr);
 /// Any format Assimp knows; one part per mesh node instance.
 TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report);
 

@@ -14,13 +14,15 @@ namespace {
 constexpr std::uint64_t header_bytes = 84;
 constexpr std::uint64_t facet_bytes = 50;
 
-TriangleSoup read_binary_stl(InputFile& file, ReadReport& report, std::uint64_t count) {
+TriangleSoup read_binary_stl(InputFile& file, ReadReport& report, std::uint64_t count,
+                             const SoupChunks* chunks) {
   report.encoding = "binary";
   if (3 * count > max_vertices) {
     throw InputError(file.name() + ": " + std::to_string(count) +
                      " triangles are more than a soup can index");
   }
-  SoupBuilder soup(file.name(), report);
+  SoupBuilder soup(file.name(), report, chunks);
+  soup.vertices_unshared();
   soup.begin_part(file.path().stem().string());
   soup.reserve(3 * count, count, file.size());
   file.take(header_bytes);
@@ -63,9 +65,10 @@ void expect_keyword(TokenReader& tokens, std::string_view keyword) {
   }
 }
 
-TriangleSoup read_ascii_stl(InputFile& file, ReadReport& report) {
+TriangleSoup read_ascii_stl(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
   report.encoding = "ascii";
-  SoupBuilder soup(file.name(), report);
+  SoupBuilder soup(file.name(), report, chunks);
+  soup.vertices_unshared();
   soup.begin_part(file.path().stem().string());
   TokenReader tokens(file);
   std::vector<std::uint32_t> corners;
@@ -124,14 +127,14 @@ std::optional<std::uint64_t> binary_stl_count(InputFile& file) {
   return count;
 }
 
-TriangleSoup read_stl(InputFile& file, ReadReport& report) {
-  if (const auto count = binary_stl_count(file)) return read_binary_stl(file, report, *count);
+TriangleSoup read_stl(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
+  if (const auto count = binary_stl_count(file)) return read_binary_stl(file, report, *count, chunks);
   const std::string_view head = file.peek(header_bytes);
   std::string_view text = head;
   while (!text.empty() && (is_space(text.front()) || text.front() == '\n')) text.remove_prefix(1);
   // ASCII STL never holds a NUL byte; a binary header usually does (zero padding).
   const bool looks_binary = head.find('\0') != std::string_view::npos;
-  if (text.starts_with("solid") && !looks_binary) return read_ascii_stl(file, report);
+  if (text.starts_with("solid") && !looks_binary) return read_ascii_stl(file, report, chunks);
   if (head.size() < header_bytes) {
     throw FormatError(file.name() + ": not an STL file: " + std::to_string(file.size()) +
                       " bytes, too short for a binary STL (84-byte header) and not ASCII "

@@ -890,5 +890,87 @@ TEST(MeshReader, RealOffMeshesAgreeWithCgalReader) {
   EXPECT_GT(compared, 0) << "no real mesh found under " << TETRAPAGE_MESH_DIR;
 }
 
+// read_mesh_in_chunks against read_mesh: CGAL's meshes written by CGAL in each format our
+// readers read (binary STL and PLY, ASCII OBJ and OFF), a file with degenerate triangles and
+// polygons, and a PLY with a part table (read whole). The chunks, appended, are the whole
+// read's triangles, parts and report; no chunk holds more than asked.
+TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  const auto folder = scratch_folder("chunks");
+  std::vector<std::filesystem::path> files;
+  for (const char* name : {"elephant.off", "mech-holes-shark.off"}) {
+    const auto path = std::filesystem::path(TETRAPAGE_MESH_DIR) / name;
+    if (!std::filesystem::exists(path)) continue;
+    std::vector<Point> points;
+    std::vector<std::vector<std::size_t>> polygons;
+    ASSERT_TRUE(CGAL::IO::read_polygon_soup(path.string(), points, polygons)) << name;
+    for (const char* extension : {".obj", ".stl", ".ply", ".off"}) {
+      files.push_back(folder / (path.stem().string() + extension));
+      ASSERT_TRUE(CGAL::IO::write_polygon_soup(files.back().string(), points, polygons,
+                                               CGAL::parameters::use_binary_mode(true)))
+          << files.back();
+    }
+  }
+  ASSERT_FALSE(files.empty()) << "no real mesh found under " << TETRAPAGE_MESH_DIR;
+  // Degenerate triangles at the chunks' seams, a quad and a pentagon.
+  files.push_back(folder / "degenerate.off");
+  write_file(files.back(), "OFF\n7 6 0\n0 0 0\n1 0 0\n0 1 0\n2 2 2\n3 3 3\n0 0 0\n4 4 5\n"
+                           "3 0 1 2\n3 0 1 1\n4 0 1 2 6\n3 0 3 4\n5 0 1 2 6 3\n3 0 5 1\n");
+  TriangleSoup parts;
+  parts.add_part("a");
+  parts.add_part("b", "x/b");
+  parts.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  parts.triangles = {{0, 1, 2}, {0, 1, 3}, {0, 2, 3}, {1, 2, 3}};
+  parts.part_of = {0, 1, 1, 0};
+  files.push_back(folder / "parts.ply");
+  write_mesh(files.back(), parts);
+
+  for (const auto& file : files) {
+    ReadReport whole_report;
+    const TriangleSoup whole = read_mesh(file, &whole_report);
+    for (const std::size_t size : {std::size_t(1), std::size_t(3), std::size_t(1000)}) {
+      SCOPED_TRACE(file.filename().string() + ", chunks of " + std::to_string(size));
+      std::vector<std::array<Vec3, 3>> corners;
+      std::vector<std::uint32_t> part_of;
+      SoupChunks chunks;
+      chunks.triangles = size;
+      chunks.take = [&](TriangleSoup&& chunk) {
+        if (file.filename() != "parts.ply") EXPECT_LE(chunk.triangle_count(), size);
+        EXPECT_EQ(chunk.part_of.size(), chunk.triangle_count());
+        for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
+          corners.push_back(chunk.corners(t));
+          part_of.push_back(chunk.part_of[t]);
+        }
+      };
+      ReadReport report;
+      const TriangleSoup names = read_mesh_in_chunks(file, &report, chunks);
+      EXPECT_EQ(names.triangle_count(), 0u);
+      EXPECT_EQ(names.part_names, whole.part_names);
+      EXPECT_EQ(names.part_paths, whole.part_paths);
+      ASSERT_EQ(corners.size(), whole.triangle_count());
+      for (std::size_t t = 0; t < corners.size(); ++t) {
+        ASSERT_EQ(corners[t], whole.corners(t)) << "triangle " << t;
+        ASSERT_EQ(part_of[t], whole.part_of[t]) << "triangle " << t;
+      }
+      EXPECT_EQ(report.triangles_read, whole_report.triangles_read);
+      EXPECT_EQ(report.degenerate_dropped, whole_report.degenerate_dropped);
+      EXPECT_EQ(report.dropped_positions, whole_report.dropped_positions);
+      EXPECT_EQ(report.polygons_triangulated, whole_report.polygons_triangulated);
+      EXPECT_EQ(report.encoding, whole_report.encoding);
+    }
+  }
+}
+
+// A file whose triangles are all degenerate is refused in chunks as it is whole.
+TEST(MeshReader, ChunksOfNothingAreRefusedAsTheWholeRead) {
+  const auto path = scratch_folder("chunks_nothing") / "flat.off";
+  write_file(path, "OFF\n3 2 0\n0 0 0\n1 1 1\n2 2 2\n3 0 1 2\n3 0 0 1\n");
+  SoupChunks chunks;
+  chunks.triangles = 1;
+  chunks.take = [](TriangleSoup&&) { ADD_FAILURE() << "a degenerate triangle was handed over"; };
+  expect_error<InputError>([&] { read_mesh_in_chunks(path, nullptr, chunks); },
+                           {path.string(), "no triangle left", "2 degenerate"});
+}
+
 }  // namespace
 }  // namespace tetrapage::test

@@ -5,6 +5,7 @@
 /// formats Assimp knows go through Assimp, which Debian builds in single precision.
 
 #include <filesystem>
+#include <functional>
 #include <span>
 
 #include "tetrapage/formats/CadReader.h"
@@ -45,6 +46,24 @@ MeshFormat mesh_format_from_path(const std::filesystem::path& path);
 TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr,
                        const TessellationOptions& tessellation = {});
 
+/// Where read_mesh_in_chunks sends a file's triangles.
+struct SoupChunks {
+  std::size_t triangles = 1 << 16;  ///< the most triangles a chunk holds (a PLY with a part table: all)
+  /// Each chunk, in file order: vertices (its own), triangles, part_of (the file's part ids).
+  std::function<void(TriangleSoup&&)> take;
+};
+
+/// Reads a mesh file as read_mesh does, handing its kept triangles to `chunks.take` a chunk at a
+/// time: the chunks appended in order are read_mesh's soup (the same corners, parts and order;
+/// the same report). Returns the parts (part_names, part_paths) and no triangle. OBJ, OFF and
+/// PLY hold their vertex table while they are read, an STL a chunk's vertices; a PLY with a
+/// part table and the formats MeshReadEstimate::chunked does not name are read whole and
+/// handed over as one chunk.
+/// @throw as read_mesh, and whatever `take` throws.
+TriangleSoup read_mesh_in_chunks(const std::filesystem::path& path, ReadReport* report,
+                                 const SoupChunks& chunks,
+                                 const TessellationOptions& tessellation = {});
+
 /// Reads any file through Assimp (aiProcess_Triangulate), even one of the formats that have a
 /// reader of our own: the comparison path for benchmarks and tests. Walks the node hierarchy
 /// applying the node transforms; one part per mesh node instance, named by the file stem when
@@ -76,6 +95,10 @@ struct MeshReadEstimate {
   /// The reader's peak heap: its soup and what it holds beside while reading (growing arrays,
   /// the degenerate filter's shrink, Assimp's scene, the read block).
   std::uint64_t reading_bytes = 0;
+  /// read_mesh_in_chunks reads the file a chunk at a time, holding chunked_bytes beside the
+  /// chunk: the vertex table (none for an STL), its chunk numbers and the read block.
+  bool chunked = false;
+  std::uint64_t chunked_bytes = 0;
   /// The soup once read: 24 B a vertex, 12 a triangle and 4 for its part.
   std::uint64_t soup_bytes() const { return 24 * vertices + 16 * triangles; }
 };
