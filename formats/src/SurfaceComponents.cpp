@@ -144,7 +144,7 @@ SurfaceComponents find_surface_components(const TriangleSoup& soup) {
   result.component_of.resize(soup.triangle_count());
   constexpr std::uint32_t kNone = 0xffffffffu;
   std::vector<std::uint32_t> component_of_root(nodes.count(), kNone);
-  std::vector<EdgeParity> parity;
+  std::vector<EdgeParity>& parity = result.parities;
   for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
     const auto& c = soup.triangles[t];
     std::array<std::uint32_t, 3> node{};

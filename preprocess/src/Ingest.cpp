@@ -8,6 +8,7 @@
 #include <memory>
 #include <random>
 
+#include "tetrapage/preprocess/ChunkedComponents.h"
 #include "Interiors.h"
 #include "OrderedPipeline.h"
 #include "SpillPath.h"
@@ -27,12 +28,27 @@ namespace {
 constexpr std::uint64_t kPartEntryBytes = 2 * sizeof(std::string) + sizeof(std::uint64_t);
 constexpr std::uint64_t kComponentEntryBytes = sizeof(SurfaceComponent);
 
+// A file too large to read whole within the budget, read in chunks by its producer: the chunks
+// in a spill of their own, their triangles labelled with their pieces of components, and the
+// components those labels unite into (ChunkedComponents).
+struct StreamedFile {
+  explicit StreamedFile(const std::filesystem::path& spill_folder) {
+    chunks.spill_to(spill_path(spill_folder, "chunks"));
+  }
+  SoupSpill<TriangleRecord> chunks;
+  ChunkedComponents::United united;
+  TriangleSoup parts;  // the file's part names and paths
+  std::vector<std::uint64_t> part_triangles;
+  std::uint64_t triangles = 0, soup_bytes = 0;
+};
+
 // One input piece as its producer left it: its file read, and either placed whole with its
 // surfaces' connected components (its part_of then holds each triangle's component, numbered
 // within the soup), or, when its copies do not fit a batch, the loader the in-order consumer
-// places them from, a batch at a time.
+// places them from, a batch at a time, or read in chunks (streamed).
 struct LoadedSoup {
   std::unique_ptr<PieceLoader> loader;  // placed in batches; null when `soup` holds the piece
+  std::unique_ptr<StreamedFile> streamed;  // read in chunks; null unless the file is
   ReadReport report;                    // the file's (placed whole)
   std::string length_unit;  // of its coordinates: the manifest's, or what the reader said
   std::string file;         // what the unit came from, for messages
@@ -71,6 +87,7 @@ void find_components(LoadedSoup& loaded, const InputPiece& piece) {
 struct PieceEstimate {
   MeshReadEstimate read;
   std::uint64_t bytes = 0;
+  bool streamed = false;  // read in chunks (StreamedFile): bytes exceed the room it has
 };
 // The reservoir sample holds at most this many centroids (ingest() says why).
 constexpr std::uint64_t kMostSampledCentroids = std::uint64_t(1) << 21;
@@ -85,6 +102,28 @@ std::uint64_t piece_bytes(const MeshReadEstimate& read, std::size_t copies, bool
   constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
   return kSlack + std::max({read.reading_bytes, soup + components, soup + sample,
                             manifest ? 2 * soup : 0});
+}
+
+// A streamed file's chunks and the buckets its positions are united in, one at a time.
+constexpr std::size_t kChunkTriangles = std::size_t(1) << 15;
+constexpr std::uint64_t kPositionBucketBytes = std::uint64_t(8) << 20;
+
+// What reading a file in chunks holds beside the reader's tables (MeshReadEstimate::
+// chunked_bytes): a chunk as the reader builds it (16 B a triangle) and hands it over (at most
+// three vertices a triangle: 88 B), its component search, its positions before they are
+// sorted out (96 B a triangle), and a bucket of positions while it is united (read, then
+// sorted in place). The labels (a component's piece per chunk, about) are tables, counted
+// with the model's.
+std::uint64_t streamed_bytes(const MeshReadEstimate& read) {
+  constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
+  constexpr std::uint64_t n = kChunkTriangles;
+  const std::uint64_t chunk = n * (16 + 88 + 96) + surface_components_bytes(3 * n, n);
+  return kSlack + read.chunked_bytes + std::max(chunk, 2 * kPositionBucketBytes);
+}
+
+// A mesh file given on its own, in a format read in chunks (MeshReadEstimate::chunked).
+bool can_stream(const InputPiece& piece, const PieceEstimate& estimate) {
+  return estimate.read.chunked && piece.manifest == nullptr;
 }
 
 PieceEstimate estimate_piece(const InputPiece& piece) {
@@ -182,10 +221,10 @@ std::uint64_t memory_admitting(std::uint64_t bytes, std::uint64_t memory, Beside
 }
 
 // Up front, before any file is read: every piece whose estimate exceeds the room the budget
-// leaves it is refused with the figure (STEP and IGES once tessellated: load_soup). Returns
-// each piece's room.
+// leaves it is read in chunks where it can be and fits so, else refused with the figure (STEP
+// and IGES once tessellated: load_soup). Returns each piece's room.
 std::vector<std::uint64_t> check_read_room(const std::vector<InputPiece>& jobs,
-                                           const std::vector<PieceEstimate>& estimates,
+                                           std::vector<PieceEstimate>& estimates,
                                            const PreprocessOptions& options, std::size_t threads) {
   const std::uint64_t memory = options.memory_bytes;
   const std::uint64_t largest = largest_estimate(estimates);
@@ -201,9 +240,15 @@ std::vector<std::uint64_t> check_read_room(const std::vector<InputPiece>& jobs,
     const std::uint64_t held = beside(memory);
     const std::uint64_t total = memory + kPreprocessInputAllowance;
     rooms[j] = total > held ? total - held : 0;
-    if (estimates[j].bytes <= rooms[j]) continue;
-    refuse_reading(jobs[j].file(), estimates[j].read, estimates[j].bytes, held,
-                   memory_admitting(estimates[j].bytes, memory, beside), memory);
+    const bool streams = can_stream(jobs[j], estimates[j]);
+    if (estimates[j].bytes <= rooms[j] && !(options.force_spill && streams)) continue;
+    const std::uint64_t bytes = streams ? streamed_bytes(estimates[j].read) : estimates[j].bytes;
+    if (bytes <= rooms[j]) {
+      estimates[j].streamed = streams;
+      continue;
+    }
+    refuse_reading(jobs[j].file(), estimates[j].read, bytes, held,
+                   memory_admitting(bytes, memory, beside), memory);
   }
   return rooms;
 }
@@ -244,9 +289,63 @@ TessellationOptions tessellation_within(const InputPiece& piece, const Preproces
   return tessellation;
 }
 
-LoadedSoup load_soup(const InputPiece& piece, const PreprocessOptions& options,
+// The tables cannot spill: a model whose tables alone exceed the budget is refused (a tetras
+// file of 50,000 parts, 9.4 MiB of tables, is a model the 16 MiB budget works with).
+void check_table_bytes(std::uint64_t parts, std::uint64_t bytes, const PreprocessOptions& options) {
+  if (bytes <= options.memory_bytes) return;
+  std::string message = std::to_string(parts);
+  message.append(" parts need about ")
+      .append(format_byte_size(bytes))
+      .append(" of part and component tables, above --memory ")
+      .append(format_byte_size(options.memory_bytes))
+      .append(": raise --memory to ")
+      .append(format_byte_size(2 * bytes))
+      .append(" or more");
+  throw InputError(message);
+}
+
+// Reads a file in chunks into a StreamedFile: each chunk's coordinates checked, its parts
+// counted, its components labelled, and the chunk spilled; the labels united at the end.
+std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const PieceEstimate& estimate,
+                                            const PreprocessOptions& options,
+                                            const std::filesystem::path& spill_folder,
+                                            ReadReport& report) {
+  auto file = std::make_unique<StreamedFile>(spill_folder);
+  // Distinct positions: about the vertices of an indexed file, a sixth of an STL's corners.
+  const std::uint64_t positions =
+      estimate.read.vertices <= 2 * estimate.read.triangles ? estimate.read.vertices
+                                                            : estimate.read.vertices / 6;
+  ChunkedComponents components(spill_folder, positions, kPositionBucketBytes);
+  SoupChunks chunks;
+  chunks.triangles = kChunkTriangles;
+  chunks.take = [&](TriangleSoup&& chunk) {
+    check_coordinate_magnitudes(chunk, piece);
+    for (const std::uint32_t part : chunk.part_of) {
+      if (part >= file->part_triangles.size()) file->part_triangles.resize(part + 1, 0);
+      ++file->part_triangles[part];
+    }
+    components.add_chunk(chunk, file->triangles);
+    check_table_bytes(file->part_triangles.size(), components.label_bytes(), options);
+    file->triangles += chunk.triangle_count();
+    file->soup_bytes += SoupSpill<TriangleRecord>::soup_bytes(chunk);
+    file->chunks.append(std::move(chunk), 0);
+  };
+  file->parts = read_mesh_in_chunks(piece.file(), &report, chunks, options.tessellation);
+  file->part_triangles.resize(std::max<std::size_t>(file->parts.part_count(), 1), 0);
+  file->united = components.unite();
+  return file;
+}
+
+LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
+                     const PreprocessOptions& options, const std::filesystem::path& spill_folder,
                      std::size_t threads, std::uint64_t room) {
   LoadedSoup loaded;
+  if (estimate.streamed) {
+    loaded.file = piece.input.string();
+    loaded.streamed = read_streamed(piece, estimate, options, spill_folder, loaded.report);
+    loaded.length_unit = loaded.report.length_unit;
+    return loaded;
+  }
   auto loader = std::make_unique<PieceLoader>(piece, tessellation_within(piece, options, room));
   loaded.file = piece.input.string();
   loaded.length_unit = piece.manifest ? piece.manifest->units : loader->report().length_unit;
@@ -292,21 +391,6 @@ void settle_length_unit(IngestedModel& model, const std::string& option) {
   }
 }
 
-
-// The tables cannot spill: a model whose tables alone exceed the budget is refused (a tetras
-// file of 50,000 parts, 9.4 MiB of tables, is a model the 16 MiB budget works with).
-void check_table_bytes(std::uint64_t parts, std::uint64_t bytes, const PreprocessOptions& options) {
-  if (bytes <= options.memory_bytes) return;
-  std::string message = std::to_string(parts);
-  message.append(" parts need about ")
-      .append(format_byte_size(bytes))
-      .append(" of part and component tables, above --memory ")
-      .append(format_byte_size(options.memory_bytes))
-      .append(": raise --memory to ")
-      .append(format_byte_size(2 * bytes))
-      .append(" or more");
-  throw InputError(message);
-}
 
 // Up front, before any file is read: each placed copy is at least one part.
 void check_part_count(const std::vector<InputPiece>& jobs, const PreprocessOptions& options) {
@@ -393,34 +477,51 @@ void sample_centroids(IngestedModel& model, const TriangleSoup& soup, IngestStat
   }
 }
 
-// Appends a placed soup's parts, components and triangles to the model (its arrays taken);
-// the soups spill once they would hold more than a quarter of the budget.
-void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptions& options,
-                 const std::filesystem::path& spill_folder, IngestState& state) {
+// Appends a file's parts (`names`, and `triangles` kept in each) to the model's tables;
+// returns the first one's number.
+std::uint32_t append_parts(IngestedModel& model, const TriangleSoup& names,
+                           const std::vector<std::uint64_t>& triangles, IngestState& state) {
   const auto part_offset = std::uint32_t(model.part_names.size());
-  for (std::size_t p = 0; p < loaded.soup.part_count(); ++p) {
-    model.part_names.push_back(loaded.soup.part_names[p]);
-    model.part_paths.push_back(loaded.soup.part_path(p));
+  for (std::size_t p = 0; p < names.part_count(); ++p) {
+    model.part_names.push_back(names.part_names[p]);
+    model.part_paths.push_back(names.part_path(p));
   }
-  if (loaded.soup.part_names.empty()) {
+  if (names.part_names.empty()) {
     model.part_names.push_back("part" + std::to_string(part_offset));
     model.part_paths.push_back(model.part_names.back());
   }
   for (std::size_t p = part_offset; p < model.part_names.size(); ++p)
     state.table_bytes +=
         kPartEntryBytes + model.part_names[p].capacity() + model.part_paths[p].capacity();
-  model.part_triangles.insert(model.part_triangles.end(), loaded.part_triangles.begin(),
-                              loaded.part_triangles.end());
-  if (model.components.size() + loaded.components.size() >= kInteriorUndecided)
+  model.part_triangles.insert(model.part_triangles.end(), triangles.begin(), triangles.end());
+  return part_offset;
+}
+
+// Appends a file's components (their parts numbered in the file) to the model's; returns the
+// first one's number.
+std::uint32_t append_components(IngestedModel& model, std::vector<SurfaceComponent>& components,
+                                std::uint32_t part_offset, const PreprocessOptions& options,
+                                IngestState& state) {
+  if (model.components.size() + components.size() >= kInteriorUndecided)
     throw InputError("the inputs hold more than 2^32 - 2 connected components");
   const auto component_offset = std::uint32_t(model.components.size());
-  for (SurfaceComponent& c : loaded.components) {
+  for (SurfaceComponent& c : components) {
     c.part += part_offset;
     model.bounds.extend(c.bounds);
     model.components.push_back(c);
   }
-  state.table_bytes += kComponentEntryBytes * loaded.components.size();
+  state.table_bytes += kComponentEntryBytes * components.size();
   check_table_bytes(model.part_names.size(), state.table_bytes, options);
+  return component_offset;
+}
+
+// Appends a placed soup's parts, components and triangles to the model (its arrays taken);
+// the soups spill once they would hold more than a quarter of the budget.
+void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptions& options,
+                 const std::filesystem::path& spill_folder, IngestState& state) {
+  const std::uint32_t part_offset = append_parts(model, loaded.soup, loaded.part_triangles, state);
+  const std::uint32_t component_offset =
+      append_components(model, loaded.components, part_offset, options, state);
   sample_centroids(model, loaded.soup, state);
   const std::uint64_t bytes = SoupSpill<TriangleRecord>::soup_bytes(loaded.soup);
   state.soup_bytes += bytes;
@@ -430,6 +531,23 @@ void append_soup(IngestedModel& model, LoadedSoup& loaded, const PreprocessOptio
     model.soups.spill_to(spill_path(spill_folder, "triangles"));
   model.soups.append(std::move(loaded.soup), component_offset);
   loaded.soup = TriangleSoup();
+}
+
+// Appends a file read in chunks: its parts and components, then its chunks one at a time, each
+// triangle's label replaced by its component; the model's soups spill (the file did not fit).
+void append_streamed(IngestedModel& model, StreamedFile& file, const PreprocessOptions& options,
+                     const std::filesystem::path& spill_folder, IngestState& state) {
+  const std::uint32_t part_offset = append_parts(model, file.parts, file.part_triangles, state);
+  const std::uint32_t component_offset =
+      append_components(model, file.united.components, part_offset, options, state);
+  if (!model.soups.spilled()) model.soups.spill_to(spill_path(spill_folder, "triangles"));
+  file.chunks.for_each_soup([&](TriangleSoup&& chunk, std::uint32_t) {
+    for (std::uint32_t& label : chunk.part_of) label = file.united.component_of_label[label];
+    sample_centroids(model, chunk, state);
+    state.soup_bytes += SoupSpill<TriangleRecord>::soup_bytes(chunk);
+    model.soups.append(std::move(chunk), component_offset);
+  });
+  file.chunks.clear();
 }
 
 // Places a piece's copies a batch at a time, each batch within its share of the budget, on all
@@ -462,6 +580,16 @@ void append_piece(IngestedModel& model, LoadedSoup& loaded, const InputPiece& pi
                   const PreprocessOptions& options, const std::filesystem::path& spill_folder,
                   const DiskRoom& room, IngestState& state, PreprocessSummary& summary,
                   std::size_t threads) {
+  if (loaded.streamed) {
+    // Its chunks' spill is on the disk beside the model's until they are appended.
+    const StreamedFile& file = *loaded.streamed;
+    check_disk_room(room, double(model.triangle_count + file.triangles),
+                    double(state.soup_bytes + 2 * file.soup_bytes), options);
+    note_file(model, loaded, loaded.report, summary);
+    append_streamed(model, *loaded.streamed, options, spill_folder, state);
+    loaded.streamed.reset();
+    return;
+  }
   if (loaded.loader) {
     const TriangleSoup& source = loaded.loader->source();
     const double copies = double(loaded.loader->copies());
@@ -534,7 +662,8 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
   produce_in_parallel_consume_in_order(
       jobs.size(), ingest_depth(largest_estimate(estimates), options.memory_bytes, threads),
       [&](std::size_t j) {
-        return std::make_shared<LoadedSoup>(load_soup(jobs[j], options, threads, rooms[j]));
+        return std::make_shared<LoadedSoup>(
+            load_soup(jobs[j], estimates[j], options, spill_folder, threads, rooms[j]));
       },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         // In input order (ids, part numbers and the sample do not depend on the threads).

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/formats/TriangleSoup.h"
 
 namespace tetrapage {
@@ -27,6 +28,9 @@ struct SurfaceComponents {
   std::vector<std::uint32_t> component_of;  ///< per triangle
   /// Numbered in the order of their first triangles (the same soup gives the same numbers).
   std::vector<SurfaceComponent> components;
+  /// Per component, its edges folded: components of one surface found apart (in chunks of a
+  /// file) unite by merging theirs.
+  std::vector<EdgeParity> parities;
 
   std::size_t closed_count() const;
 };

@@ -163,6 +163,32 @@ class SoupSpill {
     file_.seek_end();
   }
 
+  /// Calls visit(TriangleSoup&&, std::uint32_t part_offset) on each soup appended, in order,
+  /// as append() took it (vertices, triangles, part_of; no part names).
+  /// @throw IoError when the file cannot be read back.
+  template <class Visit>
+  void for_each_soup(Visit&& visit) {
+    const auto emit = [&](Piece&& piece) {
+      TriangleSoup soup;
+      soup.vertices = std::move(piece.vertices);
+      soup.triangles = std::move(piece.triangles);
+      soup.part_of = std::move(piece.part_of);
+      visit(std::move(soup), piece.part_offset);
+    };
+    if (!file_) {
+      for (const Piece& piece : pieces_) emit(Piece(piece));
+      return;
+    }
+    file_.rewind();
+    for (std::uint64_t read = 0; read < count_;) {
+      Piece piece;
+      read_piece(piece);
+      read += piece.triangles.size();
+      emit(std::move(piece));
+    }
+    file_.seek_end();
+  }
+
   /// Frees the triangles and removes the file.
   void clear() {
     file_ = SpillFile();

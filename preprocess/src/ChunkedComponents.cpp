@@ -1,0 +1,174 @@
+#include "tetrapage/preprocess/ChunkedComponents.h"
+
+#include <algorithm>
+#include <bit>
+#include <numeric>
+#include <string>
+
+#include "SpillPath.h"
+#include "tetrapage/formats/Error.h"
+
+namespace tetrapage {
+namespace {
+
+// The most buckets open at once, and the split of a bucket that outgrew its bytes.
+constexpr std::uint64_t kMostBuckets = 256;
+constexpr std::uint64_t kSplitBuckets = 16;
+constexpr unsigned kMostSplits = 3;
+
+std::uint64_t bits_of(double x) { return std::bit_cast<std::uint64_t>(x == 0.0 ? 0.0 : x); }
+
+std::uint64_t mix(std::uint64_t x) {
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+template <class Record>
+std::uint64_t hash_of(const Record& r, unsigned depth) {
+  return mix(mix(mix(r.bits[0] ^ (std::uint64_t(r.part) << 32) ^ depth) + r.bits[1]) + r.bits[2]);
+}
+
+template <class Record>
+bool same_place(const Record& a, const Record& b) {
+  return a.bits == b.bits && a.part == b.part;
+}
+
+template <class Record>
+bool place_before(const Record& a, const Record& b) {
+  if (a.bits != b.bits) return a.bits < b.bits;
+  return a.part < b.part;
+}
+
+std::uint32_t find(std::vector<std::uint32_t>& parent, std::uint32_t x) {
+  while (parent[x] != x) x = parent[x] = parent[parent[x]];
+  return x;
+}
+
+void unite_labels(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
+  a = find(parent, a), b = find(parent, b);
+  if (a != b) parent[std::max(a, b)] = std::min(a, b);
+}
+
+}  // namespace
+
+ChunkedComponents::ChunkedComponents(const std::filesystem::path& spill_folder,
+                                     std::uint64_t expected_positions, std::uint64_t bucket_bytes)
+    : spill_folder_(spill_folder), bucket_bytes_(std::max<std::uint64_t>(bucket_bytes, 1)) {
+  const std::uint64_t bytes = expected_positions * sizeof(PositionRecord);
+  const std::uint64_t count = std::clamp<std::uint64_t>(bytes / bucket_bytes_ + 1, 1, kMostBuckets);
+  buckets_.reserve(count);
+  for (std::uint64_t b = 0; b < count; ++b)
+    buckets_.emplace_back(spill_path(spill_folder_, "positions-" + std::to_string(b)));
+}
+
+std::uint64_t ChunkedComponents::label_bytes() const {
+  return labels_.size() * (sizeof(SurfaceComponent) + sizeof(EdgeParity) + sizeof(std::uint32_t));
+}
+
+void ChunkedComponents::add_chunk(TriangleSoup& chunk, std::uint64_t first_triangle) {
+  SurfaceComponents found = find_surface_components(chunk);
+  const auto first_label = std::uint32_t(labels_.size());
+  if (labels_.size() + found.components.size() >= 0xfffffffeu)
+    throw InputError("the file holds more than 2^32 - 2 pieces of connected components");
+  for (std::size_t c = 0; c < found.components.size(); ++c) {
+    found.components[c].first_triangle += first_triangle;
+    labels_.push_back(found.components[c]);
+    parities_.push_back(found.parities[c]);
+  }
+  note_positions(chunk, found.component_of, first_label);
+  for (std::size_t t = 0; t < chunk.triangle_count(); ++t)
+    chunk.part_of[t] = first_label + found.component_of[t];
+}
+
+// Each distinct (position, part) of the chunk once, sorted out of the chunk's corners: a
+// position meets one label in a chunk (the chunk's components are whole within it).
+void ChunkedComponents::note_positions(const TriangleSoup& chunk,
+                                       const std::vector<std::uint32_t>& component_of,
+                                       std::uint32_t first_label) {
+  std::vector<PositionRecord>& records = chunk_positions_;
+  records.clear();
+  records.reserve(3 * chunk.triangle_count());
+  for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
+    const std::uint32_t part = chunk.part_of.empty() ? 0 : chunk.part_of[t];
+    for (const std::uint32_t v : chunk.triangles[t]) {
+      const Vec3& p = chunk.vertices[v];
+      records.push_back({{bits_of(p[0]), bits_of(p[1]), bits_of(p[2])}, part,
+                         first_label + component_of[t]});
+    }
+  }
+  std::sort(records.begin(), records.end(), place_before<PositionRecord>);
+  records.erase(std::unique(records.begin(), records.end(), same_place<PositionRecord>),
+                records.end());
+  // Appended bucket by bucket: one write per bucket and chunk.
+  std::sort(records.begin(), records.end(), [&](const PositionRecord& a, const PositionRecord& b) {
+    return hash_of(a, 0) % buckets_.size() < hash_of(b, 0) % buckets_.size();
+  });
+  for (std::size_t first = 0; first < records.size();) {
+    const std::uint64_t bucket = hash_of(records[first], 0) % buckets_.size();
+    std::size_t end = first + 1;
+    while (end < records.size() && hash_of(records[end], 0) % buckets_.size() == bucket) ++end;
+    buckets_[bucket].append(std::span<const PositionRecord>(records.data() + first, end - first));
+    first = end;
+  }
+}
+
+void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsigned depth,
+                                     std::vector<std::uint32_t>& parent) {
+  if (bucket.size() * sizeof(PositionRecord) > bucket_bytes_ && depth < kMostSplits) {
+    std::vector<RecordSpill<PositionRecord>> parts;
+    for (std::uint64_t b = 0; b < kSplitBuckets; ++b)
+      parts.emplace_back(spill_path(spill_folder_, "positions-" + std::to_string(depth + 1) +
+                                                       "-" + std::to_string(b)));
+    bucket.for_each_block(1 << 14, [&](std::span<const PositionRecord> block) {
+      for (const PositionRecord& r : block)
+        parts[hash_of(r, depth + 1) % kSplitBuckets].append(std::span<const PositionRecord>(&r, 1));
+    });
+    bucket.clear();
+    for (RecordSpill<PositionRecord>& part : parts) unite_bucket(part, depth + 1, parent);
+    return;
+  }
+  std::vector<PositionRecord> records = bucket.read_all();
+  bucket.clear();
+  std::sort(records.begin(), records.end(), place_before<PositionRecord>);
+  for (std::size_t i = 1; i < records.size(); ++i)
+    if (same_place(records[i - 1], records[i])) unite_labels(parent, records[i - 1].label, records[i].label);
+}
+
+ChunkedComponents::United ChunkedComponents::unite() {
+  std::vector<std::uint32_t> parent(labels_.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (RecordSpill<PositionRecord>& bucket : buckets_) unite_bucket(bucket, 0, parent);
+  std::vector<RecordSpill<PositionRecord>>().swap(buckets_);
+  std::vector<PositionRecord>().swap(chunk_positions_);
+
+  // Labels ascend with their first triangles, and a root is its set's least label: the first
+  // label met of each set numbers its component, in the order of first triangles.
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  United united;
+  united.component_of_label.assign(labels_.size(), kNone);
+  std::vector<EdgeParity> parity;
+  for (std::uint32_t label = 0; label < labels_.size(); ++label) {
+    const std::uint32_t root = find(parent, label);
+    std::uint32_t& component = united.component_of_label[root];
+    if (component == kNone) {
+      component = std::uint32_t(united.components.size());
+      united.components.push_back(labels_[label]);
+      parity.push_back(parities_[label]);
+    } else {
+      SurfaceComponent& into = united.components[component];
+      into.triangles += labels_[label].triangles;
+      into.bounds.extend(labels_[label].bounds);
+      parity[component].merge(parities_[label]);
+    }
+    united.component_of_label[label] = component;
+  }
+  for (std::size_t c = 0; c < parity.size(); ++c) united.components[c].closed = parity[c].closed();
+  std::vector<SurfaceComponent>().swap(labels_);
+  std::vector<EdgeParity>().swap(parities_);
+  return united;
+}
+
+}  // namespace tetrapage
