@@ -214,7 +214,7 @@ bool header_counts(const std::filesystem::path& path, MeshFormat format, MeshRea
     }
     out.vertices = counts.vertices;
     out.triangles = counts.triangles;
-    out.chunked = !counts.part_table;
+    out.chunked = true;
     // Arrays reserved from the counts; polygons grow the triangles' (old and new while
     // growing), else the degenerate filter's shrink copies them.
     out.reading_bytes = out.soup_bytes() + (counts.triangles > counts.faces ? 16 : 12) * counts.triangles;
@@ -250,7 +250,7 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
   out.reading_bytes += kReadBlockBytes;
   if (format == MeshFormat::obj || format == MeshFormat::stl || format == MeshFormat::ply ||
       format == MeshFormat::off) {
-    if (!out.counted) out.chunked = true;  // an OBJ or an ASCII STL
+    out.chunked = true;
     // The vertex table and a chunk number per vertex (an STL: a chunk's); an OBJ's grows.
     const std::uint64_t table = format == MeshFormat::stl ? 0 : 28 * out.vertices;
     out.chunked_bytes = kReadBlockBytes + (format == MeshFormat::obj ? 2 * table : table);

@@ -258,18 +258,25 @@ class PlyPartTable {
     faces_.push_back(faces);
   }
   void note_face(std::uint64_t face, std::int64_t corners) {
+    if (known_) {
+      while (face >= part_end_ && next_ < ids_.size()) part_end_ += faces_[next_++];
+      soup_.resume_part(ids_[next_ - 1]);
+      return;
+    }
     if (present_ && corners > 3) polygons_.push_back({face, std::uint64_t(corners - 3)});
   }
-  /// After every element: the table's counts must add up to the face element's.
-  /// @throw FormatError naming both counts when they differ.
+  /// The table was read up front (apply() called): the faces get their parts as they are read,
+  /// and the table met again is skipped.
+  void know_parts() {
+    known_ = !ids_.empty();
+    next_ = 0;
+    part_end_ = 0;
+  }
+  bool known() const { return known_; }
+  /// After every element: the table checked, then each triangle given its part.
   void apply(std::uint64_t face_count) {
     if (!present_) return;
-    std::uint64_t counted = 0;  // stops past face_count: a file's counts may overflow a sum
-    for (const auto faces : faces_) counted += std::min(faces, face_count + 1 - counted);
-    if (counted != face_count)
-      throw FormatError(file_.name() + ": the part table counts " +
-                        (counted > face_count ? "more" : std::to_string(counted)) +
-                        " faces, the face element has " + std::to_string(face_count));
+    check(face_count);
     std::uint64_t face = 0, triangle = 0;
     auto polygon = polygons_.begin();
     for (std::size_t k = 0; k < ids_.size(); ++k) {
@@ -280,6 +287,16 @@ class PlyPartTable {
       triangle += triangles;
     }
   }
+  /// The table's counts must add up to the face element's.
+  /// @throw FormatError naming both counts when they differ.
+  void check(std::uint64_t face_count) const {
+    std::uint64_t counted = 0;  // stops past face_count: a file's counts may overflow a sum
+    for (const auto faces : faces_) counted += std::min(faces, face_count + 1 - counted);
+    if (counted != face_count)
+      throw FormatError(file_.name() + ": the part table counts " +
+                        (counted > face_count ? "more" : std::to_string(counted)) +
+                        " faces, the face element has " + std::to_string(face_count));
+  }
 
  private:
   const InputFile& file_;
@@ -288,7 +305,14 @@ class PlyPartTable {
   std::vector<std::uint32_t> ids_;
   std::vector<std::uint64_t> faces_;                               ///< per part
   std::vector<std::pair<std::uint64_t, std::uint64_t>> polygons_;  ///< (face, corners - 3)
+  bool known_ = false;
+  std::size_t next_ = 0;        ///< known: the part after the current face's
+  std::uint64_t part_end_ = 0;  ///< known: the face that ends the current part
 };
+
+// What a pass over a PLY file reads: everything; the part table alone (before the faces, when
+// the faces go out in chunks and need their parts as they are read); everything but the table.
+enum class PlyPass { whole, table, geometry };
 
 PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
   PlyLayout layout;
@@ -343,15 +367,17 @@ PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
 class BinaryPlyReader {
  public:
   BinaryPlyReader(InputFile& file, bool big_endian, SoupBuilder& soup, const PlyLayout& layout,
-                  PlyPartTable& parts)
-      : file_(file), big_endian_(big_endian), soup_(soup), layout_(layout), parts_(parts) {}
+                  PlyPartTable& parts, PlyPass pass = PlyPass::whole)
+      : file_(file), big_endian_(big_endian), soup_(soup), layout_(layout), parts_(parts),
+        pass_(pass) {}
 
   void read_element(const PlyElement& element) {
-    if (&element == layout_.vertex) {
+    const bool geometry = pass_ != PlyPass::table, table = pass_ != PlyPass::geometry;
+    if (&element == layout_.vertex && geometry) {
       read_vertices(element);
-    } else if (&element == layout_.face) {
+    } else if (&element == layout_.face && geometry) {
       read_faces(element);
-    } else if (&element == layout_.parts) {
+    } else if (&element == layout_.parts && table) {
       read_parts(element);
     } else {
       skip(element);
@@ -526,19 +552,24 @@ class BinaryPlyReader {
   SoupBuilder& soup_;
   const PlyLayout& layout_;
   PlyPartTable& parts_;
+  PlyPass pass_;
   std::vector<std::uint32_t> corners_;
 };
 
 class AsciiPlyReader {
  public:
-  AsciiPlyReader(InputFile& file, SoupBuilder& soup, const PlyLayout& layout, PlyPartTable& parts)
-      : file_(file), tokens_(file), soup_(soup), layout_(layout), parts_(parts) {}
+  AsciiPlyReader(InputFile& file, SoupBuilder& soup, const PlyLayout& layout, PlyPartTable& parts,
+                 PlyPass pass = PlyPass::whole)
+      : file_(file), tokens_(file), soup_(soup), layout_(layout), parts_(parts), pass_(pass) {}
 
   void read_element(const PlyElement& element) {
-    if (&element == layout_.parts) return read_parts(element);
+    const bool geometry = pass_ != PlyPass::table;
+    if (&element == layout_.parts && pass_ != PlyPass::geometry) return read_parts(element);
     if (element.properties.empty()) return;  // records of nothing, however many
-    const bool is_vertex = &element == layout_.vertex;
-    const bool is_face = &element == layout_.face;
+    // Elements not read are tokenised all the same, record by record (an ASCII file has no
+    // other way past them).
+    const bool is_vertex = geometry && &element == layout_.vertex;
+    const bool is_face = geometry && &element == layout_.face;
     for (std::uint64_t r = 0; r < element.count; ++r) {
       Vec3 point{};
       for (std::size_t p = 0; p < element.properties.size(); ++p) {
@@ -662,6 +693,7 @@ class AsciiPlyReader {
   SoupBuilder& soup_;
   const PlyLayout& layout_;
   PlyPartTable& parts_;
+  PlyPass pass_;
   std::vector<std::uint32_t> corners_;
 };
 
@@ -675,7 +707,6 @@ MeshCounts read_ply_counts(InputFile& file) {
   counts.vertices = layout.vertex->count;
   counts.faces = layout.face != nullptr ? layout.face->count : 0;
   counts.triangles = counts.faces;
-  counts.part_table = layout.parts != nullptr;
   if (header.encoding == PlyEncoding::ascii || counts.faces == 0) return counts;
   // Binary: the bytes after the fixed-size elements before the faces bound the faces' corners,
   // hence their triangles (a face of k corners makes k - 2; polygons make more than a face).
@@ -694,33 +725,48 @@ MeshCounts read_ply_counts(InputFile& file) {
   return counts;
 }
 
+namespace {
+
+// Reads the elements of `header` from `file` as `pass` says.
+void read_elements(InputFile& file, const PlyHeader& header, const PlyLayout& layout,
+                   SoupBuilder& soup, PlyPartTable& parts, PlyPass pass) {
+  if (header.encoding == PlyEncoding::ascii) {
+    AsciiPlyReader reader(file, soup, layout, parts, pass);
+    for (const auto& element : header.elements) reader.read_element(element);
+  } else {
+    BinaryPlyReader reader(file, header.encoding == PlyEncoding::binary_big_endian, soup, layout,
+                           parts, pass);
+    for (const auto& element : header.elements) reader.read_element(element);
+  }
+}
+
+}  // namespace
+
 TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);
   check_counts_fit(file, header);
-  // The part table follows the faces: a file with one is read whole, then handed over.
-  SoupBuilder soup(file.name(), report, layout.parts == nullptr ? chunks : nullptr);
+  SoupBuilder soup(file.name(), report, chunks);
   if (layout.parts == nullptr) soup.begin_part(file.path().stem().string());
   PlyPartTable parts(file, soup, layout.parts != nullptr);
-  soup.reserve(layout.vertex->count, layout.face != nullptr ? layout.face->count : 0, file.size());
-  if (header.encoding == PlyEncoding::ascii) {
-    report.encoding = "ascii";
-    AsciiPlyReader reader(file, soup, layout, parts);
-    for (const auto& element : header.elements) reader.read_element(element);
-  } else {
-    const bool big_endian = header.encoding == PlyEncoding::binary_big_endian;
-    report.encoding = big_endian ? "binary_big_endian" : "binary_little_endian";
-    BinaryPlyReader reader(file, big_endian, soup, layout, parts);
-    for (const auto& element : header.elements) reader.read_element(element);
+  const std::uint64_t faces = layout.face != nullptr ? layout.face->count : 0;
+  if (chunks != nullptr && layout.parts != nullptr) {
+    // The table follows the faces: read first, in a pass of its own over the file.
+    InputFile table_file(file.path());
+    const PlyHeader table_header = read_header(table_file);
+    const PlyLayout table_layout = find_layout(table_file, table_header);
+    read_elements(table_file, table_header, table_layout, soup, parts, PlyPass::table);
+    parts.check(faces);
+    parts.know_parts();
   }
-  parts.apply(layout.face != nullptr ? layout.face->count : 0);
-  if (chunks == nullptr || layout.parts == nullptr) return soup.finish();
-  TriangleSoup whole = soup.finish();
-  TriangleSoup names;
-  names.part_names = std::move(whole.part_names);
-  names.part_paths = std::move(whole.part_paths);
-  chunks->take(std::move(whole));
-  return names;
+  soup.reserve(layout.vertex->count, faces, file.size());
+  report.encoding = header.encoding == PlyEncoding::ascii               ? "ascii"
+                    : header.encoding == PlyEncoding::binary_big_endian ? "binary_big_endian"
+                                                                        : "binary_little_endian";
+  read_elements(file, header, layout, soup, parts,
+                parts.known() ? PlyPass::geometry : PlyPass::whole);
+  if (!parts.known()) parts.apply(faces);
+  return soup.finish();
 }
 
 }  // namespace tetrapage::detail

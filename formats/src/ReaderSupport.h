@@ -192,7 +192,6 @@ constexpr std::uint64_t max_vertices = std::numeric_limits<std::uint32_t>::max()
 /// shows more: a binary PLY's face bytes bound its corners).
 struct MeshCounts {
   std::uint64_t vertices = 0, faces = 0, triangles = 0;
-  bool part_table = false;  ///< a PLY's part table (after the faces: read whole)
 };
 /// @throw FormatError, InputError as read_ply and read_off do for the same header.
 MeshCounts read_ply_counts(InputFile& file);

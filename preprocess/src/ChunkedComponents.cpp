@@ -33,12 +33,14 @@ std::uint64_t hash_of(const Record& r, unsigned depth) {
 
 template <class Record>
 bool same_place(const Record& a, const Record& b) {
-  return a.bits == b.bits && a.part == b.part;
+  return a.bits[0] == b.bits[0] && a.bits[1] == b.bits[1] && a.bits[2] == b.bits[2] &&
+         a.part == b.part;
 }
 
 template <class Record>
 bool place_before(const Record& a, const Record& b) {
-  if (a.bits != b.bits) return a.bits < b.bits;
+  for (int k = 0; k < 3; ++k)
+    if (a.bits[k] != b.bits[k]) return a.bits[k] < b.bits[k];
   return a.part < b.part;
 }
 
@@ -83,17 +85,22 @@ void ChunkedComponents::add_chunk(TriangleSoup& chunk, std::uint64_t first_trian
     chunk.part_of[t] = first_label + found.component_of[t];
 }
 
-// Each distinct (position, part) of the chunk once, sorted out of the chunk's corners: a
-// position meets one label in a chunk (the chunk's components are whole within it).
+// Each distinct (position, part) of the chunk once: a position meets one label in a chunk
+// (the chunk's components are whole within it). A vertex entry is noted once per part (an
+// indexed chunk's vertices serve about six triangles), then equal positions of distinct
+// entries (an STL's) are sorted out.
 void ChunkedComponents::note_positions(const TriangleSoup& chunk,
                                        const std::vector<std::uint32_t>& component_of,
                                        std::uint32_t first_label) {
+  constexpr std::uint32_t kNone = 0xffffffffu;
   std::vector<PositionRecord>& records = chunk_positions_;
   records.clear();
-  records.reserve(3 * chunk.triangle_count());
+  noted_part_.assign(chunk.vertices.size(), kNone);
   for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
     const std::uint32_t part = chunk.part_of.empty() ? 0 : chunk.part_of[t];
     for (const std::uint32_t v : chunk.triangles[t]) {
+      if (noted_part_[v] == part) continue;
+      noted_part_[v] = part;
       const Vec3& p = chunk.vertices[v];
       records.push_back({{bits_of(p[0]), bits_of(p[1]), bits_of(p[2])}, part,
                          first_label + component_of[t]});
@@ -102,17 +109,20 @@ void ChunkedComponents::note_positions(const TriangleSoup& chunk,
   std::sort(records.begin(), records.end(), place_before<PositionRecord>);
   records.erase(std::unique(records.begin(), records.end(), same_place<PositionRecord>),
                 records.end());
-  // Appended bucket by bucket: one write per bucket and chunk.
-  std::sort(records.begin(), records.end(), [&](const PositionRecord& a, const PositionRecord& b) {
-    return hash_of(a, 0) % buckets_.size() < hash_of(b, 0) % buckets_.size();
-  });
-  for (std::size_t first = 0; first < records.size();) {
-    const std::uint64_t bucket = hash_of(records[first], 0) % buckets_.size();
-    std::size_t end = first + 1;
-    while (end < records.size() && hash_of(records[end], 0) % buckets_.size() == bucket) ++end;
-    buckets_[bucket].append(std::span<const PositionRecord>(records.data() + first, end - first));
-    first = end;
+  // Grouped by bucket (a counting sort): one write per bucket and chunk.
+  const std::size_t count = buckets_.size();
+  bucket_of_.resize(records.size());
+  std::vector<std::size_t> first(count + 1, 0);
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    bucket_of_[i] = std::uint32_t(hash_of(records[i], 0) % count);
+    ++first[bucket_of_[i] + 1];
   }
+  for (std::size_t b = 0; b < count; ++b) first[b + 1] += first[b];
+  grouped_.resize(records.size());
+  std::vector<std::size_t> next(first.begin(), first.end() - 1);
+  for (std::size_t i = 0; i < records.size(); ++i) grouped_[next[bucket_of_[i]]++] = records[i];
+  for (std::size_t b = 0; b < count; ++b)
+    buckets_[b].append(std::span<const PositionRecord>(grouped_.data() + first[b], first[b + 1] - first[b]));
 }
 
 void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsigned depth,
@@ -143,6 +153,9 @@ ChunkedComponents::United ChunkedComponents::unite() {
   for (RecordSpill<PositionRecord>& bucket : buckets_) unite_bucket(bucket, 0, parent);
   std::vector<RecordSpill<PositionRecord>>().swap(buckets_);
   std::vector<PositionRecord>().swap(chunk_positions_);
+  std::vector<PositionRecord>().swap(grouped_);
+  std::vector<std::uint32_t>().swap(bucket_of_);
+  std::vector<std::uint32_t>().swap(noted_part_);
 
   // Labels ascend with their first triangles, and a root is its set's least label: the first
   // label met of each set numbers its component, in the order of first triangles.

@@ -586,6 +586,7 @@ void append_piece(IngestedModel& model, LoadedSoup& loaded, const InputPiece& pi
     check_disk_room(room, double(model.triangle_count + file.triangles),
                     double(state.soup_bytes + 2 * file.soup_bytes), options);
     note_file(model, loaded, loaded.report, summary);
+    ++summary.files_read_in_chunks;
     append_streamed(model, *loaded.streamed, options, spill_folder, state);
     loaded.streamed.reset();
     return;

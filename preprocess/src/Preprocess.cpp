@@ -175,6 +175,7 @@ std::string PreprocessSummary::to_json() const {
   nlohmann::ordered_json j;
   j["output"] = output.string();
   j["files_read"] = files_read;
+  if (files_read_in_chunks > 0) j["files_read_in_chunks"] = files_read_in_chunks;
   j["parts"] = parts;
   j["length_unit"] = length_unit;
   // Keys about a feature the run did not use are left out, not written as zeros: tessellation
@@ -240,6 +241,9 @@ std::string PreprocessSummary::to_text() const {
                 (unsigned long long)triangles_read, (unsigned long long)degenerate_dropped,
                 (unsigned long long)files_read, (unsigned long long)parts);
   text << line;
+  if (files_read_in_chunks > 0)
+    text << files_read_in_chunks << (files_read_in_chunks == 1 ? " file" : " files")
+         << " read in chunks (too large to read whole within --memory)\n";
   if (!length_unit.empty()) text << "model unit " << length_unit << "\n";
   if (tessellation_deflection > 0)
     text << "STEP/IGES tessellated within a deflection of " << tessellation_deflection << " "

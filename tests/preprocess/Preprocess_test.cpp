@@ -3,6 +3,8 @@
 // coordinates keep the promised rounding, a run that spills to disk under a small budget
 // writes the same index as one in memory, and bad input leaves nothing behind.
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/IO/polygon_soup_io.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -288,6 +290,71 @@ TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
     EXPECT_EQ(ra.read_table_uint32("tet_shard"), rb.read_table_uint32("tet_shard")) << other;
     for (std::uint32_t s = 0; s < ra.shard_count(); ++s)
       ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << other << " shard " << s;
+  }
+}
+
+// A file read in chunks (as one too large for the budget is) makes the index it makes read
+// whole: the same parts, components (closed or not), interiors and shards. CGAL's meshes,
+// closed and open, some overlapping, written by CGAL as one soup in PLY, STL and OBJ; about
+// 100,000 triangles, so that components cross the chunks' seams.
+TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
+  using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
+  const fs::path folder = test_folder("chunks");
+  std::vector<Point> points;
+  std::vector<std::vector<std::size_t>> polygons;
+  int copies = 0;
+  for (const char* name : {"elephant.off", "knot1.off", "mech-holes-shark.off", "fandisk.off"}) {
+    const fs::path path = fs::path(TETRAPAGE_MESH_DIR) / name;
+    if (!fs::exists(path)) continue;
+    std::vector<Point> mesh_points;
+    std::vector<std::vector<std::size_t>> mesh_polygons;
+    ASSERT_TRUE(CGAL::IO::read_polygon_soup(path.string(), mesh_points, mesh_polygons)) << name;
+    for (int copy = 0; copy < 3; ++copy, ++copies) {
+      const std::size_t base = points.size();
+      const double shift = 0.37 * copies;  // copies overlap their neighbours
+      for (const Point& p : mesh_points) points.emplace_back(p.x() + shift, p.y(), p.z() - shift);
+      for (auto polygon : mesh_polygons) {
+        for (std::size_t& v : polygon) v += base;
+        polygons.push_back(polygon);
+      }
+    }
+  }
+  ASSERT_GT(copies, 0) << "no real mesh found under " << TETRAPAGE_MESH_DIR;
+  for (const char* extension : {".ply", ".stl", ".obj"}) {
+    SCOPED_TRACE(extension);
+    const fs::path input = folder / (std::string("soup") + extension);
+    ASSERT_TRUE(CGAL::IO::write_polygon_soup(input.string(), points, polygons,
+                                             CGAL::parameters::use_binary_mode(true)));
+    PreprocessOptions whole;
+    whole.region_triangles = 4000;
+    whole.interiors = true;
+    const PreprocessSummary a = preprocess({input}, folder / "whole.tpi", whole);
+    EXPECT_EQ(a.files_read_in_chunks, 0u);
+    PreprocessOptions chunked = whole;
+    chunked.force_spill = true;
+    const PreprocessSummary b = preprocess({input}, folder / "chunked.tpi", chunked);
+    EXPECT_EQ(b.files_read_in_chunks, 1u);
+    EXPECT_NE(b.to_json().find("\"files_read_in_chunks\": 1"), std::string::npos);
+    EXPECT_GT(b.triangles_read, 3u * 32768);
+    EXPECT_EQ(a.triangles_read, b.triangles_read);
+    EXPECT_EQ(a.components, b.components);
+    for (const auto& entry : fs::directory_iterator(folder))
+      EXPECT_EQ(entry.path().filename().string().find(".tetrapage-spill"), std::string::npos) << entry.path();
+
+    const IndexReader ra(folder / "whole.tpi"), rb(folder / "chunked.tpi");
+    for (const std::string_view table :
+         {"tet_shard", "component_part", "interior_components"})
+      EXPECT_EQ(ra.read_table_uint32(table), rb.read_table_uint32(table)) << table;
+    EXPECT_EQ(ra.read_table_uint64("interior_offsets"), rb.read_table_uint64("interior_offsets"));
+    EXPECT_EQ(ra.read_table_uint8("component_closed"), rb.read_table_uint8("component_closed"));
+    EXPECT_EQ(ra.read_table_double("component_bounds"), rb.read_table_double("component_bounds"));
+    EXPECT_EQ(ra.read_table_uint64("part_triangles"), rb.read_table_uint64("part_triangles"));
+    const std::vector<std::uint8_t> closed = rb.read_table_uint8("component_closed");
+    EXPECT_GT(std::count(closed.begin(), closed.end(), 1), 0);
+    EXPECT_GT(std::count(closed.begin(), closed.end(), 0), 0);
+    ASSERT_EQ(ra.shard_count(), rb.shard_count());
+    for (std::uint32_t s = 0; s < ra.shard_count(); ++s)
+      ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << "shard " << s;
   }
 }
 

@@ -48,7 +48,7 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report = n
 
 /// Where read_mesh_in_chunks sends a file's triangles.
 struct SoupChunks {
-  std::size_t triangles = 1 << 16;  ///< the most triangles a chunk holds (a PLY with a part table: all)
+  std::size_t triangles = 1 << 16;  ///< the most triangles a chunk holds
   /// Each chunk, in file order: vertices (its own), triangles, part_of (the file's part ids).
   std::function<void(TriangleSoup&&)> take;
 };
@@ -56,9 +56,9 @@ struct SoupChunks {
 /// Reads a mesh file as read_mesh does, handing its kept triangles to `chunks.take` a chunk at a
 /// time: the chunks appended in order are read_mesh's soup (the same corners, parts and order;
 /// the same report). Returns the parts (part_names, part_paths) and no triangle. OBJ, OFF and
-/// PLY hold their vertex table while they are read, an STL a chunk's vertices; a PLY with a
-/// part table and the formats MeshReadEstimate::chunked does not name are read whole and
-/// handed over as one chunk.
+/// PLY hold their vertex table while they are read, an STL a chunk's vertices; a PLY's part
+/// table, which follows the faces, is read first in a pass of its own. The formats
+/// MeshReadEstimate::chunked does not name are read whole and handed over as one chunk.
 /// @throw as read_mesh, and whatever `take` throws.
 TriangleSoup read_mesh_in_chunks(const std::filesystem::path& path, ReadReport* report,
                                  const SoupChunks& chunks,

@@ -61,7 +61,9 @@ class ChunkedComponents {
   std::filesystem::path spill_folder_;
   std::uint64_t bucket_bytes_;
   std::vector<RecordSpill<PositionRecord>> buckets_;
-  std::vector<PositionRecord> chunk_positions_;
+  // A chunk's positions, grouped by bucket, and what sorts them out (kept across chunks).
+  std::vector<PositionRecord> chunk_positions_, grouped_;
+  std::vector<std::uint32_t> bucket_of_, noted_part_;
   std::vector<SurfaceComponent> labels_;
   std::vector<EdgeParity> parities_;
 };

@@ -79,8 +79,9 @@ struct PreprocessOptions {
   /// The free bytes assumed of the spill's and the output's folders; 0: what the filesystem says.
   /// Tests set it to see a model too big for the disk refused (a full disk cannot be made there).
   std::uint64_t assumed_free_disk_bytes = 0;
-  /// Spill the ingested triangles and the binned copies to disk whatever the budget (tests
-  /// compare such a run with one that holds them in memory).
+  /// Spill the ingested triangles and the binned copies to disk, and read in chunks every file
+  /// that can be, whatever the budget (tests compare such a run with one that holds them in
+  /// memory).
   bool force_spill = false;
   /// Store the interiors: each tet's reference point classified, exactly, against every
   /// closed component (RayParity.h); false: not stored, and the runtime then reports only touching
@@ -105,6 +106,8 @@ struct StageFigures {
 struct PreprocessSummary {
   std::filesystem::path output;
   std::uint64_t files_read = 0;
+  /// Files too large to read whole within the budget, read a chunk at a time.
+  std::uint64_t files_read_in_chunks = 0;
   std::uint64_t parts = 0;
   std::string length_unit;                 ///< the model's, "" when no input said
   double tessellation_deflection = 0;      ///< of STEP/IGES inputs, in the model's unit
