@@ -569,12 +569,9 @@ std::string number_text(double value) {
 /// part's shape; beyond, it flattens the part or erases it.
 constexpr double kMaxPlacementOverSize = 0x1p36;
 
-/// Refuses placed vertices [first, end) of `assembly` lying further from the origin than
-/// kMaxPlacementOverSize times the placed part's size.
-void check_placement_precision(const std::string& instance, const TriangleSoup& assembly,
-                               std::size_t first) {
-  BoundingBox box;
-  for (std::size_t v = first; v < assembly.vertices.size(); ++v) box.extend(assembly.vertices[v]);
+/// Refuses a placed part whose box lies further from the origin than kMaxPlacementOverSize
+/// times its size.
+void check_placement_precision(const std::string& instance, const BoundingBox& box) {
   if (box.empty()) return;
   double far = 0, size = 0;
   for (int a = 0; a < 3; ++a) {
@@ -589,44 +586,65 @@ void check_placement_precision(const std::string& instance, const TriangleSoup& 
       "times the part's size");
 }
 
-/// Appends the parts of `source` placed by placement k of `placed`: one soup part per
-/// instance, or per node for a file of several parts. Returns the placement's largest stretch
-/// (what it scales the tessellation's deflection by).
-double append_placement(TriangleSoup& assembly, const TriangleSoup& source, PlacedEntry& placed,
-                        std::size_t k, double scale, std::uint64_t& degenerate_dropped) {
-  const Transform& m = placed.transform(k);
-  const std::string path = placed.path(k);
-  const ManifestPart& part = placed.part();
-  const std::string owner = placed.owner().path.string();
-  const std::string where = owner + ": part '" + path + "'";
-  if (assembly.vertices.size() + source.vertices.size() > std::numeric_limits<std::uint32_t>::max())
-    throw InputError(where + ": the assembly has more vertices than a soup can index");
-  const auto vertex_base = static_cast<std::uint32_t>(assembly.vertices.size());
-  const auto part_base = static_cast<std::uint32_t>(assembly.part_count());
-  if (source.part_count() == 1) {
-    assembly.add_part(part.name, path == part.name ? std::string() : path);
-  } else {
-    // A file of several parts (glTF nodes, named "stem/node") keeps its node names.
-    const std::string stem = part.file.stem().string() + "/";
-    const auto node = [&](const std::string& name) {
-      return name.starts_with(stem) ? name.substr(stem.size()) : name;
-    };
-    for (std::size_t p = 0; p < source.part_count(); ++p)
-      assembly.add_part(node(source.part_names[p]), path + "/" + node(source.part_path(p)));
+/// Where placement k of `placed` puts a file's parts, and what messages call it.
+struct Placement {
+  Placement(PlacedEntry& placed, std::size_t k, double scale)
+      : transform(placed.transform(k)), path(placed.path(k)), scale(scale) {
+    const ManifestPart& part = placed.part();
+    const std::string owner = placed.owner().path.string();
+    instance = owner + ": part '" + part.name + "' (" + part.file.filename().string() +
+               "), instance '" + path + "'";
   }
-  const std::string instance = owner + ": part '" + part.name + "' (" +
-                               part.file.filename().string() + "), instance '" + path + "'";
-  for (const Vec3& v : source.vertices) {
-    const Vec3 p = apply_transform(m, {v[0] * scale, v[1] * scale, v[2] * scale});
+  /// A vertex of the file, placed. @throw InputError beyond the accepted coordinates.
+  Vec3 place(const Vec3& v) const {
+    const Vec3 p = apply_transform(transform, {v[0] * scale, v[1] * scale, v[2] * scale});
     for (int a = 0; a < 3; ++a)
       if (!(std::fabs(p[a]) <= kMaxCoordinateMagnitude))
         throw InputError(instance + ": the placement puts " + "xyz"[a] + " = " + number_text(p[a]) +
                          ", outside the accepted coordinates [-" +
                          number_text(kMaxCoordinateMagnitude) + ", " +
                          number_text(kMaxCoordinateMagnitude) + "]");
-    assembly.vertices.push_back(p);
+    return p;
   }
-  check_placement_precision(instance, assembly, vertex_base);
+  Transform transform;
+  std::string path, instance;
+  double scale;
+};
+
+/// Adds the parts the placement `path` of `part` makes of a file whose parts `source` names:
+/// one part per instance, or per node for a file of several parts.
+void add_placed_parts(TriangleSoup& assembly, const TriangleSoup& source, const ManifestPart& part,
+                      const std::string& path) {
+  if (source.part_count() == 1) {
+    assembly.add_part(part.name, path == part.name ? std::string() : path);
+    return;
+  }
+  // A file of several parts (glTF nodes, named "stem/node") keeps its node names.
+  const std::string stem = part.file.stem().string() + "/";
+  const auto node = [&](const std::string& name) {
+    return name.starts_with(stem) ? name.substr(stem.size()) : name;
+  };
+  for (std::size_t p = 0; p < source.part_count(); ++p)
+    assembly.add_part(node(source.part_names[p]), path + "/" + node(source.part_path(p)));
+}
+
+/// Appends the parts of `source` placed by placement k of `placed`. Returns the placement's
+/// largest stretch (what it scales the tessellation's deflection by).
+double append_placement(TriangleSoup& assembly, const TriangleSoup& source, PlacedEntry& placed,
+                        std::size_t k, double scale, std::uint64_t& degenerate_dropped) {
+  const Placement placement(placed, k, scale);
+  const std::string where = placed.owner().path.string() + ": part '" + placement.path + "'";
+  if (assembly.vertices.size() + source.vertices.size() > std::numeric_limits<std::uint32_t>::max())
+    throw InputError(where + ": the assembly has more vertices than a soup can index");
+  const auto vertex_base = static_cast<std::uint32_t>(assembly.vertices.size());
+  const auto part_base = static_cast<std::uint32_t>(assembly.part_count());
+  add_placed_parts(assembly, source, placed.part(), placement.path);
+  BoundingBox box;
+  for (const Vec3& v : source.vertices) {
+    assembly.vertices.push_back(placement.place(v));
+    box.extend(assembly.vertices.back());
+  }
+  check_placement_precision(placement.instance, box);
   for (std::size_t t = 0; t < source.triangles.size(); ++t) {
     const auto& tri = source.triangles[t];
     const TriangleIndices p{tri[0] + vertex_base, tri[1] + vertex_base, tri[2] + vertex_base};
@@ -639,7 +657,7 @@ double append_placement(TriangleSoup& assembly, const TriangleSoup& source, Plac
     assembly.triangles.push_back(p);
     assembly.part_of.push_back(part_base + source.part_of[t]);
   }
-  return largest_stretch(m);
+  return largest_stretch(placement.transform);
 }
 
 /// Reads the file of mesh entry `entries` once and appends all its placements; a
@@ -799,6 +817,50 @@ ReadReport PieceLoader::report() const {
     report.tessellation_deflection *= impl_->scale * impl_->stretch;
   }
   return report;
+}
+
+struct PlacedChunks::Impl {
+  Impl(const InputPiece& piece)
+      : placed(*piece.manifest, piece.entries),
+        placement(placed, 0, part_unit_scale(placed.part(), placed.owner().units, "")) {}
+  PlacedEntry placed;
+  Placement placement;
+  BoundingBox box;
+  std::uint64_t dropped = 0;
+};
+
+PlacedChunks::PlacedChunks(const InputPiece& piece) {
+  if (!piece.manifest || piece.copies() != 1)
+    throw InputError(piece.input.string() + ": only a piece placed once is placed in chunks");
+  impl_ = std::make_unique<Impl>(piece);
+}
+PlacedChunks::~PlacedChunks() = default;
+
+void PlacedChunks::place(TriangleSoup& chunk) {
+  for (Vec3& v : chunk.vertices) {
+    v = impl_->placement.place(v);
+    impl_->box.extend(v);
+  }
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
+    const auto& c = chunk.triangles[t];
+    if (is_degenerate_triangle(chunk.vertices[c[0]], chunk.vertices[c[1]], chunk.vertices[c[2]])) {
+      ++impl_->dropped;
+      continue;
+    }
+    chunk.triangles[kept] = c;
+    chunk.part_of[kept++] = chunk.part_of[t];
+  }
+  chunk.triangles.resize(kept);
+  chunk.part_of.resize(kept);
+}
+
+TriangleSoup PlacedChunks::finish(const TriangleSoup& file_parts, ReadReport& report) {
+  check_placement_precision(impl_->placement.instance, impl_->box);
+  TriangleSoup parts;
+  add_placed_parts(parts, file_parts, impl_->placed.part(), impl_->placement.path);
+  report.degenerate_dropped += impl_->dropped;
+  return parts;
 }
 
 TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports,

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <random>
 
 #include "tetrapage/preprocess/ChunkedComponents.h"
@@ -121,9 +122,11 @@ std::uint64_t streamed_bytes(const MeshReadEstimate& read) {
   return kSlack + read.chunked_bytes + std::max(chunk, 2 * kPositionBucketBytes);
 }
 
-// A mesh file given on its own, in a format read in chunks (MeshReadEstimate::chunked).
+// A mesh file given on its own or placed once, in a format read in chunks
+// (MeshReadEstimate::chunked). A file placed many times is read once and its copies placed in
+// batches (a file too large for that is refused).
 bool can_stream(const InputPiece& piece, const PieceEstimate& estimate) {
-  return estimate.read.chunked && piece.manifest == nullptr;
+  return estimate.read.chunked && (piece.manifest == nullptr || piece.copies() == 1);
 }
 
 PieceEstimate estimate_piece(const InputPiece& piece) {
@@ -316,9 +319,13 @@ std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const Piece
       estimate.read.vertices <= 2 * estimate.read.triangles ? estimate.read.vertices
                                                             : estimate.read.vertices / 6;
   ChunkedComponents components(spill_folder, positions, kPositionBucketBytes);
+  std::optional<PlacedChunks> placement;
+  if (piece.manifest) placement.emplace(piece);
   SoupChunks chunks;
   chunks.triangles = kChunkTriangles;
   chunks.take = [&](TriangleSoup&& chunk) {
+    if (placement) placement->place(chunk);
+    if (chunk.triangle_count() == 0) return;
     check_coordinate_magnitudes(chunk, piece);
     for (const std::uint32_t part : chunk.part_of) {
       if (part >= file->part_triangles.size()) file->part_triangles.resize(part + 1, 0);
@@ -331,6 +338,7 @@ std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const Piece
     file->chunks.append(std::move(chunk), 0);
   };
   file->parts = read_mesh_in_chunks(piece.file(), &report, chunks, options.tessellation);
+  if (placement) file->parts = placement->finish(file->parts, report);
   file->part_triangles.resize(std::max<std::size_t>(file->parts.part_count(), 1), 0);
   file->united = components.unite();
   return file;
@@ -343,7 +351,7 @@ LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
   if (estimate.streamed) {
     loaded.file = piece.input.string();
     loaded.streamed = read_streamed(piece, estimate, options, spill_folder, loaded.report);
-    loaded.length_unit = loaded.report.length_unit;
+    loaded.length_unit = piece.manifest ? piece.manifest->units : loaded.report.length_unit;
     return loaded;
   }
   auto loader = std::make_unique<PieceLoader>(piece, tessellation_within(piece, options, room));

@@ -320,11 +320,24 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
     }
   }
   ASSERT_GT(copies, 0) << "no real mesh found under " << TETRAPAGE_MESH_DIR;
-  for (const char* extension : {".ply", ".stl", ".obj"}) {
+  // A manifest in mm placing the PLY once, turned and moved, in cm (read in chunks), beside a
+  // part placed three times (placed in batches, whole).
+  const fs::path small = fs::path(TETRAPAGE_MESH_DIR) / "cube-shuffled.off";
+  std::ofstream(folder / "assembly.json") << nlohmann::json{
+      {"units", "mm"},
+      {"parts",
+       {{{"name", "soup"}, {"file", "soup.ply"}, {"units", "cm"},
+         {"instances", {{{"rotation", {0.9, 0.1, 0.3, 0.2}}, {"translation", {1e3, -2.5, 7.0}}}}}},
+        {{"name", "cube"}, {"file", small.string()},
+         {"instances", {{{"translation", {0.0, 0.0, 0.0}}}, {{"translation", {10.0, 0.0, 0.0}}},
+                        {{"translation", {0.0, 10.0, 0.0}}}}}}}}};
+  for (const char* extension : {".ply", ".stl", ".obj", ".json"}) {
     SCOPED_TRACE(extension);
-    const fs::path input = folder / (std::string("soup") + extension);
-    ASSERT_TRUE(CGAL::IO::write_polygon_soup(input.string(), points, polygons,
-                                             CGAL::parameters::use_binary_mode(true)));
+    const fs::path input = folder / (std::string(extension) == ".json" ? std::string("assembly.json")
+                                                                        : std::string("soup") + extension);
+    if (std::string(extension) != ".json")
+      ASSERT_TRUE(CGAL::IO::write_polygon_soup(input.string(), points, polygons,
+                                               CGAL::parameters::use_binary_mode(true)));
     PreprocessOptions whole;
     whole.region_triangles = 4000;
     whole.interiors = true;
@@ -334,6 +347,8 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
     chunked.force_spill = true;
     const PreprocessSummary b = preprocess({input}, folder / "chunked.tpi", chunked);
     EXPECT_EQ(b.files_read_in_chunks, 1u);
+    EXPECT_EQ(a.parts, b.parts);
+    EXPECT_EQ(a.degenerate_dropped, b.degenerate_dropped);
     EXPECT_NE(b.to_json().find("\"files_read_in_chunks\": 1"), std::string::npos);
     EXPECT_GT(b.triangles_read, 3u * 32768);
     EXPECT_EQ(a.triangles_read, b.triangles_read);
@@ -349,6 +364,7 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
     EXPECT_EQ(ra.read_table_uint8("component_closed"), rb.read_table_uint8("component_closed"));
     EXPECT_EQ(ra.read_table_double("component_bounds"), rb.read_table_double("component_bounds"));
     EXPECT_EQ(ra.read_table_uint64("part_triangles"), rb.read_table_uint64("part_triangles"));
+    EXPECT_EQ(ra.read_table_uint8("part_path_bytes"), rb.read_table_uint8("part_path_bytes"));
     const std::vector<std::uint8_t> closed = rb.read_table_uint8("component_closed");
     EXPECT_GT(std::count(closed.begin(), closed.end(), 1), 0);
     EXPECT_GT(std::count(closed.begin(), closed.end(), 0), 0);
