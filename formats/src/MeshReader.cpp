@@ -62,7 +62,6 @@ namespace detail {
 
 bool SoupBuilder::drop_if_degenerate(std::size_t t, std::uint64_t position) {
   const auto& tri = soup_.triangles[t];
-  const auto vertex = [&](std::uint32_t v) -> const Vec3& { return soup_.vertices[v - vertex_base_]; };
   const bool repeated = tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2];
   if (!repeated && !is_degenerate_triangle(vertex(tri[0]), vertex(tri[1]), vertex(tri[2])))
     return false;
@@ -78,34 +77,39 @@ void SoupBuilder::throw_no_triangle_left() const {
 }
 
 void SoupBuilder::hand_over_chunk() {
-  constexpr std::uint32_t kNone = 0xffffffffu;
+  // The chunk's vertices numbered as its kept triangles first use them: an open-addressing map
+  // from the file's vertex to the chunk's, at most half full (a table of the file's vertices
+  // would hold 4 B each whatever the budget).
+  constexpr std::uint32_t kEmpty = 0xffffffffu;
+  std::size_t slots = 16;
+  while (slots < 6 * soup_.triangles.size()) slots *= 2;
+  chunk_map_.assign(slots, {kEmpty, 0});
   TriangleSoup chunk;
   chunk.triangles.reserve(soup_.triangles.size());
   chunk.part_of.reserve(soup_.triangles.size());
-  if (chunk_vertex_.size() < soup_.vertices.size()) chunk_vertex_.resize(soup_.vertices.size(), kNone);
   for (std::size_t t = 0; t < soup_.triangles.size(); ++t) {
     if (drop_if_degenerate(t, triangles_before_ + t)) continue;
     TriangleIndices local{};
     for (int k = 0; k < 3; ++k) {
-      std::uint32_t& number = chunk_vertex_[soup_.triangles[t][k] - vertex_base_];
-      if (number == kNone) {
-        number = std::uint32_t(chunk.vertices.size());
-        chunk.vertices.push_back(soup_.vertices[soup_.triangles[t][k] - vertex_base_]);
+      const std::uint32_t v = soup_.triangles[t][k];
+      std::size_t slot = (std::uint64_t(v) * 0x9e3779b97f4a7c15ULL >> 20) & (slots - 1);
+      while (chunk_map_[slot].first != kEmpty && chunk_map_[slot].first != v) slot = (slot + 1) & (slots - 1);
+      if (chunk_map_[slot].first == kEmpty) {
+        chunk_map_[slot] = {v, std::uint32_t(chunk.vertices.size())};
+        chunk.vertices.push_back(vertex(v));
       }
-      local[k] = number;
+      local[k] = chunk_map_[slot].second;
     }
     chunk.triangles.push_back(local);
     chunk.part_of.push_back(soup_.part_of[t]);
   }
-  for (const auto& tri : soup_.triangles)
-    for (const std::uint32_t v : tri) chunk_vertex_[v - vertex_base_] = kNone;
   triangles_before_ += soup_.triangles.size();
   kept_before_ += chunk.triangles.size();
   soup_.triangles.clear();
   soup_.part_of.clear();
   if (vertices_unshared_) {
-    vertex_base_ += soup_.vertices.size();
-    soup_.vertices.clear();
+    vertex_base_ += table_.size();
+    table_.clear();
   }
   if (!chunk.triangles.empty()) chunks_->take(std::move(chunk));
 }
@@ -251,9 +255,10 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
   if (format == MeshFormat::obj || format == MeshFormat::stl || format == MeshFormat::ply ||
       format == MeshFormat::off) {
     out.chunked = true;
-    // The vertex table and a chunk number per vertex (an STL: a chunk's); an OBJ's grows.
-    const std::uint64_t table = format == MeshFormat::stl ? 0 : 28 * out.vertices;
-    out.chunked_bytes = kReadBlockBytes + (format == MeshFormat::obj ? 2 * table : table);
+    // The vertex table (an STL's: a chunk's), reserved from a header's count, else grown.
+    const std::uint64_t table = format == MeshFormat::stl ? 0 : 24 * out.vertices;
+    out.chunked_bytes = kReadBlockBytes;
+    out.vertex_table_bytes = out.counted ? table : 2 * table;
   }
   const bool assimp = format == MeshFormat::gltf || format == MeshFormat::glb ||
                       format == MeshFormat::assimp_other;

@@ -13,10 +13,12 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "InputFile.h"
 #include "TextNumbers.h"
+#include "VertexTable.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/TriangleSoup.h"
@@ -55,7 +57,10 @@ class SoupBuilder {
   /// With `chunks`, the kept triangles go to chunks->take a chunk at a time (finish() then
   /// returns the parts alone): the builder holds the vertex table and one chunk.
   SoupBuilder(std::string file_name, ReadReport& report, const SoupChunks* chunks = nullptr)
-      : file_name_(std::move(file_name)), report_(report), chunks_(chunks) {}
+      : file_name_(std::move(file_name)), report_(report), chunks_(chunks) {
+    if (chunks_ != nullptr)
+      table_.limit(chunks_->held_vertices, chunks_->vertex_folder, chunks_->vertex_cache_bytes);
+  }
 
   /// No later triangle uses a vertex added before it (an STL): a chunk's vertices are let go
   /// with it.
@@ -86,7 +91,8 @@ class SoupBuilder {
   /// in fewer than 3 bytes or a face in fewer than 4, so the file size caps the reservation.
   void reserve(std::uint64_t vertices, std::uint64_t triangles, std::uint64_t file_bytes) {
     if (chunks_ != nullptr) {
-      if (vertices_unshared_) vertices = 0;
+      if (!vertices_unshared_) table_.reserve(std::min(vertices, file_bytes / 3));
+      vertices = 0;
       triangles = std::min<std::uint64_t>(triangles, chunks_->triangles);
     }
     soup_.vertices.reserve(static_cast<std::size_t>(std::min(vertices, file_bytes / 3)));
@@ -95,8 +101,16 @@ class SoupBuilder {
     soup_.part_of.reserve(faces);
   }
 
-  std::uint64_t vertex_count() const { return vertex_base_ + soup_.vertices.size(); }
-  void add_vertex(const Vec3& p) { soup_.vertices.push_back(p); }
+  std::uint64_t vertex_count() const {
+    return chunks_ != nullptr ? vertex_base_ + table_.size() : soup_.vertices.size();
+  }
+  void add_vertex(const Vec3& p) {
+    if (chunks_ != nullptr) {
+      table_.push_back(p);
+    } else {
+      soup_.vertices.push_back(p);
+    }
+  }
 
   /// Indices are global (into every vertex added so far) and already range-checked.
   void add_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) {
@@ -119,6 +133,10 @@ class SoupBuilder {
   TriangleSoup finish();
 
  private:
+  // Vertex v (a global index) of the vertices added.
+  Vec3 vertex(std::uint32_t v) {
+    return chunks_ != nullptr ? table_.at(v - vertex_base_) : soup_.vertices[v];
+  }
   // True (and counted in the report) when triangle `t` of the soup, the file's triangle at
   // `position`, repeats a corner or has collinear corners.
   bool drop_if_degenerate(std::size_t t, std::uint64_t position);
@@ -136,7 +154,9 @@ class SoupBuilder {
   std::uint64_t vertex_base_ = 0;        // vertices let go with earlier chunks
   std::uint64_t triangles_before_ = 0;   // the file's triangles handed over (or dropped) before
   std::uint64_t kept_before_ = 0;        // triangles kept in chunks handed over
-  std::vector<std::uint32_t> chunk_vertex_;  // a vertex's number in the chunk being made
+  VertexTable table_;                    // in chunks: the vertices (soup_ holds none)
+  // In chunks: the file's vertex -> the chunk's, for the chunk being made.
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> chunk_map_;
 };
 
 /// Whitespace-separated tokens of a text file, with the line they came from; a token never

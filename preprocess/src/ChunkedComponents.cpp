@@ -58,7 +58,9 @@ void unite_labels(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint
 
 ChunkedComponents::ChunkedComponents(const std::filesystem::path& spill_folder,
                                      std::uint64_t expected_positions, std::uint64_t bucket_bytes)
-    : spill_folder_(spill_folder), bucket_bytes_(std::max<std::uint64_t>(bucket_bytes, 1)) {
+    : spill_folder_(spill_folder),
+      bucket_bytes_(std::max<std::uint64_t>(bucket_bytes, 1)),
+      labels_(spill_path(spill_folder, "labels")) {
   const std::uint64_t bytes = expected_positions * sizeof(PositionRecord);
   const std::uint64_t count = std::clamp<std::uint64_t>(bytes / bucket_bytes_ + 1, 1, kMostBuckets);
   buckets_.reserve(count);
@@ -67,19 +69,21 @@ ChunkedComponents::ChunkedComponents(const std::filesystem::path& spill_folder,
 }
 
 std::uint64_t ChunkedComponents::label_bytes() const {
-  return labels_.size() * (sizeof(SurfaceComponent) + sizeof(EdgeParity) + sizeof(std::uint32_t));
+  return parent_.capacity() * sizeof(std::uint32_t) + parent_.size() * sizeof(std::uint32_t);
 }
 
 void ChunkedComponents::add_chunk(TriangleSoup& chunk, std::uint64_t first_triangle) {
   SurfaceComponents found = find_surface_components(chunk);
-  const auto first_label = std::uint32_t(labels_.size());
-  if (labels_.size() + found.components.size() >= 0xfffffffeu)
+  const auto first_label = std::uint32_t(parent_.size());
+  if (parent_.size() + found.components.size() >= 0xfffffffeu)
     throw InputError("the file holds more than 2^32 - 2 pieces of connected components");
+  std::vector<LabelRecord> records(found.components.size());
   for (std::size_t c = 0; c < found.components.size(); ++c) {
     found.components[c].first_triangle += first_triangle;
-    labels_.push_back(found.components[c]);
-    parities_.push_back(found.parities[c]);
+    records[c] = {found.components[c], found.parities[c]};
+    parent_.push_back(std::uint32_t(parent_.size()));
   }
+  labels_.append(std::span<const LabelRecord>(records));
   note_positions(chunk, found.component_of, first_label);
   for (std::size_t t = 0; t < chunk.triangle_count(); ++t)
     chunk.part_of[t] = first_label + found.component_of[t];
@@ -125,8 +129,7 @@ void ChunkedComponents::note_positions(const TriangleSoup& chunk,
     buckets_[b].append(std::span<const PositionRecord>(grouped_.data() + first[b], first[b + 1] - first[b]));
 }
 
-void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsigned depth,
-                                     std::vector<std::uint32_t>& parent) {
+void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsigned depth) {
   if (bucket.size() * sizeof(PositionRecord) > bucket_bytes_ && depth < kMostSplits) {
     std::vector<RecordSpill<PositionRecord>> parts;
     for (std::uint64_t b = 0; b < kSplitBuckets; ++b)
@@ -137,20 +140,18 @@ void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsign
         parts[hash_of(r, depth + 1) % kSplitBuckets].append(std::span<const PositionRecord>(&r, 1));
     });
     bucket.clear();
-    for (RecordSpill<PositionRecord>& part : parts) unite_bucket(part, depth + 1, parent);
+    for (RecordSpill<PositionRecord>& part : parts) unite_bucket(part, depth + 1);
     return;
   }
   std::vector<PositionRecord> records = bucket.read_all();
   bucket.clear();
   std::sort(records.begin(), records.end(), place_before<PositionRecord>);
   for (std::size_t i = 1; i < records.size(); ++i)
-    if (same_place(records[i - 1], records[i])) unite_labels(parent, records[i - 1].label, records[i].label);
+    if (same_place(records[i - 1], records[i])) unite_labels(parent_, records[i - 1].label, records[i].label);
 }
 
 ChunkedComponents::United ChunkedComponents::unite() {
-  std::vector<std::uint32_t> parent(labels_.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  for (RecordSpill<PositionRecord>& bucket : buckets_) unite_bucket(bucket, 0, parent);
+  for (RecordSpill<PositionRecord>& bucket : buckets_) unite_bucket(bucket, 0);
   std::vector<RecordSpill<PositionRecord>>().swap(buckets_);
   std::vector<PositionRecord>().swap(chunk_positions_);
   std::vector<PositionRecord>().swap(grouped_);
@@ -158,29 +159,33 @@ ChunkedComponents::United ChunkedComponents::unite() {
   std::vector<std::uint32_t>().swap(noted_part_);
 
   // Labels ascend with their first triangles, and a root is its set's least label: the first
-  // label met of each set numbers its component, in the order of first triangles.
+  // label met of each set numbers its component, in the order of first triangles; the labels'
+  // records are read back in that order.
   constexpr std::uint32_t kNone = 0xffffffffu;
   United united;
-  united.component_of_label.assign(labels_.size(), kNone);
+  united.component_of_label.assign(parent_.size(), kNone);
   std::vector<EdgeParity> parity;
-  for (std::uint32_t label = 0; label < labels_.size(); ++label) {
-    const std::uint32_t root = find(parent, label);
-    std::uint32_t& component = united.component_of_label[root];
-    if (component == kNone) {
-      component = std::uint32_t(united.components.size());
-      united.components.push_back(labels_[label]);
-      parity.push_back(parities_[label]);
-    } else {
-      SurfaceComponent& into = united.components[component];
-      into.triangles += labels_[label].triangles;
-      into.bounds.extend(labels_[label].bounds);
-      parity[component].merge(parities_[label]);
+  std::uint32_t label = 0;
+  labels_.for_each_block(1 << 12, [&](std::span<const LabelRecord> block) {
+    for (const LabelRecord& record : block) {
+      const std::uint32_t root = find(parent_, label);
+      std::uint32_t& component = united.component_of_label[root];
+      if (component == kNone) {
+        component = std::uint32_t(united.components.size());
+        united.components.push_back(record.component);
+        parity.push_back(record.parity);
+      } else {
+        SurfaceComponent& into = united.components[component];
+        into.triangles += record.component.triangles;
+        into.bounds.extend(record.component.bounds);
+        parity[component].merge(record.parity);
+      }
+      united.component_of_label[label++] = component;
     }
-    united.component_of_label[label] = component;
-  }
+  });
   for (std::size_t c = 0; c < parity.size(); ++c) united.components[c].closed = parity[c].closed();
-  std::vector<SurfaceComponent>().swap(labels_);
-  std::vector<EdgeParity>().swap(parities_);
+  std::vector<std::uint32_t>().swap(parent_);
+  labels_.clear();
   return united;
 }
 

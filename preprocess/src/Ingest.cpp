@@ -89,6 +89,7 @@ struct PieceEstimate {
   MeshReadEstimate read;
   std::uint64_t bytes = 0;
   bool streamed = false;  // read in chunks (StreamedFile): bytes exceed the room it has
+  std::uint64_t held_vertices = ~std::uint64_t(0);  // streamed: of its vertex table, in memory
 };
 // The reservoir sample holds at most this many centroids (ingest() says why).
 constexpr std::uint64_t kMostSampledCentroids = std::uint64_t(1) << 21;
@@ -105,21 +106,33 @@ std::uint64_t piece_bytes(const MeshReadEstimate& read, std::size_t copies, bool
                             manifest ? 2 * soup : 0});
 }
 
-// A streamed file's chunks and the buckets its positions are united in, one at a time.
+// A streamed file's chunks, the buckets its positions are united in, one at a time, and the
+// cache its vertex table is read back through once it goes to disk.
 constexpr std::size_t kChunkTriangles = std::size_t(1) << 15;
 constexpr std::uint64_t kPositionBucketBytes = std::uint64_t(8) << 20;
+constexpr std::uint64_t kVertexCacheBytes = std::uint64_t(8) << 20;
 
-// What reading a file in chunks holds beside the reader's tables (MeshReadEstimate::
-// chunked_bytes): a chunk as the reader builds it (16 B a triangle) and hands it over (at most
-// three vertices a triangle: 88 B), its component search, its positions before they are
-// sorted out (96 B a triangle), and a bucket of positions while it is united (read, then
-// sorted in place). The labels (a component's piece per chunk, about) are tables, counted
-// with the model's.
-std::uint64_t streamed_bytes(const MeshReadEstimate& read) {
+// What reading a file in chunks holds: the reader's block (MeshReadEstimate::chunked_bytes); a
+// chunk as the reader builds it (16 B a triangle) and hands it over (at most three vertices a
+// triangle: 88 B), its component search, its positions before they are sorted out (96 B a
+// triangle), or a bucket of positions while it is united (read, then sorted in place); the
+// vertex cache; and as much of the vertex table as `room` leaves (the rest goes to disk). The
+// labels (a component's piece per chunk, about) are tables, counted with the model's.
+struct StreamPlan {
+  std::uint64_t bytes = 0;
+  std::uint64_t held_vertices = ~std::uint64_t(0);
+};
+StreamPlan plan_stream(const MeshReadEstimate& read, std::uint64_t room) {
   constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
   constexpr std::uint64_t n = kChunkTriangles;
   const std::uint64_t chunk = n * (16 + 88 + 96) + surface_components_bytes(3 * n, n);
-  return kSlack + read.chunked_bytes + std::max(chunk, 2 * kPositionBucketBytes);
+  const std::uint64_t fixed =
+      kSlack + read.chunked_bytes + std::max(chunk, 2 * kPositionBucketBytes) + kVertexCacheBytes;
+  if (fixed + read.vertex_table_bytes <= room) return {fixed + read.vertex_table_bytes};
+  // A table grown as it is read holds up to twice its vertices' bytes.
+  const std::uint64_t per_vertex = read.counted ? 24 : 48;
+  const std::uint64_t held = room > fixed ? (room - fixed) / per_vertex : 0;
+  return {fixed + held * per_vertex, held};
 }
 
 // A mesh file given on its own or placed once, in a format read in chunks
@@ -245,9 +258,15 @@ std::vector<std::uint64_t> check_read_room(const std::vector<InputPiece>& jobs,
     rooms[j] = total > held ? total - held : 0;
     const bool streams = can_stream(jobs[j], estimates[j]);
     if (estimates[j].bytes <= rooms[j] && !(options.force_spill && streams)) continue;
-    const std::uint64_t bytes = streams ? streamed_bytes(estimates[j].read) : estimates[j].bytes;
+    const StreamPlan plan = streams ? plan_stream(estimates[j].read, rooms[j]) : StreamPlan{};
+    const std::uint64_t bytes = streams ? plan.bytes : estimates[j].bytes;
     if (bytes <= rooms[j]) {
       estimates[j].streamed = streams;
+      // Forced spills send the vertex table to disk too, past a few blocks.
+      constexpr std::uint64_t kForcedHeldVertices = 4096;
+      estimates[j].held_vertices = options.force_spill
+                                       ? std::min(plan.held_vertices, kForcedHeldVertices)
+                                       : plan.held_vertices;
       continue;
     }
     refuse_reading(jobs[j].file(), estimates[j].read, bytes, held,
@@ -323,6 +342,9 @@ std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const Piece
   if (piece.manifest) placement.emplace(piece);
   SoupChunks chunks;
   chunks.triangles = kChunkTriangles;
+  chunks.held_vertices = estimate.held_vertices;
+  chunks.vertex_folder = spill_folder;
+  chunks.vertex_cache_bytes = kVertexCacheBytes;
   chunks.take = [&](TriangleSoup&& chunk) {
     if (placement) placement->place(chunk);
     if (chunk.triangle_count() == 0) return;

@@ -939,12 +939,19 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
   for (const auto& file : files) {
     ReadReport whole_report;
     const TriangleSoup whole = read_mesh(file, &whole_report);
+    // Chunks of 1, 3 and 1000 triangles; the vertex table beyond its first 37 vertices on disk,
+    // read back through one block (the least cache), then held whole.
     for (const std::size_t size : {std::size_t(1), std::size_t(3), std::size_t(1000)}) {
       SCOPED_TRACE(file.filename().string() + ", chunks of " + std::to_string(size));
       std::vector<std::array<Vec3, 3>> corners;
       std::vector<std::uint32_t> part_of;
       SoupChunks chunks;
       chunks.triangles = size;
+      if (size < 1000) {
+        chunks.held_vertices = 37;
+        chunks.vertex_folder = folder;
+        chunks.vertex_cache_bytes = 1;
+      }
       chunks.take = [&](TriangleSoup&& chunk) {
         EXPECT_LE(chunk.triangle_count(), size);
         EXPECT_EQ(chunk.part_of.size(), chunk.triangle_count());
@@ -970,6 +977,8 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
       EXPECT_EQ(report.encoding, whole_report.encoding);
     }
   }
+  for (const auto& entry : std::filesystem::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename().string().find(".tetrapage-vertices"), std::string::npos);
 }
 
 // A file whose triangles are all degenerate is refused in chunks as it is whole.

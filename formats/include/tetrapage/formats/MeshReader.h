@@ -51,6 +51,12 @@ struct SoupChunks {
   std::size_t triangles = 1 << 16;  ///< the most triangles a chunk holds
   /// Each chunk, in file order: vertices (its own), triangles, part_of (the file's part ids).
   std::function<void(TriangleSoup&&)> take;
+  /// The most vertices of the file's table held in memory (24 B each); the rest go to an
+  /// unlinked temporary file in `vertex_folder` (empty: the system's), read back through a
+  /// cache of about vertex_cache_bytes.
+  std::uint64_t held_vertices = ~std::uint64_t(0);
+  std::filesystem::path vertex_folder;
+  std::uint64_t vertex_cache_bytes = std::uint64_t(8) << 20;
 };
 
 /// Reads a mesh file as read_mesh does, handing its kept triangles to `chunks.take` a chunk at a
@@ -96,9 +102,11 @@ struct MeshReadEstimate {
   /// the degenerate filter's shrink, Assimp's scene, the read block).
   std::uint64_t reading_bytes = 0;
   /// read_mesh_in_chunks reads the file a chunk at a time, holding chunked_bytes beside the
-  /// chunk: the vertex table (none for an STL), its chunk numbers and the read block.
+  /// chunk (the read block) and the vertex table (none for an STL), which may go to disk
+  /// (SoupChunks::held_vertices).
   bool chunked = false;
   std::uint64_t chunked_bytes = 0;
+  std::uint64_t vertex_table_bytes = 0;
   /// The soup once read: 24 B a vertex, 12 a triangle and 4 for its part.
   std::uint64_t soup_bytes() const { return 24 * vertices + 16 * triangles; }
 };

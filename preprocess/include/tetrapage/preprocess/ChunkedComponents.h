@@ -32,8 +32,10 @@ class ChunkedComponents {
   /// @throw IoError when a bucket cannot be written.
   void add_chunk(TriangleSoup& chunk, std::uint64_t first_triangle);
 
-  std::uint64_t label_count() const { return labels_.size(); }
-  /// The bytes the labels take in memory (each a component and its parity).
+  std::uint64_t label_count() const { return parent_.size(); }
+  /// The bytes the labels take in memory: a parent each while they are found, and a component
+  /// each once united (a chunk of a file whose triangles come in no spatial order holds many
+  /// pieces of one component; their records wait on disk).
   std::uint64_t label_bytes() const;
 
   struct United {
@@ -55,17 +57,22 @@ class ChunkedComponents {
                       std::uint32_t first_label);
   // Unites the labels of one bucket's equal positions; a bucket larger than bucket_bytes_ is
   // split by another hash first.
-  void unite_bucket(RecordSpill<PositionRecord>& bucket, unsigned depth,
-                    std::vector<std::uint32_t>& parent);
+  void unite_bucket(RecordSpill<PositionRecord>& bucket, unsigned depth);
+
+  // A label's piece of a component, as the chunk found it.
+  struct LabelRecord {
+    SurfaceComponent component;
+    EdgeParity parity;
+  };
 
   std::filesystem::path spill_folder_;
   std::uint64_t bucket_bytes_;
   std::vector<RecordSpill<PositionRecord>> buckets_;
+  RecordSpill<LabelRecord> labels_;
+  std::vector<std::uint32_t> parent_;  // the labels' union-find
   // A chunk's positions, grouped by bucket, and what sorts them out (kept across chunks).
   std::vector<PositionRecord> chunk_positions_, grouped_;
   std::vector<std::uint32_t> bucket_of_, noted_part_;
-  std::vector<SurfaceComponent> labels_;
-  std::vector<EdgeParity> parities_;
 };
 
 }  // namespace tetrapage

@@ -80,8 +80,8 @@ struct PreprocessOptions {
   /// Tests set it to see a model too big for the disk refused (a full disk cannot be made there).
   std::uint64_t assumed_free_disk_bytes = 0;
   /// Spill the ingested triangles and the binned copies to disk, and read in chunks every file
-  /// that can be, whatever the budget (tests compare such a run with one that holds them in
-  /// memory).
+  /// that can be, its vertex table on disk, whatever the budget (tests compare such a run with
+  /// one that holds them in memory).
   bool force_spill = false;
   /// Store the interiors: each tet's reference point classified, exactly, against every
   /// closed component (RayParity.h); false: not stored, and the runtime then reports only touching
