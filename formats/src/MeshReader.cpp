@@ -107,7 +107,7 @@ void SoupBuilder::hand_over_chunk() {
   kept_before_ += chunk.triangles.size();
   soup_.triangles.clear();
   soup_.part_of.clear();
-  if (vertices_unshared_) {
+  if (vertices_unshared_ && !in_polygon_) {
     vertex_base_ += table_.size();
     table_.clear();
   }
@@ -218,7 +218,7 @@ bool header_counts(const std::filesystem::path& path, MeshFormat format, MeshRea
     }
     out.vertices = counts.vertices;
     out.triangles = counts.triangles;
-    out.chunked = true;
+    out.chunked = counts.vertices_first;
     // Arrays reserved from the counts; polygons grow the triangles' (old and new while
     // growing), else the degenerate filter's shrink copies them.
     out.reading_bytes = out.soup_bytes() + (counts.triangles > counts.faces ? 16 : 12) * counts.triangles;
@@ -254,7 +254,7 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
   out.reading_bytes += kReadBlockBytes;
   if (format == MeshFormat::obj || format == MeshFormat::stl || format == MeshFormat::ply ||
       format == MeshFormat::off) {
-    out.chunked = true;
+    if (!out.counted) out.chunked = true;  // an OBJ or an ASCII STL
     // The vertex table (an STL's: a chunk's), reserved from a header's count, else grown.
     const std::uint64_t table = format == MeshFormat::stl ? 0 : 24 * out.vertices;
     out.chunked_bytes = kReadBlockBytes;

@@ -699,6 +699,16 @@ class AsciiPlyReader {
 
 }  // namespace
 
+namespace {
+
+// The vertex element comes before the faces (the layout's elements point into the header's,
+// in file order).
+bool vertices_first(const PlyLayout& layout) {
+  return layout.face == nullptr || layout.vertex < layout.face;
+}
+
+}  // namespace
+
 MeshCounts read_ply_counts(InputFile& file) {
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);
@@ -707,6 +717,7 @@ MeshCounts read_ply_counts(InputFile& file) {
   counts.vertices = layout.vertex->count;
   counts.faces = layout.face != nullptr ? layout.face->count : 0;
   counts.triangles = counts.faces;
+  counts.vertices_first = vertices_first(layout);
   if (header.encoding == PlyEncoding::ascii || counts.faces == 0) return counts;
   // Binary: the bytes after the fixed-size elements before the faces bound the faces' corners,
   // hence their triangles (a face of k corners makes k - 2; polygons make more than a face).
@@ -746,11 +757,14 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chu
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);
   check_counts_fit(file, header);
-  SoupBuilder soup(file.name(), report, chunks);
+  // Faces before their vertices (PLY allows it) cannot be handed over as they are read: read
+  // whole, then handed over as one chunk (MeshReadEstimate::chunked says so up front).
+  const SoupChunks* in_chunks = vertices_first(layout) ? chunks : nullptr;
+  SoupBuilder soup(file.name(), report, in_chunks);
   if (layout.parts == nullptr) soup.begin_part(file.path().stem().string());
   PlyPartTable parts(file, soup, layout.parts != nullptr);
   const std::uint64_t faces = layout.face != nullptr ? layout.face->count : 0;
-  if (chunks != nullptr && layout.parts != nullptr) {
+  if (in_chunks != nullptr && layout.parts != nullptr) {
     // The table follows the faces: read first, in a pass of its own over the file.
     InputFile table_file(file.path());
     const PlyHeader table_header = read_header(table_file);
@@ -766,7 +780,13 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chu
   read_elements(file, header, layout, soup, parts,
                 parts.known() ? PlyPass::geometry : PlyPass::whole);
   if (!parts.known()) parts.apply(faces);
-  return soup.finish();
+  if (chunks == nullptr || in_chunks != nullptr) return soup.finish();
+  TriangleSoup whole = soup.finish();
+  TriangleSoup names;
+  names.part_names = std::move(whole.part_names);
+  names.part_paths = std::move(whole.part_paths);
+  chunks->take(std::move(whole));
+  return names;
 }
 
 }  // namespace tetrapage::detail

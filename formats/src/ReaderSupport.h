@@ -123,8 +123,10 @@ class SoupBuilder {
   /// caller rejects it first).
   void add_polygon(std::span<const std::uint32_t> corners) {
     if (corners.size() > 3) ++report_.polygons_triangulated;
+    in_polygon_ = true;  // a chunk handed over in between keeps the polygon's vertices
     for (std::size_t i = 1; i + 1 < corners.size(); ++i)
       add_triangle(corners[0], corners[i], corners[i + 1]);
+    in_polygon_ = false;
   }
 
   /// Drops degenerate triangles and returns the soup (in chunks: the last chunk handed over,
@@ -151,6 +153,7 @@ class SoupBuilder {
   std::uint32_t part_ = 0;
   std::set<std::string> used_paths_;
   bool vertices_unshared_ = false;
+  bool in_polygon_ = false;
   std::uint64_t vertex_base_ = 0;        // vertices let go with earlier chunks
   std::uint64_t triangles_before_ = 0;   // the file's triangles handed over (or dropped) before
   std::uint64_t kept_before_ = 0;        // triangles kept in chunks handed over
@@ -212,6 +215,8 @@ constexpr std::uint64_t max_vertices = std::numeric_limits<std::uint32_t>::max()
 /// shows more: a binary PLY's face bytes bound its corners).
 struct MeshCounts {
   std::uint64_t vertices = 0, faces = 0, triangles = 0;
+  /// The vertices come before the faces (PLY allows either order; faces first are read whole).
+  bool vertices_first = true;
 };
 /// @throw FormatError, InputError as read_ply and read_off do for the same header.
 MeshCounts read_ply_counts(InputFile& file);
