@@ -340,6 +340,10 @@ std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const Piece
   ChunkedComponents components(spill_folder, positions, kPositionBucketBytes);
   std::optional<PlacedChunks> placement;
   if (piece.manifest) placement.emplace(piece);
+  // A file read in chunks is long work of its own: its triangles are counted as they come.
+  Progress progress("reading " + piece.file().filename().string() + " in chunks (triangles)",
+                    estimate.read.counted ? estimate.read.triangles : 0, options.progress,
+                    options.on_progress);
   SoupChunks chunks;
   chunks.triangles = kChunkTriangles;
   chunks.held_vertices = estimate.held_vertices;
@@ -357,10 +361,12 @@ std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const Piece
     check_table_bytes(file->part_triangles.size(), components.label_bytes(), options);
     file->triangles += chunk.triangle_count();
     file->soup_bytes += SoupSpill<TriangleRecord>::soup_bytes(chunk);
+    progress.advance(chunk.triangle_count());
     file->chunks.append(std::move(chunk), 0);
   };
   file->parts = read_mesh_in_chunks(piece.file(), &report, chunks, options.tessellation);
   if (placement) file->parts = placement->finish(file->parts, report);
+  progress.finish();
   file->part_triangles.resize(std::max<std::size_t>(file->parts.part_count(), 1), 0);
   file->united = components.unite();
   return file;
