@@ -326,6 +326,49 @@ void check_table_bytes(std::uint64_t parts, std::uint64_t bytes, const Preproces
   throw InputError(message);
 }
 
+// The disk the spill and the index need for `triangles` triangles whose soups take
+// `soup_bytes`: the index's 32 B a triangle measured (24 counted), and, once the soups exceed
+// their share of the budget, the soups and at least one binned 88-byte record a triangle.
+struct DiskNeed {
+  std::uint64_t spill = 0, index = 0;
+};
+DiskNeed disk_need(double triangles, double soup_bytes, const PreprocessOptions& options) {
+  constexpr double kIndexBytes = 24, kRecordBytes = sizeof(TriangleRecord);
+  const bool spills = options.force_spill || soup_bytes > double(options.memory_bytes / 4);
+  const double spill = spills ? soup_bytes + kRecordBytes * triangles : 0;
+  const double cap = 1.8e19;  // within std::uint64_t
+  return {std::uint64_t(std::min(spill, cap)),
+          std::uint64_t(std::min(kIndexBytes * triangles, cap))};
+}
+
+// Refuses a model that the free disk cannot hold, as soon as what it places is known.
+void check_disk_room(const DiskRoom& room, double triangles, double soup_bytes,
+                     const PreprocessOptions& options) {
+  const DiskNeed need = disk_need(triangles, soup_bytes, options);
+  const auto refuse = [&](std::uint64_t bytes, const std::filesystem::path& folder,
+                          std::uint64_t free) {
+    char count[32];
+    std::snprintf(count, sizeof count, "%.2g", triangles);
+    std::string message = "the model places ";
+    message.append(count)
+        .append(" triangles, about ")
+        .append(format_byte_size(bytes))
+        .append(" of spill and index, but ")
+        .append(folder.string())
+        .append(" has ")
+        .append(format_byte_size(free))
+        .append(" free");
+    throw InputError(message);
+  };
+  if (room.same_device) {
+    if (need.spill + need.index > room.spill_free)
+      refuse(need.spill + need.index, room.spill_folder, room.spill_free);
+    return;
+  }
+  if (need.spill > room.spill_free) refuse(need.spill, room.spill_folder, room.spill_free);
+  if (need.index > room.output_free) refuse(need.index, room.output_folder, room.output_free);
+}
+
 // Reads a file in chunks into a StreamedFile: each chunk's coordinates checked, its parts
 // counted, its components labelled, and the chunk spilled; the labels united at the end.
 std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const PieceEstimate& estimate,
@@ -374,9 +417,13 @@ std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const Piece
 
 LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
                      const PreprocessOptions& options, const std::filesystem::path& spill_folder,
-                     std::size_t threads, std::uint64_t room) {
+                     const DiskRoom& disk, std::size_t threads, std::uint64_t room) {
   LoadedSoup loaded;
   if (estimate.streamed) {
+    // Before it is read, by its estimate alone: its chunks spill twice (its own spill, then the
+    // model's), and the whole model is weighed again once it is read (append_piece).
+    const double triangles = double(estimate.read.triangles);
+    check_disk_room(disk, triangles, 2.0 * double(estimate.read.soup_bytes()), options);
     loaded.file = piece.input.string();
     loaded.streamed = read_streamed(piece, estimate, options, spill_folder, loaded.report);
     loaded.length_unit = piece.manifest ? piece.manifest->units : loaded.report.length_unit;
@@ -433,49 +480,6 @@ void check_part_count(const std::vector<InputPiece>& jobs, const PreprocessOptio
   std::uint64_t parts = 0;
   for (const InputPiece& job : jobs) parts += job.copies();
   check_table_bytes(parts, parts * kPartEntryBytes, options);
-}
-
-// The disk the spill and the index need for `triangles` triangles whose soups take
-// `soup_bytes`: the index's 32 B a triangle measured (24 counted), and, once the soups exceed
-// their share of the budget, the soups and at least one binned 88-byte record a triangle.
-struct DiskNeed {
-  std::uint64_t spill = 0, index = 0;
-};
-DiskNeed disk_need(double triangles, double soup_bytes, const PreprocessOptions& options) {
-  constexpr double kIndexBytes = 24, kRecordBytes = sizeof(TriangleRecord);
-  const bool spills = options.force_spill || soup_bytes > double(options.memory_bytes / 4);
-  const double spill = spills ? soup_bytes + kRecordBytes * triangles : 0;
-  const double cap = 1.8e19;  // within std::uint64_t
-  return {std::uint64_t(std::min(spill, cap)),
-          std::uint64_t(std::min(kIndexBytes * triangles, cap))};
-}
-
-// Refuses a model that the free disk cannot hold, as soon as what it places is known.
-void check_disk_room(const DiskRoom& room, double triangles, double soup_bytes,
-                     const PreprocessOptions& options) {
-  const DiskNeed need = disk_need(triangles, soup_bytes, options);
-  const auto refuse = [&](std::uint64_t bytes, const std::filesystem::path& folder,
-                          std::uint64_t free) {
-    char count[32];
-    std::snprintf(count, sizeof count, "%.2g", triangles);
-    std::string message = "the model places ";
-    message.append(count)
-        .append(" triangles, about ")
-        .append(format_byte_size(bytes))
-        .append(" of spill and index, but ")
-        .append(folder.string())
-        .append(" has ")
-        .append(format_byte_size(free))
-        .append(" free");
-    throw InputError(message);
-  };
-  if (room.same_device) {
-    if (need.spill + need.index > room.spill_free)
-      refuse(need.spill + need.index, room.spill_folder, room.spill_free);
-    return;
-  }
-  if (need.spill > room.spill_free) refuse(need.spill, room.spill_folder, room.spill_free);
-  if (need.index > room.output_free) refuse(need.index, room.output_folder, room.output_free);
 }
 
 // What the ingest accumulates besides the model: the sample's generator and the figures the
@@ -700,7 +704,7 @@ IngestedModel ingest(const std::vector<std::filesystem::path>& inputs,
       jobs.size(), ingest_depth(largest_estimate(estimates), options.memory_bytes, threads),
       [&](std::size_t j) {
         return std::make_shared<LoadedSoup>(
-            load_soup(jobs[j], estimates[j], options, spill_folder, threads, rooms[j]));
+            load_soup(jobs[j], estimates[j], options, spill_folder, room, threads, rooms[j]));
       },
       [&](const std::shared_ptr<LoadedSoup>& loaded) {
         // In input order (ids, part numbers and the sample do not depend on the threads).

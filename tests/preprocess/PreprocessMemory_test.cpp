@@ -298,6 +298,26 @@ TEST(PreprocessMemory, AModelTheDiskCannotHoldIsRefusedWithTheFigure) {
   EXPECT_NO_THROW(preprocess({manifest}, folder / "model.tpi", options));
 }
 
+// A file read in chunks is weighed against the free disk before it is read: 300,000 triangles
+// need about 30 MiB of spill and index; with 8 MiB free the run is refused with the figure.
+TEST(PreprocessMemory, AFileReadInChunksTheDiskCannotHoldIsRefusedBeforeItIsRead) {
+  const fs::path folder = test_folder("disk-chunks");
+  const fs::path input = make_terrain(folder / "terrain.ply", 300'000);
+  PreprocessOptions options;
+  options.force_spill = true;  // read in chunks
+  options.assumed_free_disk_bytes = std::uint64_t(8) << 20;
+  try {
+    preprocess({input}, folder / "model.tpi", options);
+    ADD_FAILURE() << "not refused";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("the model places 3e+05 triangles, about "), std::string::npos) << message;
+    EXPECT_NE(message.find("has 8.0 MiB free"), std::string::npos) << message;
+  }
+  for (const auto& entry : fs::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename(), "terrain.ply") << "left behind: " << entry.path();
+}
+
 // Copies placed in batches (16M: about 10 copies a batch) store the triangles of the soup placed
 // whole (load_inputs), with the same ids and parts: every tet checked against brute force.
 TEST(PreprocessMemory, BatchedCopiesStoreTheSameTrianglesIdsAndParts) {
