@@ -820,19 +820,19 @@ ReadReport PieceLoader::report() const {
 }
 
 struct PlacedChunks::Impl {
-  Impl(const InputPiece& piece)
+  Impl(const InputPiece& piece, std::size_t copy)
       : placed(*piece.manifest, piece.entries),
-        placement(placed, 0, part_unit_scale(placed.part(), placed.owner().units, "")) {}
+        placement(placed, copy, part_unit_scale(placed.part(), placed.owner().units, "")) {}
   PlacedEntry placed;
   Placement placement;
   BoundingBox box;
   std::uint64_t dropped = 0;
 };
 
-PlacedChunks::PlacedChunks(const InputPiece& piece) {
-  if (!piece.manifest || piece.copies() != 1)
-    throw InputError(piece.input.string() + ": only a piece placed once is placed in chunks");
-  impl_ = std::make_unique<Impl>(piece);
+PlacedChunks::PlacedChunks(const InputPiece& piece, std::size_t copy) {
+  if (!piece.manifest || copy >= piece.copies())
+    throw InputError(piece.input.string() + ": no placement " + std::to_string(copy) + " to place");
+  impl_ = std::make_unique<Impl>(piece, copy);
 }
 PlacedChunks::~PlacedChunks() = default;
 
@@ -855,13 +855,14 @@ void PlacedChunks::place(TriangleSoup& chunk) {
   chunk.part_of.resize(kept);
 }
 
-TriangleSoup PlacedChunks::finish(const TriangleSoup& file_parts, ReadReport& report) {
+TriangleSoup PlacedChunks::finish(const TriangleSoup& file_parts) {
   check_placement_precision(impl_->placement.instance, impl_->box);
   TriangleSoup parts;
   add_placed_parts(parts, file_parts, impl_->placed.part(), impl_->placement.path);
-  report.degenerate_dropped += impl_->dropped;
   return parts;
 }
+
+std::uint64_t PlacedChunks::dropped() const { return impl_->dropped; }
 
 TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports,
                               const TessellationOptions& tessellation) {

@@ -135,12 +135,9 @@ StreamPlan plan_stream(const MeshReadEstimate& read, std::uint64_t room) {
   return {fixed + held * per_vertex, held};
 }
 
-// A mesh file given on its own or placed once, in a format read in chunks
-// (MeshReadEstimate::chunked). A file placed many times is read once and its copies placed in
-// batches (a file too large for that is refused).
-bool can_stream(const InputPiece& piece, const PieceEstimate& estimate) {
-  return estimate.read.chunked && (piece.manifest == nullptr || piece.copies() == 1);
-}
+// A mesh file in a format read in chunks (MeshReadEstimate::chunked), however many times it is
+// placed (read once per copy: a file that fits is read once and its copies placed in batches).
+bool can_stream(const InputPiece&, const PieceEstimate& estimate) { return estimate.read.chunked; }
 
 PieceEstimate estimate_piece(const InputPiece& piece) {
   PieceEstimate estimate;
@@ -369,51 +366,85 @@ void check_disk_room(const DiskRoom& room, double triangles, double soup_bytes,
   if (need.index > room.output_free) refuse(need.index, room.output_folder, room.output_free);
 }
 
-// Reads a file in chunks into a StreamedFile: each chunk's coordinates checked, its parts
-// counted, its components labelled, and the chunk spilled; the labels united at the end.
-std::unique_ptr<StreamedFile> read_streamed(const InputPiece& piece, const PieceEstimate& estimate,
-                                            const PreprocessOptions& options,
-                                            const std::filesystem::path& spill_folder,
-                                            ReadReport& report) {
-  auto file = std::make_unique<StreamedFile>(spill_folder);
+// Reads a file in chunks into a StreamedFile, once per copy a manifest places (each copy's
+// triangles follow the one before, as the copies placed whole do): each chunk placed, its
+// coordinates checked, its parts counted, its components labelled, and the chunk spilled; the
+// labels united at the end. Copies are parts of their own: no component spans two.
+class StreamedReading {
+ public:
+  StreamedReading(const InputPiece& piece, const PieceEstimate& estimate,
+                  const PreprocessOptions& options, const std::filesystem::path& spill_folder)
+      : piece_(piece),
+        options_(options),
+        copies_(piece.manifest ? piece.copies() : 1),
+        file_(std::make_unique<StreamedFile>(spill_folder)),
+        components_(spill_folder, copies_ * distinct_positions(estimate.read), kPositionBucketBytes),
+        progress_("reading " + piece.file().filename().string() + " in chunks (triangles)",
+                  estimate.read.counted ? copies_ * estimate.read.triangles : 0, options.progress,
+                  options.on_progress) {
+    chunks_.triangles = kChunkTriangles;
+    chunks_.held_vertices = estimate.held_vertices;
+    chunks_.vertex_folder = spill_folder;
+    chunks_.vertex_cache_bytes = kVertexCacheBytes;
+    chunks_.take = [this](TriangleSoup&& chunk) { take(std::move(chunk)); };
+  }
+
+  std::unique_ptr<StreamedFile> read(ReadReport& report) {
+    for (std::size_t copy = 0; copy < copies_; ++copy) read_copy(copy, report);
+    progress_.finish();
+    file_->part_triangles.resize(std::max<std::size_t>(file_->parts.part_count(), 1), 0);
+    file_->united = components_.unite();
+    return std::move(file_);
+  }
+
+ private:
   // Distinct positions: about the vertices of an indexed file, a sixth of an STL's corners.
-  const std::uint64_t positions =
-      estimate.read.vertices <= 2 * estimate.read.triangles ? estimate.read.vertices
-                                                            : estimate.read.vertices / 6;
-  ChunkedComponents components(spill_folder, positions, kPositionBucketBytes);
-  std::optional<PlacedChunks> placement;
-  if (piece.manifest) placement.emplace(piece);
-  // A file read in chunks is long work of its own: its triangles are counted as they come.
-  Progress progress("reading " + piece.file().filename().string() + " in chunks (triangles)",
-                    estimate.read.counted ? estimate.read.triangles : 0, options.progress,
-                    options.on_progress);
-  SoupChunks chunks;
-  chunks.triangles = kChunkTriangles;
-  chunks.held_vertices = estimate.held_vertices;
-  chunks.vertex_folder = spill_folder;
-  chunks.vertex_cache_bytes = kVertexCacheBytes;
-  chunks.take = [&](TriangleSoup&& chunk) {
-    if (placement) placement->place(chunk);
+  static std::uint64_t distinct_positions(const MeshReadEstimate& read) {
+    return read.vertices <= 2 * read.triangles ? read.vertices : read.vertices / 6;
+  }
+
+  // The file's report once (its first reading), and every copy's flattened triangles.
+  void read_copy(std::size_t copy, ReadReport& report) {
+    if (piece_.manifest) placement_.emplace(piece_, copy);
+    part_base_ = std::uint32_t(file_->parts.part_count());
+    ReadReport reading;
+    const TriangleSoup file_parts =
+        read_mesh_in_chunks(piece_.file(), &reading, chunks_, options_.tessellation);
+    if (copy == 0) report = reading;
+    const TriangleSoup parts = placement_ ? placement_->finish(file_parts) : file_parts;
+    if (placement_) report.degenerate_dropped += placement_->dropped();
+    for (std::size_t p = 0; p < parts.part_count(); ++p)
+      file_->parts.add_part(parts.part_names[p], parts.part_paths.empty() ? "" : parts.part_paths[p]);
+    placement_.reset();
+  }
+
+  void take(TriangleSoup&& chunk) {
+    if (placement_) placement_->place(chunk);
     if (chunk.triangle_count() == 0) return;
-    check_coordinate_magnitudes(chunk, piece);
-    for (const std::uint32_t part : chunk.part_of) {
-      if (part >= file->part_triangles.size()) file->part_triangles.resize(part + 1, 0);
-      ++file->part_triangles[part];
+    check_coordinate_magnitudes(chunk, piece_);
+    for (std::uint32_t& part : chunk.part_of) {
+      part += part_base_;
+      if (part >= file_->part_triangles.size()) file_->part_triangles.resize(part + 1, 0);
+      ++file_->part_triangles[part];
     }
-    components.add_chunk(chunk, file->triangles);
-    check_table_bytes(file->part_triangles.size(), components.label_bytes(), options);
-    file->triangles += chunk.triangle_count();
-    file->soup_bytes += SoupSpill<TriangleRecord>::soup_bytes(chunk);
-    progress.advance(chunk.triangle_count());
-    file->chunks.append(std::move(chunk), 0);
-  };
-  file->parts = read_mesh_in_chunks(piece.file(), &report, chunks, options.tessellation);
-  if (placement) file->parts = placement->finish(file->parts, report);
-  progress.finish();
-  file->part_triangles.resize(std::max<std::size_t>(file->parts.part_count(), 1), 0);
-  file->united = components.unite();
-  return file;
-}
+    components_.add_chunk(chunk, file_->triangles);
+    check_table_bytes(file_->part_triangles.size(), components_.label_bytes(), options_);
+    file_->triangles += chunk.triangle_count();
+    file_->soup_bytes += SoupSpill<TriangleRecord>::soup_bytes(chunk);
+    progress_.advance(chunk.triangle_count());
+    file_->chunks.append(std::move(chunk), 0);
+  }
+
+  const InputPiece& piece_;
+  const PreprocessOptions& options_;
+  std::size_t copies_;
+  std::unique_ptr<StreamedFile> file_;
+  ChunkedComponents components_;
+  Progress progress_;  // a file read in chunks is long work of its own
+  SoupChunks chunks_;
+  std::optional<PlacedChunks> placement_;  // of the copy being read
+  std::uint32_t part_base_ = 0;            // its first part
+};
 
 LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
                      const PreprocessOptions& options, const std::filesystem::path& spill_folder,
@@ -422,10 +453,11 @@ LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
   if (estimate.streamed) {
     // Before it is read, by its estimate alone: its chunks spill twice (its own spill, then the
     // model's), and the whole model is weighed again once it is read (append_piece).
-    const double triangles = double(estimate.read.triangles);
-    check_disk_room(disk, triangles, 2.0 * double(estimate.read.soup_bytes()), options);
+    const double copies = double(piece.copies());
+    check_disk_room(disk, copies * double(estimate.read.triangles),
+                    2.0 * copies * double(estimate.read.soup_bytes()), options);
     loaded.file = piece.input.string();
-    loaded.streamed = read_streamed(piece, estimate, options, spill_folder, loaded.report);
+    loaded.streamed = StreamedReading(piece, estimate, options, spill_folder).read(loaded.report);
     loaded.length_unit = piece.manifest ? piece.manifest->units : loaded.report.length_unit;
     return loaded;
   }

@@ -168,27 +168,28 @@ class PieceLoader {
   std::unique_ptr<Impl> impl_;
 };
 
-/// A piece placed once whose file is read in chunks (read_mesh_in_chunks; formats whose readers
-/// state no unit): each chunk placed as PieceLoader::place places the whole file, so that the
-/// placed chunks, in order, are its placed soup triangle for triangle.
+/// A placement of a piece whose file is read in chunks (read_mesh_in_chunks; formats whose
+/// readers state no unit): each chunk placed as PieceLoader::place places the whole file, so that
+/// the placed chunks, in order, are that copy's placed soup triangle for triangle.
 class PlacedChunks {
  public:
-  /// @throw InputError for an entry the manifest does not hold, or a piece placed more than
-  /// once.
-  explicit PlacedChunks(const InputPiece& piece);
+  /// Placement `copy` (< piece.copies()) of a piece a manifest places.
+  /// @throw InputError for an entry the manifest does not hold.
+  PlacedChunks(const InputPiece& piece, std::size_t copy);
   ~PlacedChunks();
   PlacedChunks(const PlacedChunks&) = delete;
   PlacedChunks& operator=(const PlacedChunks&) = delete;
 
   /// Moves the chunk's vertices where the placement puts them and drops the triangles that
-  /// rounding flattens (counted by finish()). Its parts stay the file's.
+  /// rounding flattens (counted by dropped()). Its parts stay the file's.
   /// @throw InputError for a vertex placed beyond the accepted coordinates.
   void place(TriangleSoup& chunk);
   /// After the last chunk: the placed part's precision checked over its whole box; returns the
-  /// parts of the placement (part_names, part_paths) for the file's parts `file_parts`, and
-  /// adds the triangles dropped to `report`.
+  /// parts of the placement (part_names, part_paths) for the file's parts `file_parts`.
   /// @throw InputError for a part placed too far from the origin for its size.
-  TriangleSoup finish(const TriangleSoup& file_parts, ReadReport& report);
+  TriangleSoup finish(const TriangleSoup& file_parts);
+  /// The triangles the placement flattened and dropped so far.
+  std::uint64_t dropped() const;
 
  private:
   struct Impl;
