@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -381,7 +382,8 @@ class StreamedReading {
         components_(spill_folder, copies_ * distinct_positions(estimate.read), kPositionBucketBytes),
         progress_("reading " + piece.file().filename().string() + " in chunks (triangles)",
                   estimate.read.counted ? copies_ * estimate.read.triangles : 0, options.progress,
-                  options.on_progress) {
+                  options.on_progress),
+        expected_triangles_(copies_ * estimate.read.triangles) {
     chunks_.triangles = kChunkTriangles;
     chunks_.held_vertices = estimate.held_vertices;
     chunks_.vertex_folder = spill_folder;
@@ -428,11 +430,36 @@ class StreamedReading {
       ++file_->part_triangles[part];
     }
     components_.add_chunk(chunk, file_->triangles);
-    check_table_bytes(file_->part_triangles.size(), components_.label_bytes(), options_);
+    check_label_bytes();
     file_->triangles += chunk.triangle_count();
     file_->soup_bytes += SoupSpill<TriangleRecord>::soup_bytes(chunk);
     progress_.advance(chunk.triangle_count());
     file_->chunks.append(std::move(chunk), 0);
+  }
+
+  // The labels (8 B each) stay in memory until they are united: a file whose triangles follow
+  // no spatial order makes about one a triangle. Refused past a quarter of the budget.
+  void check_label_bytes() const {
+    const std::uint64_t bytes = components_.label_bytes(), limit = options_.memory_bytes / 4;
+    if (bytes <= limit) return;
+    // The labels grow with the triangles: the whole file's, at the rate so far.
+    const double whole = double(bytes) * double(std::max(expected_triangles_, file_->triangles)) /
+                         double(std::max<std::uint64_t>(file_->triangles, 1));
+    constexpr double kStep = double(std::uint64_t(8) << 20);
+    const auto raise_to = std::uint64_t(std::ceil(4 * whole / kStep) * kStep);
+    std::string message = quoted_input(piece_.file().string(), 4096);
+    message.append(": read in chunks, its first ")
+        .append(thousands(file_->triangles))
+        .append(" triangles make ")
+        .append(thousands(components_.label_count()))
+        .append(" pieces of connected components (its triangles follow no spatial order), ")
+        .append(format_byte_size(bytes))
+        .append(" of labels, above a quarter of --memory ")
+        .append(format_byte_size(options_.memory_bytes))
+        .append("; raise --memory to ")
+        .append(format_byte_size(raise_to))
+        .append(" or more, or write the file with its triangles in order");
+    throw InputError(message);
   }
 
   const InputPiece& piece_;
@@ -442,6 +469,7 @@ class StreamedReading {
   ChunkedComponents components_;
   Progress progress_;  // a file read in chunks is long work of its own
   SoupChunks chunks_;
+  std::uint64_t expected_triangles_;       // by the estimate, every copy
   std::optional<PlacedChunks> placement_;  // of the copy being read
   std::uint32_t part_base_ = 0;            // its first part
 };

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <fstream>
 #include <string>
 
@@ -296,6 +297,36 @@ TEST(PreprocessMemory, AModelTheDiskCannotHoldIsRefusedWithTheFigure) {
   options.assumed_free_disk_bytes = std::uint64_t(1) << 30;
   options.memory_bytes = std::uint64_t(64) << 20;
   EXPECT_NO_THROW(preprocess({manifest}, folder / "model.tpi", options));
+}
+
+// A file whose triangles follow no spatial order (a terrain's, shuffled) makes about one piece of
+// a component per triangle in each chunk: read in chunks under 16M, its labels pass a quarter of
+// the budget and the run is refused with the figure, leaving nothing behind.
+TEST(PreprocessMemory, AFileInNoSpatialOrderIsRefusedWithTheFigureWhenItsPiecesExceedTheBudget) {
+  const fs::path folder = test_folder("shuffled");
+  TriangleSoup terrain = read_mesh(make_terrain(folder / "terrain.ply", 1'500'000));
+  std::mt19937_64 random(7);
+  std::shuffle(terrain.triangles.begin(), terrain.triangles.end(), random);
+  const fs::path input = folder / "shuffled.ply";
+  write_as(terrain, input, "ply-float");
+  fs::remove(folder / "terrain.ply");
+  PreprocessOptions options;
+  options.memory_bytes = std::uint64_t(16) << 20;
+  options.force_spill = true;  // read in chunks
+  try {
+    preprocess({input}, folder / "model.tpi", options);
+    ADD_FAILURE() << "not refused";
+  } catch (const InputError& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find("pieces of connected components"), std::string::npos) << message;
+    EXPECT_NE(message.find("above a quarter of --memory 16.0 MiB"), std::string::npos) << message;
+    // The figure: a quarter of it holds the labels of the whole file at the rate so far.
+    const std::string raised = raised_memory(message);
+    ASSERT_FALSE(raised.empty()) << message;
+    EXPECT_GE(std::stoull(raised), 32u) << message;
+  }
+  for (const auto& entry : fs::directory_iterator(folder))
+    EXPECT_EQ(entry.path().filename(), "shuffled.ply") << "left behind: " << entry.path();
 }
 
 // A file read in chunks is weighed against the free disk before it is read: 300,000 triangles
