@@ -836,11 +836,12 @@ PlacedChunks::PlacedChunks(const InputPiece& piece, std::size_t copy) {
 }
 PlacedChunks::~PlacedChunks() = default;
 
+void PlacedChunks::note_vertex(const Vec3& vertex) {
+  impl_->box.extend(impl_->placement.place(vertex));
+}
+
 void PlacedChunks::place(TriangleSoup& chunk) {
-  for (Vec3& v : chunk.vertices) {
-    v = impl_->placement.place(v);
-    impl_->box.extend(v);
-  }
+  for (Vec3& v : chunk.vertices) v = impl_->placement.place(v);
   std::size_t kept = 0;
   for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
     const auto& c = chunk.triangles[t];

@@ -66,7 +66,8 @@ bool SoupBuilder::drop_if_degenerate(std::size_t t, std::uint64_t position) {
   if (!repeated && !is_degenerate_triangle(vertex(tri[0]), vertex(tri[1]), vertex(tri[2])))
     return false;
   ++report_.degenerate_dropped;
-  report_.dropped_positions.push_back(position);
+  if (chunks_ == nullptr || chunks_->keep_dropped_positions)
+    report_.dropped_positions.push_back(position);
   return true;
 }
 
@@ -107,7 +108,7 @@ void SoupBuilder::hand_over_chunk() {
   kept_before_ += chunk.triangles.size();
   soup_.triangles.clear();
   soup_.part_of.clear();
-  if (vertices_unshared_ && !in_polygon_) {
+  if (vertices_unshared_) {
     vertex_base_ += table_.size();
     table_.clear();
   }

@@ -106,6 +106,7 @@ class SoupBuilder {
   }
   void add_vertex(const Vec3& p) {
     if (chunks_ != nullptr) {
+      if (chunks_->on_vertex) chunks_->on_vertex(p);
       table_.push_back(p);
     } else {
       soup_.vertices.push_back(p);
@@ -117,16 +118,21 @@ class SoupBuilder {
     soup_.triangles.push_back({a, b, c});
     soup_.part_of.push_back(part_);
     ++report_.triangles_read;
-    if (chunks_ != nullptr && soup_.triangles.size() >= chunks_->triangles) hand_over_chunk();
+    // An unshared table (an STL's) is let go with a chunk: not between a facet's triangles.
+    if (chunks_ != nullptr && soup_.triangles.size() >= chunks_->triangles &&
+        !(vertices_unshared_ && in_polygon_))
+      hand_over_chunk();
   }
   /// A face of any size, fan-triangulated around its first corner (fewer than 3 corners: the
   /// caller rejects it first).
   void add_polygon(std::span<const std::uint32_t> corners) {
     if (corners.size() > 3) ++report_.polygons_triangulated;
-    in_polygon_ = true;  // a chunk handed over in between keeps the polygon's vertices
+    in_polygon_ = true;
     for (std::size_t i = 1; i + 1 < corners.size(); ++i)
       add_triangle(corners[0], corners[i], corners[i + 1]);
     in_polygon_ = false;
+    if (chunks_ != nullptr && vertices_unshared_ && soup_.triangles.size() >= chunks_->triangles)
+      hand_over_chunk();
   }
 
   /// Drops degenerate triangles and returns the soup (in chunks: the last chunk handed over,

@@ -57,15 +57,17 @@ void unite_labels(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint
 }  // namespace
 
 ChunkedComponents::ChunkedComponents(const std::filesystem::path& spill_folder,
-                                     std::uint64_t expected_positions, std::uint64_t bucket_bytes)
+                                     const std::string& name, std::uint64_t expected_positions,
+                                     std::uint64_t bucket_bytes)
     : spill_folder_(spill_folder),
+      name_(name),
       bucket_bytes_(std::max<std::uint64_t>(bucket_bytes, 1)),
-      labels_(spill_path(spill_folder, "labels")) {
+      labels_(spill_path(spill_folder, name + "-labels")) {
   const std::uint64_t bytes = expected_positions * sizeof(PositionRecord);
   const std::uint64_t count = std::clamp<std::uint64_t>(bytes / bucket_bytes_ + 1, 1, kMostBuckets);
   buckets_.reserve(count);
   for (std::uint64_t b = 0; b < count; ++b)
-    buckets_.emplace_back(spill_path(spill_folder_, "positions-" + std::to_string(b)));
+    buckets_.emplace_back(spill_path(spill_folder_, name_ + "-positions-" + std::to_string(b)));
 }
 
 std::uint64_t ChunkedComponents::label_bytes() const {
@@ -133,7 +135,7 @@ void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsign
   if (bucket.size() * sizeof(PositionRecord) > bucket_bytes_ && depth < kMostSplits) {
     std::vector<RecordSpill<PositionRecord>> parts;
     for (std::uint64_t b = 0; b < kSplitBuckets; ++b)
-      parts.emplace_back(spill_path(spill_folder_, "positions-" + std::to_string(depth + 1) +
+      parts.emplace_back(spill_path(spill_folder_, name_ + "-positions-" + std::to_string(depth + 1) +
                                                        "-" + std::to_string(b)));
     bucket.for_each_block(1 << 14, [&](std::span<const PositionRecord> block) {
       for (const PositionRecord& r : block)
@@ -150,7 +152,8 @@ void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsign
     if (same_place(records[i - 1], records[i])) unite_labels(parent_, records[i - 1].label, records[i].label);
 }
 
-ChunkedComponents::United ChunkedComponents::unite() {
+ChunkedComponents::United ChunkedComponents::unite(std::uint64_t most_components,
+                                                   const std::string& refusal) {
   for (RecordSpill<PositionRecord>& bucket : buckets_) unite_bucket(bucket, 0);
   std::vector<RecordSpill<PositionRecord>>().swap(buckets_);
   std::vector<PositionRecord>().swap(chunk_positions_);
@@ -171,6 +174,7 @@ ChunkedComponents::United ChunkedComponents::unite() {
       const std::uint32_t root = find(parent_, label);
       std::uint32_t& component = united.component_of_label[root];
       if (component == kNone) {
+        if (united.components.size() >= most_components) throw InputError(refusal);
         component = std::uint32_t(united.components.size());
         united.components.push_back(record.component);
         parity.push_back(record.parity);

@@ -4,6 +4,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -34,8 +35,8 @@ constexpr std::uint64_t kComponentEntryBytes = sizeof(SurfaceComponent);
 // in a spill of their own, their triangles labelled with their pieces of components, and the
 // components those labels unite into (ChunkedComponents).
 struct StreamedFile {
-  explicit StreamedFile(const std::filesystem::path& spill_folder) {
-    chunks.spill_to(spill_path(spill_folder, "chunks"));
+  StreamedFile(const std::filesystem::path& spill_folder, const std::string& name) {
+    chunks.spill_to(spill_path(spill_folder, name + "-chunks"));
   }
   SoupSpill<TriangleRecord> chunks;
   ChunkedComponents::United united;
@@ -61,14 +62,22 @@ struct LoadedSoup {
 
 // Coordinates beyond kMaxCoordinateMagnitude overflow the distances to the model and the
 // exact predicates' products: refused, naming the file and the value.
-void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& piece) {
-  const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup);
-  if (!beyond.found) return;
+[[noreturn]] void refuse_coordinate(double coordinate, const InputPiece& piece) {
   char value[64], limit[64];
-  std::snprintf(value, sizeof value, "%g", beyond.value);
+  std::snprintf(value, sizeof value, "%g", coordinate);
   std::snprintf(limit, sizeof limit, "%g", kMaxCoordinateMagnitude);
   throw InputError(piece.file().string() + ": a vertex coordinate of " + value + " is beyond " +
                    limit + " in magnitude: distances would overflow; scale the model");
+}
+
+void check_coordinate_magnitudes(const TriangleSoup& soup, const InputPiece& piece) {
+  const CoordinateBeyondLimit beyond = find_coordinate_beyond_limit(soup);
+  if (beyond.found) refuse_coordinate(beyond.value, piece);
+}
+
+void check_coordinate_magnitude(const Vec3& vertex, const InputPiece& piece) {
+  for (const double coordinate : vertex)
+    if (std::fabs(coordinate) > kMaxCoordinateMagnitude) refuse_coordinate(coordinate, piece);
 }
 
 // Per triangle: its parts counted, then part_of replaced by its component's number.
@@ -126,14 +135,14 @@ struct StreamPlan {
 StreamPlan plan_stream(const MeshReadEstimate& read, std::uint64_t room) {
   constexpr std::uint64_t kSlack = std::uint64_t(8) << 20;
   constexpr std::uint64_t n = kChunkTriangles;
-  const std::uint64_t chunk = n * (16 + 88 + 96) + surface_components_bytes(3 * n, n);
+  const std::uint64_t chunk = n * (16 + 88 + 2 * 96 + 48) + surface_components_bytes(3 * n, n);
   const std::uint64_t fixed =
       kSlack + read.chunked_bytes + std::max(chunk, 2 * kPositionBucketBytes) + kVertexCacheBytes;
-  if (fixed + read.vertex_table_bytes <= room) return {fixed + read.vertex_table_bytes};
-  // A table grown as it is read holds up to twice its vertices' bytes.
+  // A table grown as it is read holds up to twice its vertices' bytes. Capped whatever the
+  // estimate: an OBJ's vertices are counted from its size, and may be more.
   const std::uint64_t per_vertex = read.counted ? 24 : 48;
   const std::uint64_t held = room > fixed ? (room - fixed) / per_vertex : 0;
-  return {fixed + held * per_vertex, held};
+  return {fixed + std::min(read.vertex_table_bytes, held * per_vertex), held};
 }
 
 // A mesh file in a format read in chunks (MeshReadEstimate::chunked), however many times it is
@@ -378,8 +387,10 @@ class StreamedReading {
       : piece_(piece),
         options_(options),
         copies_(piece.manifest ? piece.copies() : 1),
-        file_(std::make_unique<StreamedFile>(spill_folder)),
-        components_(spill_folder, copies_ * distinct_positions(estimate.read), kPositionBucketBytes),
+        name_("streamed-" + std::to_string(next_name_++)),
+        file_(std::make_unique<StreamedFile>(spill_folder, name_)),
+        components_(spill_folder, name_, copies_ * distinct_positions(estimate.read),
+                    kPositionBucketBytes),
         progress_("reading " + piece.file().filename().string() + " in chunks (triangles)",
                   estimate.read.counted ? copies_ * estimate.read.triangles : 0, options.progress,
                   options.on_progress),
@@ -389,13 +400,30 @@ class StreamedReading {
     chunks_.vertex_folder = spill_folder;
     chunks_.vertex_cache_bytes = kVertexCacheBytes;
     chunks_.take = [this](TriangleSoup&& chunk) { take(std::move(chunk)); };
+    // Every vertex, used or not, is checked as the whole read checks it.
+    chunks_.on_vertex = [this](const Vec3& vertex) {
+      if (placement_) {
+        placement_->note_vertex(vertex);
+      } else {
+        check_coordinate_magnitude(vertex, piece_);
+      }
+    };
+    chunks_.keep_dropped_positions = false;
   }
 
   std::unique_ptr<StreamedFile> read(ReadReport& report) {
     for (std::size_t copy = 0; copy < copies_; ++copy) read_copy(copy, report);
     progress_.finish();
     file_->part_triangles.resize(std::max<std::size_t>(file_->parts.part_count(), 1), 0);
-    file_->united = components_.unite();
+    // The components' table cannot spill: past the budget, refused as the model's would be.
+    const std::uint64_t most = std::max<std::uint64_t>(options_.memory_bytes / kComponentEntryBytes, 1);
+    std::string refusal = quoted_input(piece_.file().string(), 4096);
+    refusal.append(": more than ")
+        .append(thousands(most))
+        .append(" connected components, whose table exceeds --memory ")
+        .append(format_byte_size(options_.memory_bytes))
+        .append("; raise --memory");
+    file_->united = components_.unite(most, refusal);
     return std::move(file_);
   }
 
@@ -462,9 +490,12 @@ class StreamedReading {
     throw InputError(message);
   }
 
+  static inline std::atomic<unsigned> next_name_{0};  // streamed files read at once differ
+
   const InputPiece& piece_;
   const PreprocessOptions& options_;
   std::size_t copies_;
+  std::string name_;  // of its spill files
   std::unique_ptr<StreamedFile> file_;
   ChunkedComponents components_;
   Progress progress_;  // a file read in chunks is long work of its own

@@ -13,6 +13,7 @@
 #include <map>
 #include <numeric>
 
+#include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/MeshReader.h"
 
 namespace tetrapage {
@@ -152,14 +153,14 @@ TEST(ChunkedComponents, ChunksUniteIntoTheWholeSoupsComponents) {
     {
       SCOPED_TRACE("chunks of " + std::to_string(size) + ", " + std::to_string(run.positions) +
                    " positions expected in buckets of " + std::to_string(run.bytes));
-      ChunkedComponents chunked(folder, run.positions, run.bytes);
+      ChunkedComponents chunked(folder, "test", run.positions, run.bytes);
       std::vector<std::uint32_t> label_of;
       for (std::size_t first = 0; first < soup.triangle_count(); first += size) {
         TriangleSoup chunk = chunk_of(soup, first, std::min(first + size, soup.triangle_count()));
         chunked.add_chunk(chunk, first);
         label_of.insert(label_of.end(), chunk.part_of.begin(), chunk.part_of.end());
       }
-      const ChunkedComponents::United united = chunked.unite();
+      const ChunkedComponents::United united = chunked.unite(~std::uint64_t(0), "");
       ASSERT_EQ(united.components.size(), expected.components.size());
       for (std::size_t t = 0; t < soup.triangle_count(); ++t)
         ASSERT_EQ(united.component_of_label[label_of[t]], expected.component_of[t]) << "triangle " << t;
@@ -173,6 +174,18 @@ TEST(ChunkedComponents, ChunksUniteIntoTheWholeSoupsComponents) {
         EXPECT_EQ(a.bounds.lo, b.bounds.lo) << c;
         EXPECT_EQ(a.bounds.hi, b.bounds.hi) << c;
       }
+    }
+  }
+  // More components than allowed: refused with the caller's words.
+  {
+    ChunkedComponents chunked(folder, "limit", soup.vertices.size(), 1 << 16);
+    TriangleSoup chunk = chunk_of(soup, 0, soup.triangle_count());
+    chunked.add_chunk(chunk, 0);
+    try {
+      chunked.unite(expected.components.size() - 1, "too many");
+      ADD_FAILURE() << "not refused";
+    } catch (const InputError& error) {
+      EXPECT_STREQ(error.what(), "too many");
     }
   }
   for (const auto& entry : fs::directory_iterator(folder))

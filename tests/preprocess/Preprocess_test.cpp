@@ -335,9 +335,10 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
     SCOPED_TRACE(extension);
     const fs::path input = folder / (std::string(extension) == ".json" ? std::string("assembly.json")
                                                                         : std::string("soup") + extension);
-    if (std::string(extension) != ".json")
+    if (std::string(extension) != ".json") {
       ASSERT_TRUE(CGAL::IO::write_polygon_soup(input.string(), points, polygons,
                                                CGAL::parameters::use_binary_mode(true)));
+    }
     PreprocessOptions whole;
     whole.region_triangles = 4000;
     whole.interiors = true;

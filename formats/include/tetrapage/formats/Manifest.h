@@ -180,11 +180,16 @@ class PlacedChunks {
   PlacedChunks(const PlacedChunks&) = delete;
   PlacedChunks& operator=(const PlacedChunks&) = delete;
 
+  /// Notes a vertex of the file as it is read (SoupChunks::on_vertex), used or not: the whole
+  /// placement places every vertex and checks its precision over all of them.
+  /// @throw InputError for a vertex placed beyond the accepted coordinates.
+  void note_vertex(const Vec3& vertex);
   /// Moves the chunk's vertices where the placement puts them and drops the triangles that
   /// rounding flattens (counted by dropped()). Its parts stay the file's.
   /// @throw InputError for a vertex placed beyond the accepted coordinates.
   void place(TriangleSoup& chunk);
-  /// After the last chunk: the placed part's precision checked over its whole box; returns the
+  /// After the last chunk: the placed part's precision checked over the box of every vertex
+  /// noted; returns the
   /// parts of the placement (part_names, part_paths) for the file's parts `file_parts`.
   /// @throw InputError for a part placed too far from the origin for its size.
   TriangleSoup finish(const TriangleSoup& file_parts);

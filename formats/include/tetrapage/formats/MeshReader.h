@@ -57,6 +57,10 @@ struct SoupChunks {
   std::uint64_t held_vertices = ~std::uint64_t(0);
   std::filesystem::path vertex_folder;
   std::uint64_t vertex_cache_bytes = std::uint64_t(8) << 20;
+  /// Each vertex as it is read, used or not (what a whole read's checks see of the file).
+  std::function<void(const Vec3&)> on_vertex;
+  /// Fill ReadReport::dropped_positions (8 B a degenerate triangle, held to the end).
+  bool keep_dropped_positions = true;
 };
 
 /// Reads a mesh file as read_mesh does, handing its kept triangles to `chunks.take` a chunk at a

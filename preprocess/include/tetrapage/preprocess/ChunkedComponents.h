@@ -20,11 +20,12 @@ namespace tetrapage {
 
 class ChunkedComponents {
  public:
-  /// Buckets in `spill_folder`, as many as `expected_positions` (the file's distinct vertex
-  /// positions, about) need for each to hold about `bucket_bytes`.
+  /// Buckets in `spill_folder`, their names starting with `name` (files found at once must
+  /// differ), as many as `expected_positions` (the file's distinct vertex positions, about)
+  /// need for each to hold about `bucket_bytes`.
   /// @throw IoError when a bucket cannot be created.
-  ChunkedComponents(const std::filesystem::path& spill_folder, std::uint64_t expected_positions,
-                    std::uint64_t bucket_bytes);
+  ChunkedComponents(const std::filesystem::path& spill_folder, const std::string& name,
+                    std::uint64_t expected_positions, std::uint64_t bucket_bytes);
 
   /// Finds the components of `chunk`, whose part_of holds the file's parts and whose first
   /// triangle is the file's `first_triangle`, and replaces part_of by their labels (ascending
@@ -44,8 +45,9 @@ class ChunkedComponents {
   };
   /// Unites the labels whose triangles share a position within a part and numbers the
   /// components; the buckets are emptied.
-  /// @throw IoError when a bucket cannot be read back.
-  United unite();
+  /// @throw InputError `refusal` when there are more than `most_components`; IoError when a
+  /// bucket cannot be read back.
+  United unite(std::uint64_t most_components, const std::string& refusal);
 
  private:
   // A distinct (position, part) of a chunk and the label of its triangles there.
@@ -66,6 +68,7 @@ class ChunkedComponents {
   };
 
   std::filesystem::path spill_folder_;
+  std::string name_;
   std::uint64_t bucket_bytes_;
   std::vector<RecordSpill<PositionRecord>> buckets_;
   RecordSpill<LabelRecord> labels_;
