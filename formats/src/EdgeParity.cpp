@@ -1,26 +1,18 @@
 #include "tetrapage/formats/EdgeParity.h"
 
-#include <bit>
 #include <utility>
+
+#include "tetrapage/formats/PositionBits.h"
 
 namespace tetrapage {
 namespace {
-
-std::uint64_t mix(std::uint64_t x) {
-  // splitmix64's finaliser: every input bit moves every output bit.
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  x ^= x >> 31;
-  return x;
-}
 
 // A 128-bit hash of an unordered pair of positions from their hashes: the pair is ordered
 // first, then each lane chains the two vertices' words of that lane.
 std::array<std::uint64_t, 2> edge_hash(const EdgeParity::VertexHash& p, const EdgeParity::VertexHash& q) {
   const auto& [a, b] = q < p ? std::pair(q, p) : std::pair(p, q);
-  return {mix(mix(a[0] ^ 0x243f6a8885a308d3ULL) ^ b[0]), mix(mix(a[1] + 0x13198a2e03707344ULL) + b[1])};
+  return {mix_bits(mix_bits(a[0] ^ 0x243f6a8885a308d3ULL) ^ b[0]),
+          mix_bits(mix_bits(a[1] + 0x13198a2e03707344ULL) + b[1])};
 }
 
 }  // namespace
@@ -28,9 +20,9 @@ std::array<std::uint64_t, 2> edge_hash(const EdgeParity::VertexHash& p, const Ed
 EdgeParity::VertexHash EdgeParity::hash_vertex(const Vec3& p) {
   VertexHash lane{0xa4093822299f31d0ULL, 0x082efa98ec4e6c89ULL};
   for (int a = 0; a < 3; ++a) {
-    const std::uint64_t w = std::bit_cast<std::uint64_t>(p[a] == 0.0 ? 0.0 : p[a]);  // -0 is 0
-    lane[0] = mix(lane[0] ^ w);
-    lane[1] = mix(lane[1] + (w ^ 0x452821e638d01377ULL));
+    const std::uint64_t w = coordinate_bits(p[a]);  // -0 is 0
+    lane[0] = mix_bits(lane[0] ^ w);
+    lane[1] = mix_bits(lane[1] + (w ^ 0x452821e638d01377ULL));
   }
   return lane;
 }

@@ -269,27 +269,30 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
   return out;
 }
 
-TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report,
-                       const TessellationOptions& tessellation) {
+namespace {
+
+// The reader for the file's format, timed into the report. With `chunks`, our own readers hand
+// their triangles over and return the parts alone; the others return the whole soup.
+TriangleSoup read_mesh_file(const std::filesystem::path& path, ReadReport* report,
+                            const TessellationOptions& tessellation, const SoupChunks* chunks) {
   const auto start = std::chrono::steady_clock::now();
   ReadReport local;
   ReadReport& out = report != nullptr ? *report : local;
   out = ReadReport{};
   out.path = path.string();
-  const MeshFormat format = mesh_format_from_path(path);
   TriangleSoup soup;
-  switch (format) {
+  switch (mesh_format_from_path(path)) {
     case MeshFormat::obj:
-      soup = read_with(detail::read_obj, path, "obj", out);
+      soup = read_with(detail::read_obj, path, "obj", out, chunks);
       break;
     case MeshFormat::stl:
-      soup = read_with(detail::read_stl, path, "stl", out);
+      soup = read_with(detail::read_stl, path, "stl", out, chunks);
       break;
     case MeshFormat::ply:
-      soup = read_with(detail::read_ply, path, "ply", out);
+      soup = read_with(detail::read_ply, path, "ply", out, chunks);
       break;
     case MeshFormat::off:
-      soup = read_with(detail::read_off, path, "off", out);
+      soup = read_with(detail::read_off, path, "off", out, chunks);
       break;
     case MeshFormat::gltf:
     case MeshFormat::glb:
@@ -304,37 +307,19 @@ TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report,
   return soup;
 }
 
+}  // namespace
+
+TriangleSoup read_mesh(const std::filesystem::path& path, ReadReport* report,
+                       const TessellationOptions& tessellation) {
+  return read_mesh_file(path, report, tessellation, nullptr);
+}
+
 TriangleSoup read_mesh_in_chunks(const std::filesystem::path& path, ReadReport* report,
                                  const SoupChunks& chunks, const TessellationOptions& tessellation) {
-  const auto start = std::chrono::steady_clock::now();
-  ReadReport local;
-  ReadReport& out = report != nullptr ? *report : local;
-  out = ReadReport{};
-  out.path = path.string();
-  TriangleSoup parts;
-  switch (mesh_format_from_path(path)) {
-    case MeshFormat::obj:
-      parts = read_with(detail::read_obj, path, "obj", out, &chunks);
-      break;
-    case MeshFormat::stl:
-      parts = read_with(detail::read_stl, path, "stl", out, &chunks);
-      break;
-    case MeshFormat::ply:
-      parts = read_with(detail::read_ply, path, "ply", out, &chunks);
-      break;
-    case MeshFormat::off:
-      parts = read_with(detail::read_off, path, "off", out, &chunks);
-      break;
-    default: {
-      TriangleSoup whole = read_mesh(path, &out, tessellation);
-      parts.part_names = std::move(whole.part_names);
-      parts.part_paths = std::move(whole.part_paths);
-      chunks.take(std::move(whole));
-      return parts;
-    }
-  }
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return parts;
+  TriangleSoup soup = read_mesh_file(path, report, tessellation, &chunks);
+  // Read whole (the formats of other libraries): handed over as one chunk.
+  if (soup.triangle_count() > 0) return detail::hand_over_whole(std::move(soup), chunks);
+  return soup;
 }
 
 void load_readers_for(std::span<const std::filesystem::path> inputs) {

@@ -781,12 +781,7 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chu
                 parts.known() ? PlyPass::geometry : PlyPass::whole);
   if (!parts.known()) parts.apply(faces);
   if (chunks == nullptr || in_chunks != nullptr) return soup.finish();
-  TriangleSoup whole = soup.finish();
-  TriangleSoup names;
-  names.part_names = std::move(whole.part_names);
-  names.part_paths = std::move(whole.part_paths);
-  chunks->take(std::move(whole));
-  return names;
+  return hand_over_whole(soup.finish(), *chunks);
 }
 
 }  // namespace tetrapage::detail

@@ -168,6 +168,15 @@ class SoupBuilder {
   std::vector<std::pair<std::uint32_t, std::uint32_t>> chunk_map_;
 };
 
+/// Hands a soup read whole to `chunks` as one chunk; returns its parts alone.
+inline TriangleSoup hand_over_whole(TriangleSoup&& whole, const SoupChunks& chunks) {
+  TriangleSoup parts;
+  parts.part_names = std::move(whole.part_names);
+  parts.part_paths = std::move(whole.part_paths);
+  chunks.take(std::move(whole));
+  return parts;
+}
+
 /// Whitespace-separated tokens of a text file, with the line they came from; a token never
 /// spans lines. `comment` (if not '\0') starts a comment that runs to the end of the line.
 class TokenReader {

@@ -1,43 +1,14 @@
 #include "tetrapage/formats/SurfaceComponents.h"
 
 #include <algorithm>
-#include <bit>
 #include <numeric>
 
 #include "tetrapage/formats/EdgeParity.h"
+#include "tetrapage/formats/PositionBits.h"
+#include "tetrapage/formats/UnionFind.h"
 
 namespace tetrapage {
 namespace {
-
-// Bits of a coordinate, -0.0 read as 0.0.
-std::uint64_t bits_of(double x) { return std::bit_cast<std::uint64_t>(x == 0.0 ? 0.0 : x); }
-
-std::uint64_t mix(std::uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
-class UnionFind {
- public:
-  std::uint32_t add() {
-    parent_.push_back(std::uint32_t(parent_.size()));
-    return parent_.back();
-  }
-  std::uint32_t find(std::uint32_t x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-    return x;
-  }
-  void unite(std::uint32_t a, std::uint32_t b) {
-    a = find(a), b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<std::uint32_t> parent_;
-};
 
 // The distinct positions a soup is expected to hold: about one per vertex entry in an indexed
 // soup, about one per six in a soup whose triangles share no entries (an STL).
@@ -69,7 +40,7 @@ class PositionNodes {
   std::uint32_t node(std::uint32_t v, std::uint32_t part, UnionFind& sets) {
     if (part_of_vertex_[v] == part) return node_of_vertex_[v];  // indexed soups share vertices
     const Vec3& p = soup_.vertices[v];
-    const std::array<std::uint64_t, 3> key{bits_of(p[0]), bits_of(p[1]), bits_of(p[2])};
+    const std::array<std::uint64_t, 3> key{coordinate_bits(p[0]), coordinate_bits(p[1]), coordinate_bits(p[2])};
     std::uint32_t found = kEmpty;
     for (std::size_t slot = hash(key, part) & (slots_.size() - 1);; slot = (slot + 1) & (slots_.size() - 1)) {
       const std::uint32_t entry = slots_[slot];
@@ -82,7 +53,7 @@ class PositionNodes {
       }
       const Entry& e = entries_[entry];
       const Vec3& q = soup_.vertices[e.vertex];
-      if (e.part == part && bits_of(q[0]) == key[0] && bits_of(q[1]) == key[1] && bits_of(q[2]) == key[2]) {
+      if (e.part == part && coordinate_bits(q[0]) == key[0] && coordinate_bits(q[1]) == key[1] && coordinate_bits(q[2]) == key[2]) {
         found = e.node;
         break;
       }
@@ -99,13 +70,13 @@ class PositionNodes {
     std::uint32_t vertex, part, node;
   };
   static std::uint64_t hash(const std::array<std::uint64_t, 3>& key, std::uint32_t part) {
-    return mix(mix(mix(key[0] ^ part) + key[1]) + key[2]);
+    return mix_bits(mix_bits(mix_bits(key[0] ^ part) + key[1]) + key[2]);
   }
   void grow() {
     std::vector<std::uint32_t> slots(2 * slots_.size(), kEmpty);
     for (std::uint32_t i = 0; i < entries_.size(); ++i) {
       const Vec3& q = soup_.vertices[entries_[i].vertex];
-      std::size_t slot = hash({bits_of(q[0]), bits_of(q[1]), bits_of(q[2])}, entries_[i].part) & (slots.size() - 1);
+      std::size_t slot = hash({coordinate_bits(q[0]), coordinate_bits(q[1]), coordinate_bits(q[2])}, entries_[i].part) & (slots.size() - 1);
       while (slots[slot] != kEmpty) slot = (slot + 1) & (slots.size() - 1);
       slots[slot] = i;
     }

@@ -1,12 +1,11 @@
 #include "tetrapage/preprocess/ChunkedComponents.h"
 
 #include <algorithm>
-#include <bit>
-#include <numeric>
 #include <string>
 
 #include "SpillPath.h"
 #include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/PositionBits.h"
 
 namespace tetrapage {
 namespace {
@@ -16,19 +15,9 @@ constexpr std::uint64_t kMostBuckets = 256;
 constexpr std::uint64_t kSplitBuckets = 16;
 constexpr unsigned kMostSplits = 3;
 
-std::uint64_t bits_of(double x) { return std::bit_cast<std::uint64_t>(x == 0.0 ? 0.0 : x); }
-
-std::uint64_t mix(std::uint64_t x) {
-  x ^= x >> 30;
-  x *= 0xbf58476d1ce4e5b9ULL;
-  x ^= x >> 27;
-  x *= 0x94d049bb133111ebULL;
-  return x ^ (x >> 31);
-}
-
 template <class Record>
 std::uint64_t hash_of(const Record& r, unsigned depth) {
-  return mix(mix(mix(r.bits[0] ^ (std::uint64_t(r.part) << 32) ^ depth) + r.bits[1]) + r.bits[2]);
+  return mix_bits(mix_bits(mix_bits(r.bits[0] ^ (std::uint64_t(r.part) << 32) ^ depth) + r.bits[1]) + r.bits[2]);
 }
 
 template <class Record>
@@ -42,16 +31,6 @@ bool place_before(const Record& a, const Record& b) {
   for (int k = 0; k < 3; ++k)
     if (a.bits[k] != b.bits[k]) return a.bits[k] < b.bits[k];
   return a.part < b.part;
-}
-
-std::uint32_t find(std::vector<std::uint32_t>& parent, std::uint32_t x) {
-  while (parent[x] != x) x = parent[x] = parent[parent[x]];
-  return x;
-}
-
-void unite_labels(std::vector<std::uint32_t>& parent, std::uint32_t a, std::uint32_t b) {
-  a = find(parent, a), b = find(parent, b);
-  if (a != b) parent[std::max(a, b)] = std::min(a, b);
 }
 
 }  // namespace
@@ -71,19 +50,20 @@ ChunkedComponents::ChunkedComponents(const std::filesystem::path& spill_folder,
 }
 
 std::uint64_t ChunkedComponents::label_bytes() const {
-  return parent_.capacity() * sizeof(std::uint32_t) + parent_.size() * sizeof(std::uint32_t);
+  // The parents, and a component number each once united.
+  return sets_.bytes() + sets_.size() * sizeof(std::uint32_t);
 }
 
 void ChunkedComponents::add_chunk(TriangleSoup& chunk, std::uint64_t first_triangle) {
   SurfaceComponents found = find_surface_components(chunk);
-  const auto first_label = std::uint32_t(parent_.size());
-  if (parent_.size() + found.components.size() >= 0xfffffffeu)
+  const auto first_label = std::uint32_t(sets_.size());
+  if (sets_.size() + found.components.size() >= 0xfffffffeu)
     throw InputError("the file holds more than 2^32 - 2 pieces of connected components");
   std::vector<LabelRecord> records(found.components.size());
   for (std::size_t c = 0; c < found.components.size(); ++c) {
     found.components[c].first_triangle += first_triangle;
     records[c] = {found.components[c], found.parities[c]};
-    parent_.push_back(std::uint32_t(parent_.size()));
+    sets_.add();
   }
   labels_.append(std::span<const LabelRecord>(records));
   note_positions(chunk, found.component_of, first_label);
@@ -108,7 +88,7 @@ void ChunkedComponents::note_positions(const TriangleSoup& chunk,
       if (noted_part_[v] == part) continue;
       noted_part_[v] = part;
       const Vec3& p = chunk.vertices[v];
-      records.push_back({{bits_of(p[0]), bits_of(p[1]), bits_of(p[2])}, part,
+      records.push_back({{coordinate_bits(p[0]), coordinate_bits(p[1]), coordinate_bits(p[2])}, part,
                          first_label + component_of[t]});
     }
   }
@@ -149,7 +129,7 @@ void ChunkedComponents::unite_bucket(RecordSpill<PositionRecord>& bucket, unsign
   bucket.clear();
   std::sort(records.begin(), records.end(), place_before<PositionRecord>);
   for (std::size_t i = 1; i < records.size(); ++i)
-    if (same_place(records[i - 1], records[i])) unite_labels(parent_, records[i - 1].label, records[i].label);
+    if (same_place(records[i - 1], records[i])) sets_.unite(records[i - 1].label, records[i].label);
 }
 
 ChunkedComponents::United ChunkedComponents::unite(std::uint64_t most_components,
@@ -166,12 +146,12 @@ ChunkedComponents::United ChunkedComponents::unite(std::uint64_t most_components
   // records are read back in that order.
   constexpr std::uint32_t kNone = 0xffffffffu;
   United united;
-  united.component_of_label.assign(parent_.size(), kNone);
+  united.component_of_label.assign(sets_.size(), kNone);
   std::vector<EdgeParity> parity;
   std::uint32_t label = 0;
   labels_.for_each_block(1 << 12, [&](std::span<const LabelRecord> block) {
     for (const LabelRecord& record : block) {
-      const std::uint32_t root = find(parent_, label);
+      const std::uint32_t root = sets_.find(label);
       std::uint32_t& component = united.component_of_label[root];
       if (component == kNone) {
         if (united.components.size() >= most_components) throw InputError(refusal);
@@ -188,7 +168,7 @@ ChunkedComponents::United ChunkedComponents::unite(std::uint64_t most_components
     }
   });
   for (std::size_t c = 0; c < parity.size(); ++c) united.components[c].closed = parity[c].closed();
-  std::vector<std::uint32_t>().swap(parent_);
+  sets_ = UnionFind();
   labels_.clear();
   return united;
 }

@@ -145,10 +145,6 @@ StreamPlan plan_stream(const MeshReadEstimate& read, std::uint64_t room) {
   return {fixed + std::min(read.vertex_table_bytes, held * per_vertex), held};
 }
 
-// A mesh file in a format read in chunks (MeshReadEstimate::chunked), however many times it is
-// placed (read once per copy: a file that fits is read once and its copies placed in batches).
-bool can_stream(const InputPiece&, const PieceEstimate& estimate) { return estimate.read.chunked; }
-
 PieceEstimate estimate_piece(const InputPiece& piece) {
   PieceEstimate estimate;
   estimate.read = estimate_mesh_read(piece.file());
@@ -263,7 +259,9 @@ std::vector<std::uint64_t> check_read_room(const std::vector<InputPiece>& jobs,
     const std::uint64_t held = beside(memory);
     const std::uint64_t total = memory + kPreprocessInputAllowance;
     rooms[j] = total > held ? total - held : 0;
-    const bool streams = can_stream(jobs[j], estimates[j]);
+    // A file in a format read in chunks, however many times it is placed (read once per copy;
+    // a file that fits is read once and its copies placed in batches).
+    const bool streams = estimates[j].read.chunked;
     if (estimates[j].bytes <= rooms[j] && !(options.force_spill && streams)) continue;
     const StreamPlan plan = streams ? plan_stream(estimates[j].read, rooms[j]) : StreamPlan{};
     const std::uint64_t bytes = streams ? plan.bytes : estimates[j].bytes;
@@ -450,8 +448,7 @@ class StreamedReading {
 
   void take(TriangleSoup&& chunk) {
     if (placement_) placement_->place(chunk);
-    if (chunk.triangle_count() == 0) return;
-    check_coordinate_magnitudes(chunk, piece_);
+    if (chunk.triangle_count() == 0) return;  // its vertices were checked as they were read
     for (std::uint32_t& part : chunk.part_of) {
       part += part_base_;
       if (part >= file_->part_triangles.size()) file_->part_triangles.resize(part + 1, 0);

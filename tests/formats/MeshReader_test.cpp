@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "TestSupport.h"
@@ -995,6 +996,62 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
   }
   for (const auto& entry : std::filesystem::directory_iterator(folder))
     EXPECT_EQ(entry.path().filename().string().find(".tetrapage-vertices"), std::string::npos);
+}
+
+// Debian's assimp-testmodels in the formats our readers read (binary and ASCII, float and
+// double, polygons, files our readers refuse): read in chunks of 7 with the vertex table past
+// 50 vertices on disk, each succeeds or fails as its whole read does, with the same triangles,
+// parts and part names.
+TEST(MeshReader, ForeignFilesReadInChunksAsWhole) {
+  const std::filesystem::path models = "/usr/share/assimp/models";
+  ASSERT_TRUE(std::filesystem::exists(models)) << "assimp-testmodels (make deps) holds them";
+  const auto folder = scratch_folder("chunks_foreign");
+  int read = 0, refused = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(models)) {
+    std::string extension = entry.path().extension().string();
+    for (char& c : extension) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (!entry.is_regular_file() ||
+        (extension != ".ply" && extension != ".stl" && extension != ".obj" && extension != ".off"))
+      continue;
+    SCOPED_TRACE(entry.path().string());
+    std::optional<TriangleSoup> whole;
+    try {
+      whole = read_mesh(entry.path());
+    } catch (const Error&) {
+    }
+    std::vector<std::array<Vec3, 3>> corners;
+    std::vector<std::uint32_t> part_of;
+    SoupChunks chunks;
+    chunks.triangles = 7;
+    chunks.held_vertices = 50;
+    chunks.vertex_folder = folder;
+    chunks.take = [&](TriangleSoup&& chunk) {
+      for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
+        corners.push_back(chunk.corners(t));
+        part_of.push_back(chunk.part_of[t]);
+      }
+    };
+    std::optional<TriangleSoup> names;
+    try {
+      names = read_mesh_in_chunks(entry.path(), nullptr, chunks);
+    } catch (const Error&) {
+    }
+    ASSERT_EQ(whole.has_value(), names.has_value());
+    if (!whole) {
+      ++refused;
+      continue;
+    }
+    ++read;
+    ASSERT_EQ(corners.size(), whole->triangle_count());
+    for (std::size_t t = 0; t < corners.size(); ++t) {
+      ASSERT_EQ(corners[t], whole->corners(t)) << "triangle " << t;
+      ASSERT_EQ(part_of[t], whole->part_of[t]) << "triangle " << t;
+    }
+    EXPECT_EQ(names->part_names, whole->part_names);
+    EXPECT_EQ(names->part_paths, whole->part_paths);
+  }
+  EXPECT_GT(read, 25);
+  std::printf("%d foreign files read alike in chunks, %d refused by both\n", read, refused);
 }
 
 // A file whose triangles are all degenerate is refused in chunks as it is whole.

@@ -14,6 +14,7 @@
 #include "tetrapage/formats/EdgeParity.h"
 #include "tetrapage/formats/SurfaceComponents.h"
 #include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/UnionFind.h"
 #include "tetrapage/preprocess/RecordSpill.h"
 
 namespace tetrapage {
@@ -33,7 +34,7 @@ class ChunkedComponents {
   /// @throw IoError when a bucket cannot be written.
   void add_chunk(TriangleSoup& chunk, std::uint64_t first_triangle);
 
-  std::uint64_t label_count() const { return parent_.size(); }
+  std::uint64_t label_count() const { return sets_.size(); }
   /// The bytes the labels take in memory: a parent each while they are found, and a component
   /// each once united (a chunk of a file whose triangles come in no spatial order holds many
   /// pieces of one component; their records wait on disk).
@@ -72,7 +73,7 @@ class ChunkedComponents {
   std::uint64_t bucket_bytes_;
   std::vector<RecordSpill<PositionRecord>> buckets_;
   RecordSpill<LabelRecord> labels_;
-  std::vector<std::uint32_t> parent_;  // the labels' union-find
+  UnionFind sets_;  // of the labels
   // A chunk's positions, grouped by bucket, and what sorts them out (kept across chunks).
   std::vector<PositionRecord> chunk_positions_, grouped_;
   std::vector<std::uint32_t> bucket_of_, noted_part_;
