@@ -295,6 +295,13 @@ void prepare_child(int write_fd, pid_t parent, std::uint64_t address_space) {
     ::signal(signal_number, SIG_DFL);
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(4);  // the caller died before prctl
+  // The child inherits the caller's unwritten stdout buffer, and OCCT writes to stdout: the
+  // caller's pending lines came out twice (`mesh info a.step b.step | cat`). The child answers
+  // through its pipe alone.
+  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
+    ::dup2(null, STDOUT_FILENO);
+    ::close(null);
+  }
   if (write_fd > 3) ::close_range(3, unsigned(write_fd) - 1, 0);
   ::close_range(unsigned(write_fd) + 1, ~0U, 0);
   if (address_space != 0 && memory_limit_applies()) {

@@ -768,6 +768,17 @@ PieceLoader::PieceLoader(const InputPiece& piece, const TessellationOptions& tes
   impl_->scale = part_unit_scale(placed.part(), placed.owner().units, impl_->report.length_unit);
 }
 
+PieceLoader::PieceLoader(const InputPiece& piece, TriangleSoup source, const ReadReport& report)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->piece = piece;
+  impl_->report = report;
+  impl_->source = std::move(source);
+  if (!piece.manifest) return;
+  const PlacedEntry placed(*piece.manifest, piece.entries);
+  impl_->copies = placed.count();
+  impl_->scale = part_unit_scale(placed.part(), placed.owner().units, report.length_unit);
+}
+
 PieceLoader::~PieceLoader() = default;
 PieceLoader::PieceLoader(PieceLoader&&) noexcept = default;
 PieceLoader& PieceLoader::operator=(PieceLoader&&) noexcept = default;
@@ -820,19 +831,21 @@ ReadReport PieceLoader::report() const {
 }
 
 struct PlacedChunks::Impl {
-  Impl(const InputPiece& piece, std::size_t copy)
+  Impl(const InputPiece& piece, std::size_t copy, const std::string& file_unit)
       : placed(*piece.manifest, piece.entries),
-        placement(placed, copy, part_unit_scale(placed.part(), placed.owner().units, "")) {}
+        scale(part_unit_scale(placed.part(), placed.owner().units, file_unit)),
+        placement(placed, copy, scale) {}
   PlacedEntry placed;
+  double scale;
   Placement placement;
   BoundingBox box;
   std::uint64_t dropped = 0;
 };
 
-PlacedChunks::PlacedChunks(const InputPiece& piece, std::size_t copy) {
+PlacedChunks::PlacedChunks(const InputPiece& piece, std::size_t copy, const std::string& file_unit) {
   if (!piece.manifest || copy >= piece.copies())
     throw InputError(piece.input.string() + ": no placement " + std::to_string(copy) + " to place");
-  impl_ = std::make_unique<Impl>(piece, copy);
+  impl_ = std::make_unique<Impl>(piece, copy, file_unit);
 }
 PlacedChunks::~PlacedChunks() = default;
 
@@ -864,6 +877,10 @@ TriangleSoup PlacedChunks::finish(const TriangleSoup& file_parts) {
 }
 
 std::uint64_t PlacedChunks::dropped() const { return impl_->dropped; }
+
+double PlacedChunks::largest_scale() const {
+  return impl_->scale * largest_stretch(impl_->placement.transform);
+}
 
 TriangleSoup load_input_piece(const InputPiece& piece, std::vector<ReadReport>* reports,
                               const TessellationOptions& tessellation) {

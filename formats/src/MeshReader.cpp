@@ -15,6 +15,7 @@
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/Manifest.h"
 #include "CadModule.h"
+#include "tetrapage/formats/TessellatedFile.h"
 #include "ReaderSupport.h"
 
 namespace tetrapage {
@@ -219,7 +220,6 @@ bool header_counts(const std::filesystem::path& path, MeshFormat format, MeshRea
     }
     out.vertices = counts.vertices;
     out.triangles = counts.triangles;
-    out.chunked = counts.vertices_first;
     // Arrays reserved from the counts; polygons grow the triangles' (old and new while
     // growing), else the degenerate filter's shrink copies them.
     out.reading_bytes = out.soup_bytes() + (counts.triangles > counts.faces ? 16 : 12) * counts.triangles;
@@ -255,7 +255,7 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
   out.reading_bytes += kReadBlockBytes;
   if (format == MeshFormat::obj || format == MeshFormat::stl || format == MeshFormat::ply ||
       format == MeshFormat::off) {
-    if (!out.counted) out.chunked = true;  // an OBJ or an ASCII STL
+    out.chunked = true;
     // The vertex table (an STL's: a chunk's), reserved from a header's count, else grown.
     const std::uint64_t table = format == MeshFormat::stl ? 0 : 24 * out.vertices;
     out.chunked_bytes = kReadBlockBytes;
@@ -301,7 +301,9 @@ TriangleSoup read_mesh_file(const std::filesystem::path& path, ReadReport* repor
       break;
     case MeshFormat::step:
     case MeshFormat::iges:
-      return read_cad(path, tessellation, &out);
+      if (chunks == nullptr) return read_cad(path, tessellation, &out);
+      soup = TessellatedFile(path, tessellation, out).place_in_chunks(*chunks, out);
+      break;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return soup;

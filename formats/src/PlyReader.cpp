@@ -310,9 +310,14 @@ class PlyPartTable {
   std::uint64_t part_end_ = 0;  ///< known: the face that ends the current part
 };
 
-// What a pass over a PLY file reads: everything; the part table alone (before the faces, when
-// the faces go out in chunks and need their parts as they are read); everything but the table.
-enum class PlyPass { whole, table, geometry };
+// What a pass over a PLY file reads of its vertices, faces and part table: everything; the part
+// table alone (before the faces, when the faces go out in chunks and need their parts as they
+// are read); the vertices alone (before the faces, when they come after them and the faces go
+// out in chunks); the rest.
+struct PlyPass {
+  bool vertices = true, faces = true, table = true;
+};
+constexpr PlyPass kWholePass{}, kTablePass{false, false, true}, kVerticesPass{true, false, false};
 
 PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
   PlyLayout layout;
@@ -367,17 +372,16 @@ PlyLayout find_layout(const InputFile& file, const PlyHeader& header) {
 class BinaryPlyReader {
  public:
   BinaryPlyReader(InputFile& file, bool big_endian, SoupBuilder& soup, const PlyLayout& layout,
-                  PlyPartTable& parts, PlyPass pass = PlyPass::whole)
+                  PlyPartTable& parts, PlyPass pass = kWholePass)
       : file_(file), big_endian_(big_endian), soup_(soup), layout_(layout), parts_(parts),
         pass_(pass) {}
 
   void read_element(const PlyElement& element) {
-    const bool geometry = pass_ != PlyPass::table, table = pass_ != PlyPass::geometry;
-    if (&element == layout_.vertex && geometry) {
+    if (&element == layout_.vertex && pass_.vertices) {
       read_vertices(element);
-    } else if (&element == layout_.face && geometry) {
+    } else if (&element == layout_.face && pass_.faces) {
       read_faces(element);
-    } else if (&element == layout_.parts && table) {
+    } else if (&element == layout_.parts && pass_.table) {
       read_parts(element);
     } else {
       skip(element);
@@ -559,17 +563,16 @@ class BinaryPlyReader {
 class AsciiPlyReader {
  public:
   AsciiPlyReader(InputFile& file, SoupBuilder& soup, const PlyLayout& layout, PlyPartTable& parts,
-                 PlyPass pass = PlyPass::whole)
+                 PlyPass pass = kWholePass)
       : file_(file), tokens_(file), soup_(soup), layout_(layout), parts_(parts), pass_(pass) {}
 
   void read_element(const PlyElement& element) {
-    const bool geometry = pass_ != PlyPass::table;
-    if (&element == layout_.parts && pass_ != PlyPass::geometry) return read_parts(element);
+    if (&element == layout_.parts && pass_.table) return read_parts(element);
     if (element.properties.empty()) return;  // records of nothing, however many
     // Elements not read are tokenised all the same, record by record (an ASCII file has no
     // other way past them).
-    const bool is_vertex = geometry && &element == layout_.vertex;
-    const bool is_face = geometry && &element == layout_.face;
+    const bool is_vertex = pass_.vertices && &element == layout_.vertex;
+    const bool is_face = pass_.faces && &element == layout_.face;
     for (std::uint64_t r = 0; r < element.count; ++r) {
       Vec3 point{};
       for (std::size_t p = 0; p < element.properties.size(); ++p) {
@@ -717,7 +720,6 @@ MeshCounts read_ply_counts(InputFile& file) {
   counts.vertices = layout.vertex->count;
   counts.faces = layout.face != nullptr ? layout.face->count : 0;
   counts.triangles = counts.faces;
-  counts.vertices_first = vertices_first(layout);
   if (header.encoding == PlyEncoding::ascii || counts.faces == 0) return counts;
   // Binary: the bytes after the fixed-size elements before the faces bound the faces' corners,
   // hence their triangles (a face of k corners makes k - 2; polygons make more than a face).
@@ -751,37 +753,44 @@ void read_elements(InputFile& file, const PlyHeader& header, const PlyLayout& la
   }
 }
 
+// Reads the elements `pass` names in a pass of its own over the file (a second InputFile):
+// the part table, or the vertices, before the faces that need them when those go out in chunks.
+void read_elements_first(const InputFile& file, SoupBuilder& soup, PlyPartTable& parts,
+                         PlyPass pass) {
+  InputFile first(file.path());
+  const PlyHeader header = read_header(first);
+  const PlyLayout layout = find_layout(first, header);
+  read_elements(first, header, layout, soup, parts, pass);
+}
+
 }  // namespace
 
 TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chunks) {
   const PlyHeader header = read_header(file);
   const PlyLayout layout = find_layout(file, header);
   check_counts_fit(file, header);
-  // Faces before their vertices (PLY allows it) cannot be handed over as they are read: read
-  // whole, then handed over as one chunk (MeshReadEstimate::chunked says so up front).
-  const SoupChunks* in_chunks = vertices_first(layout) ? chunks : nullptr;
-  SoupBuilder soup(file.name(), report, in_chunks);
+  SoupBuilder soup(file.name(), report, chunks);
   if (layout.parts == nullptr) soup.begin_part(file.path().stem().string());
   PlyPartTable parts(file, soup, layout.parts != nullptr);
   const std::uint64_t faces = layout.face != nullptr ? layout.face->count : 0;
-  if (in_chunks != nullptr && layout.parts != nullptr) {
-    // The table follows the faces: read first, in a pass of its own over the file.
-    InputFile table_file(file.path());
-    const PlyHeader table_header = read_header(table_file);
-    const PlyLayout table_layout = find_layout(table_file, table_header);
-    read_elements(table_file, table_header, table_layout, soup, parts, PlyPass::table);
+  if (chunks != nullptr && layout.parts != nullptr) {
+    // The table follows the faces: read first.
+    read_elements_first(file, soup, parts, kTablePass);
     parts.check(faces);
     parts.know_parts();
   }
+  // Faces before their vertices (PLY allows it): the vertices read first when the faces go
+  // out in chunks.
+  const bool vertices_read_first = chunks != nullptr && !vertices_first(layout);
+  if (vertices_read_first) read_elements_first(file, soup, parts, kVerticesPass);
   soup.reserve(layout.vertex->count, faces, file.size());
   report.encoding = header.encoding == PlyEncoding::ascii               ? "ascii"
                     : header.encoding == PlyEncoding::binary_big_endian ? "binary_big_endian"
                                                                         : "binary_little_endian";
   read_elements(file, header, layout, soup, parts,
-                parts.known() ? PlyPass::geometry : PlyPass::whole);
+                PlyPass{!vertices_read_first, true, !parts.known()});
   if (!parts.known()) parts.apply(faces);
-  if (chunks == nullptr || in_chunks != nullptr) return soup.finish();
-  return hand_over_whole(soup.finish(), *chunks);
+  return soup.finish();
 }
 
 }  // namespace tetrapage::detail

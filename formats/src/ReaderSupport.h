@@ -230,8 +230,6 @@ constexpr std::uint64_t max_vertices = std::numeric_limits<std::uint32_t>::max()
 /// shows more: a binary PLY's face bytes bound its corners).
 struct MeshCounts {
   std::uint64_t vertices = 0, faces = 0, triangles = 0;
-  /// The vertices come before the faces (PLY allows either order; faces first are read whole).
-  bool vertices_first = true;
 };
 /// @throw FormatError, InputError as read_ply and read_off do for the same header.
 MeshCounts read_ply_counts(InputFile& file);

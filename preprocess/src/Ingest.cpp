@@ -22,6 +22,7 @@
 #include "tetrapage/formats/Pose.h"
 #include "tetrapage/formats/Progress.h"
 #include "tetrapage/formats/QuotedInput.h"
+#include "tetrapage/formats/TessellatedFile.h"
 
 namespace tetrapage {
 namespace {
@@ -241,7 +242,7 @@ std::uint64_t memory_admitting(std::uint64_t bytes, std::uint64_t memory, Beside
 
 // Up front, before any file is read: every piece whose estimate exceeds the room the budget
 // leaves it is read in chunks where it can be and fits so, else refused with the figure (STEP
-// and IGES once tessellated: load_soup). Returns each piece's room.
+// and IGES once tessellated: load_tessellated). Returns each piece's room.
 std::vector<std::uint64_t> check_read_room(const std::vector<InputPiece>& jobs,
                                            std::vector<PieceEstimate>& estimates,
                                            const PreprocessOptions& options, std::size_t threads) {
@@ -291,29 +292,6 @@ std::uint64_t copy_working_bytes(const TriangleSoup& source) {
 // placed copies: a sixteenth, split between the batches placed at once.
 std::uint64_t batch_bytes(const PreprocessOptions& options, std::size_t threads) {
   return std::max<std::uint64_t>(options.memory_bytes / 16 / (threads + 1), 1);
-}
-
-// A STEP or IGES file's triangles are known once tessellated: refused then, before they are
-// placed (in the reading child), when they need more than `room`.
-TessellationOptions tessellation_within(const InputPiece& piece, const PreprocessOptions& options,
-                                        std::uint64_t room) {
-  TessellationOptions tessellation = options.tessellation;
-  const std::uint64_t memory = options.memory_bytes;
-  const std::uint64_t held = memory + kPreprocessInputAllowance - std::min(room, memory + kPreprocessInputAllowance);
-  tessellation.before_placing = [file = piece.file(), copies = piece.copies(),
-                                 manifest = piece.manifest != nullptr, room, held,
-                                 memory](std::uint64_t vertices, std::uint64_t triangles) {
-    MeshReadEstimate read;
-    read.cad = read.counted = true;
-    read.vertices = vertices;
-    read.triangles = triangles;
-    read.reading_bytes = read.soup_bytes();
-    const std::uint64_t bytes = piece_bytes(read, copies, manifest);
-    if (bytes <= room) return;
-    refuse_reading(file, read, bytes, held,
-                   memory_admitting(bytes, memory, [held](std::uint64_t) { return held; }), memory);
-  };
-  return tessellation;
 }
 
 // The tables cannot spill: a model whose tables alone exceed the budget is refused (a tetras
@@ -380,10 +358,16 @@ void check_disk_room(const DiskRoom& room, double triangles, double soup_bytes,
 // labels united at the end. Copies are parts of their own: no component spans two.
 class StreamedReading {
  public:
+  // `tessellated`: the piece's STEP or IGES file, read already (its report `tessellated_report`),
+  // whose instances are placed in chunks; null for a mesh file, read in chunks once per copy.
   StreamedReading(const InputPiece& piece, const PieceEstimate& estimate,
-                  const PreprocessOptions& options, const std::filesystem::path& spill_folder)
+                  const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                  const TessellatedFile* tessellated = nullptr,
+                  const ReadReport& tessellated_report = {})
       : piece_(piece),
         options_(options),
+        tessellated_(tessellated),
+        tessellated_report_(tessellated_report),
         copies_(piece.manifest ? piece.copies() : 1),
         name_("streamed-" + std::to_string(next_name_++)),
         file_(std::make_unique<StreamedFile>(spill_folder, name_)),
@@ -411,6 +395,7 @@ class StreamedReading {
 
   std::unique_ptr<StreamedFile> read(ReadReport& report) {
     for (std::size_t copy = 0; copy < copies_; ++copy) read_copy(copy, report);
+    report.tessellation_deflection = largest_deflection_;
     progress_.finish();
     file_->part_triangles.resize(std::max<std::size_t>(file_->parts.part_count(), 1), 0);
     // The components' table cannot spill: past the budget, refused as the model's would be.
@@ -431,14 +416,19 @@ class StreamedReading {
     return read.vertices <= 2 * read.triangles ? read.vertices : read.vertices / 6;
   }
 
-  // The file's report once (its first reading), and every copy's flattened triangles.
+  // The file's report once (its first reading), every copy's flattened triangles, and the
+  // tessellation's deflection over every copy (in the top manifest's unit).
   void read_copy(std::size_t copy, ReadReport& report) {
-    if (piece_.manifest) placement_.emplace(piece_, copy);
+    if (piece_.manifest)
+      placement_.emplace(piece_, copy, tessellated_ ? tessellated_report_.length_unit : std::string());
     part_base_ = std::uint32_t(file_->parts.part_count());
-    ReadReport reading;
+    ReadReport reading = tessellated_report_;
     const TriangleSoup file_parts =
-        read_mesh_in_chunks(piece_.file(), &reading, chunks_, options_.tessellation);
+        tessellated_ ? tessellated_->place_in_chunks(chunks_, reading)
+                     : read_mesh_in_chunks(piece_.file(), &reading, chunks_, options_.tessellation);
     if (copy == 0) report = reading;
+    largest_deflection_ = std::max(largest_deflection_, reading.tessellation_deflection *
+                                                            (placement_ ? placement_->largest_scale() : 1.0));
     const TriangleSoup parts = placement_ ? placement_->finish(file_parts) : file_parts;
     if (placement_) report.degenerate_dropped += placement_->dropped();
     for (std::size_t p = 0; p < parts.part_count(); ++p)
@@ -491,6 +481,9 @@ class StreamedReading {
 
   const InputPiece& piece_;
   const PreprocessOptions& options_;
+  const TessellatedFile* tessellated_;
+  ReadReport tessellated_report_;
+  double largest_deflection_ = 0;
   std::size_t copies_;
   std::string name_;  // of its spill files
   std::unique_ptr<StreamedFile> file_;
@@ -502,22 +495,31 @@ class StreamedReading {
   std::uint32_t part_base_ = 0;            // its first part
 };
 
-LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
-                     const PreprocessOptions& options, const std::filesystem::path& spill_folder,
-                     const DiskRoom& disk, std::size_t threads, std::uint64_t room) {
+// Reads a piece in chunks (estimate.streamed): a mesh file once per copy, or the instances of a
+// STEP or IGES file read already (`tessellated`, with its report) placed a chunk at a time.
+LoadedSoup load_streamed(const InputPiece& piece, const PieceEstimate& estimate,
+                         const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                         const DiskRoom& disk, const TessellatedFile* tessellated = nullptr,
+                         const ReadReport& tessellated_report = {}) {
+  // Before it is read, by its estimate alone: its chunks spill twice (its own spill, then the
+  // model's), and the whole model is weighed again once it is read (append_piece).
+  const double copies = double(piece.copies());
+  check_disk_room(disk, copies * double(estimate.read.triangles),
+                  2.0 * copies * double(estimate.read.soup_bytes()), options);
   LoadedSoup loaded;
-  if (estimate.streamed) {
-    // Before it is read, by its estimate alone: its chunks spill twice (its own spill, then the
-    // model's), and the whole model is weighed again once it is read (append_piece).
-    const double copies = double(piece.copies());
-    check_disk_room(disk, copies * double(estimate.read.triangles),
-                    2.0 * copies * double(estimate.read.soup_bytes()), options);
-    loaded.file = piece.input.string();
-    loaded.streamed = StreamedReading(piece, estimate, options, spill_folder).read(loaded.report);
-    loaded.length_unit = piece.manifest ? piece.manifest->units : loaded.report.length_unit;
-    return loaded;
-  }
-  auto loader = std::make_unique<PieceLoader>(piece, tessellation_within(piece, options, room));
+  loaded.file = piece.input.string();
+  loaded.streamed = StreamedReading(piece, estimate, options, spill_folder, tessellated,
+                                    tessellated_report)
+                        .read(loaded.report);
+  loaded.length_unit = piece.manifest ? piece.manifest->units : loaded.report.length_unit;
+  return loaded;
+}
+
+// A piece whose file `loader` read: its copies left to be placed in batches when together they
+// exceed a batch, else placed whole with their components found.
+LoadedSoup load_placed(const InputPiece& piece, std::unique_ptr<PieceLoader> loader,
+                       const PreprocessOptions& options, std::size_t threads) {
+  LoadedSoup loaded;
   loaded.file = piece.input.string();
   loaded.length_unit = piece.manifest ? piece.manifest->units : loader->report().length_unit;
   const std::uint64_t whole = copy_working_bytes(loader->source()) * loader->copies();
@@ -534,6 +536,51 @@ LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
   loader.reset();  // the file's soup is not held beside its placed copy
   find_components(loaded, piece);
   return loaded;
+}
+
+// A STEP or IGES file's triangles are known once it is tessellated: its distinct shapes held,
+// its instances are placed whole when that fits `room` (the file's placed soup beside the
+// shapes, then its components), else a chunk at a time when the shapes fit, else refused with
+// the figure.
+LoadedSoup load_tessellated(const InputPiece& piece, PieceEstimate estimate,
+                            const PreprocessOptions& options,
+                            const std::filesystem::path& spill_folder, const DiskRoom& disk,
+                            std::size_t threads, std::uint64_t room) {
+  ReadReport report;
+  auto tessellated = std::make_unique<TessellatedFile>(piece.file(), options.tessellation, report);
+  MeshReadEstimate& read = estimate.read;
+  read.counted = true;
+  read.vertices = tessellated->placed_vertices();
+  read.triangles = tessellated->placed_triangles();
+  read.reading_bytes = read.soup_bytes() + tessellated->held_bytes();
+  estimate.bytes = piece_bytes(read, piece.copies(), piece.manifest != nullptr);
+  if (estimate.bytes <= room && !options.force_spill) {
+    TriangleSoup soup = tessellated->place(report);
+    tessellated.reset();  // its shapes are not held beside the placed soup's components
+    return load_placed(piece, std::make_unique<PieceLoader>(piece, std::move(soup), report),
+                       options, threads);
+  }
+  read.chunked_bytes = tessellated->held_bytes();
+  read.vertex_table_bytes = 0;
+  const std::uint64_t bytes = plan_stream(read, room).bytes;
+  if (bytes > room) {
+    const std::uint64_t memory = options.memory_bytes, total = memory + kPreprocessInputAllowance;
+    const std::uint64_t held = total - std::min(room, total);
+    refuse_reading(piece.file(), read, bytes, held,
+                   memory_admitting(bytes, memory, [held](std::uint64_t) { return held; }), memory);
+  }
+  estimate.streamed = true;
+  return load_streamed(piece, estimate, options, spill_folder, disk, tessellated.get(), report);
+}
+
+LoadedSoup load_soup(const InputPiece& piece, const PieceEstimate& estimate,
+                     const PreprocessOptions& options, const std::filesystem::path& spill_folder,
+                     const DiskRoom& disk, std::size_t threads, std::uint64_t room) {
+  if (estimate.read.cad)
+    return load_tessellated(piece, estimate, options, spill_folder, disk, threads, room);
+  if (estimate.streamed) return load_streamed(piece, estimate, options, spill_folder, disk);
+  return load_placed(piece, std::make_unique<PieceLoader>(piece, options.tessellation), options,
+                     threads);
 }
 
 // The model's unit is the one its inputs state; inputs that state different units cannot be

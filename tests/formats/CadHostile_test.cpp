@@ -197,6 +197,26 @@ TEST(CadHostile, AChainOfFiveThousandSubAssembliesIsRefused) {
   EXPECT_FALSE(std::filesystem::exists(folder / "model.tpi"));
 }
 
+// The reading child inherits the command's unwritten stdout and OCCT writes to stdout: piped,
+// `mesh info` of three CAD files printed the first file's lines three times, the second's twice.
+TEST(CadHostile, TheReadingChildLeavesTheCommandsOutputAlone) {
+  const auto folder = fresh_folder("stdout");
+  const auto screw = kOcctData / "step" / "screw.step", bearing = kOcctData / "iges" / "bearing.iges";
+  if (!std::filesystem::exists(screw) || !std::filesystem::exists(bearing))
+    GTEST_SKIP() << "occt-misc not installed";
+  const test::CliResult result = test::run_cli_in(
+      folder, "mesh info " + screw.string() + " " + bearing.string() + " " + screw.string(), 120);
+  ASSERT_EQ(result.status, 0) << result.err;
+  const auto count = [&](const std::string& line) {
+    std::size_t found = 0;
+    for (std::size_t at = result.out.find(line); at != std::string::npos; at = result.out.find(line, at + 1))
+      ++found;
+    return found;
+  };
+  EXPECT_EQ(count(screw.string() + ": step,"), 2u) << result.out;
+  EXPECT_EQ(count(bearing.string() + ": iges,"), 1u) << result.out;
+}
+
 TEST(CadHostile, TooManyOccurrencesAreRefusedWithTheLimitToRaise) {
   const auto folder = fresh_folder("occurrences");
   std::vector<std::pair<int, int>> copies;

@@ -21,6 +21,7 @@
 #include <XCAFDoc_DocumentTool.hxx>
 #include <XCAFDoc_ShapeTool.hxx>
 #include <gp_Quaternion.hxx>
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -28,6 +29,7 @@
 
 #include "TestSupport.h"
 #include "tetrapage/formats/CadReader.h"
+#include "tetrapage/formats/MeshReader.h"
 
 namespace tetrapage {
 namespace {
@@ -230,6 +232,62 @@ TEST(CadReader, AnAssemblyGivesEveryInstanceWithItsNamePathAndPlacement) {
         got.insert({std::lround(c[0] * 1e6), std::lround(c[1] * 1e6), std::lround(c[2] * 1e6)});
     }
     EXPECT_EQ(got, expected) << soup.part_path(boxes[k]);
+  }
+}
+
+// The instances of a STEP or IGES file placed a chunk at a time (read_mesh_in_chunks, for an
+// assembly too large to hold placed) are the whole read's: the same corners, parts, paths and
+// report, every placed vertex given to on_vertex, no chunk larger than asked, and a chunk's
+// vertices only those its triangles use. OCCT's samples and the written rack (each instance of
+// a shape placed from the one tessellation), in chunks of 1, 7 and 1000.
+TEST(CadReader, InstancesPlacedInChunksAreTheWholeRead) {
+  const auto folder = test::scratch_folder("chunks");
+  std::vector<std::filesystem::path> files = {write_rack(folder, "MM").path,
+                                              write_rack(folder, "M").path};
+  for (const auto& sample : {kOcctData / "step" / "linkrods.step", kOcctData / "step" / "screw.step",
+                             kOcctData / "iges" / "bearing.iges"})
+    if (std::filesystem::exists(sample)) files.push_back(sample);
+  for (const auto& file : files) {
+    ReadReport whole_report;
+    const TriangleSoup whole = read_mesh(file, &whole_report);
+    for (const std::size_t size : {std::size_t(1), std::size_t(7), std::size_t(1000)}) {
+      SCOPED_TRACE(file.filename().string() + ", chunks of " + std::to_string(size));
+      std::vector<std::array<Vec3, 3>> corners;
+      std::vector<std::uint32_t> part_of;
+      std::vector<Vec3> noted;
+      SoupChunks chunks;
+      chunks.triangles = size;
+      chunks.on_vertex = [&](const Vec3& vertex) { noted.push_back(vertex); };
+      chunks.take = [&](TriangleSoup&& chunk) {
+        EXPECT_LE(chunk.triangle_count(), size);
+        EXPECT_GT(chunk.triangle_count(), 0u);
+        EXPECT_EQ(chunk.part_of.size(), chunk.triangle_count());
+        std::vector<bool> used(chunk.vertices.size(), false);
+        for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
+          for (const std::uint32_t v : chunk.triangles[t]) used.at(v) = true;
+          corners.push_back(chunk.corners(t));
+          part_of.push_back(chunk.part_of[t]);
+        }
+        EXPECT_EQ(std::count(used.begin(), used.end(), false), 0);
+      };
+      ReadReport report;
+      const TriangleSoup names = read_mesh_in_chunks(file, &report, chunks);
+      EXPECT_EQ(names.triangle_count(), 0u);
+      EXPECT_EQ(names.part_names, whole.part_names);
+      EXPECT_EQ(names.part_paths, whole.part_paths);
+      ASSERT_EQ(corners.size(), whole.triangle_count());
+      for (std::size_t t = 0; t < corners.size(); ++t) {
+        ASSERT_EQ(corners[t], whole.corners(t)) << "triangle " << t;
+        ASSERT_EQ(part_of[t], whole.part_of[t]) << "triangle " << t;
+      }
+      EXPECT_EQ(noted, whole.vertices);
+      EXPECT_EQ(report.triangles_read, whole_report.triangles_read);
+      EXPECT_EQ(report.degenerate_dropped, whole_report.degenerate_dropped);
+      EXPECT_EQ(report.tessellation_deflection, whole_report.tessellation_deflection);
+      EXPECT_EQ(report.length_unit, "mm");
+      EXPECT_EQ(report.format, whole_report.format);
+      EXPECT_EQ(report.bytes, whole_report.bytes);
+    }
   }
 }
 

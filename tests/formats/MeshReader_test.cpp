@@ -932,12 +932,40 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
                            "vertex 1 1 0\nvertex 0.5 2 0\nvertex 0 1 0\nendloop\nendfacet\n"
                            "facet normal 0 0 1\nouter loop\nvertex 0 0 1\nvertex 1 0 1\n"
                            "vertex 1 1 1\nendloop\nendfacet\nendsolid p\n");
-  // Faces before their vertices (PLY allows it): read whole, handed over as one chunk.
+  // Faces before their vertices (PLY allows it), ASCII and binary, with a part table after the
+  // faces: the vertices are read first, in a pass of their own.
   files.push_back(folder / "faces_first.ply");
   write_file(files.back(), "ply\nformat ascii 1.0\nelement face 2\n"
                            "property list uchar int vertex_indices\nelement vertex 4\n"
                            "property double x\nproperty double y\nproperty double z\nend_header\n"
                            "3 0 1 2\n3 0 2 3\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n");
+  {
+    // Binary: a quad, a degenerate triangle, a pentagon; two parts in a table after the faces.
+    std::string bytes =
+        "ply\nformat binary_little_endian 1.0\nelement face 4\n"
+        "property list uchar int vertex_indices\nelement vertex 6\nproperty double x\n"
+        "property double y\nproperty double z\nelement part 2\nproperty uint faces\n"
+        "property list uint uchar name\nproperty list uint uchar path\nend_header\n";
+    const auto put = [&bytes](const auto value) {
+      bytes.append(reinterpret_cast<const char*>(&value), sizeof value);
+    };
+    for (const std::vector<std::int32_t>& face :
+         std::vector<std::vector<std::int32_t>>{{0, 1, 2, 3}, {0, 0, 1}, {0, 1, 5}, {0, 1, 2, 4, 5}}) {
+      put(std::uint8_t(face.size()));
+      for (const std::int32_t corner : face) put(corner);
+    }
+    for (const double coordinate : {0., 0., 0., 1., 0., 0., 1., 1., 0., 0., 1., 0., 0., 0., 1., 2., 2., 3.})
+      put(coordinate);
+    for (const auto& [faces, name] : {std::pair{3u, std::string("a")}, std::pair{1u, std::string("b")}}) {
+      put(std::uint32_t(faces));
+      put(std::uint32_t(name.size()));
+      bytes += name;
+      put(std::uint32_t(name.size()));
+      bytes += name;
+    }
+    files.push_back(folder / "faces_first_binary.ply");
+    write_file(files.back(), bytes);
+  }
   // An ASCII part table: a part of no face, a quad, a part met again (parts need not be runs).
   files.push_back(folder / "table.ply");
   write_file(files.back(), "ply\nformat ascii 1.0\nelement vertex 5\nproperty double x\n"
@@ -966,10 +994,8 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
         chunks.vertex_cache_bytes = 1;
       }
       chunks.take = [&](TriangleSoup&& chunk) {
-        // A PLY of faces first is one chunk; an STL facet's triangles share a chunk.
-        const std::size_t most = file.filename() == "polygon.stl"       ? size + 2
-                                 : file.filename() == "faces_first.ply" ? ~std::size_t(0)
-                                                                        : size;
+        // An STL facet's triangles share a chunk.
+        const std::size_t most = file.filename() == "polygon.stl" ? size + 2 : size;
         EXPECT_LE(chunk.triangle_count(), most);
         EXPECT_EQ(chunk.part_of.size(), chunk.triangle_count());
         for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {

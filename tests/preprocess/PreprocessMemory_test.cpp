@@ -3,6 +3,13 @@
 // a child process; a model whose tables or placed triangles cannot fit is refused up front
 // with the figure; and placing copies in batches stores the same triangles, ids and parts.
 
+#include <BRepPrimAPI_MakeSphere.hxx>
+#include <STEPCAFControl_Writer.hxx>
+#include <TDataStd_Name.hxx>
+#include <TDocStd_Document.hxx>
+#include <XCAFApp_Application.hxx>
+#include <XCAFDoc_DocumentTool.hxx>
+#include <XCAFDoc_ShapeTool.hxx>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -212,6 +219,52 @@ TEST(PreprocessMemory, AFileTooLargeForTheBudgetIsRefusedBeforeItIsRead) {
   ASSERT_FALSE(raised.empty()) << message;
   const ChildRun run = run_preprocess(input, folder / "terrain.tpi", raised.c_str());
   expect_within_promise(run, std::stoull(raised) << 20);
+}
+
+// A STEP assembly written by OCCT's XCAF writer: one sphere of radius 10 mm placed `copies`
+// times, 30 mm apart in a square grid.
+fs::path write_spheres(const fs::path& path, std::size_t copies) {
+  Handle(TDocStd_Document) document;
+  XCAFApp_Application::GetApplication()->NewDocument("MDTV-XCAF", document);
+  const Handle(XCAFDoc_ShapeTool) tool = XCAFDoc_DocumentTool::ShapeTool(document->Main());
+  const TDF_Label sphere = tool->AddShape(BRepPrimAPI_MakeSphere(10).Shape(), Standard_False);
+  TDataStd_Name::Set(sphere, "BALL");
+  const TDF_Label tray = tool->NewShape();
+  TDataStd_Name::Set(tray, "tray");
+  const auto side = std::size_t(std::ceil(std::sqrt(double(copies))));
+  for (std::size_t k = 0; k < copies; ++k) {
+    gp_Trsf placement;
+    placement.SetTranslation(gp_Vec(30.0 * double(k % side), 30.0 * double(k / side), 0));
+    tool->AddComponent(tray, sphere, TopLoc_Location(placement));
+  }
+  tool->UpdateAssemblies();
+  STEPCAFControl_Writer writer;
+  EXPECT_TRUE(writer.Transfer(document, STEPControl_AsIs));
+  EXPECT_EQ(writer.Write(path.string().c_str()), IFSelect_RetDone);
+  XCAFApp_Application::GetApplication()->Close(document);
+  return path;
+}
+
+// A STEP assembly whose instances, placed, need more than 16M + 64 MiB (a sphere tessellated
+// once, placed for about 2M triangles) is read in chunks within the promise: its instances
+// placed a chunk at a time from the one tessellation, never held placed. On ddbb396 it was
+// refused with the figure ("raise --memory to ...").
+TEST(PreprocessMemory, AStepAssemblyTooLargeToHoldPlacedIsReadInChunksWithinTheBudget) {
+  const fs::path folder = test_folder("step-chunks");
+  const std::uint64_t per_sphere = read_mesh(write_spheres(folder / "one.step", 1)).triangle_count();
+  ASSERT_GT(per_sphere, 100u);
+  const std::size_t copies = std::size_t((2'000'000 + per_sphere - 1) / per_sphere);
+  ASSERT_LE(copies, 10000u) << "more occurrences than a STEP file may hold by default";
+  const fs::path input = write_spheres(folder / "spheres.step", copies);
+  const ChildRun run = run_preprocess(input, folder / "spheres.tpi", "16M");
+  expect_within_promise(run, std::uint64_t(16) << 20);
+  EXPECT_EQ(run.report.value("files_read_in_chunks", 0), 1) << run.report.dump(2);
+  EXPECT_EQ(run.report.at("parts").get<std::uint64_t>(), copies);
+  const TriangleSoup whole = read_mesh(input);
+  EXPECT_EQ(run.report.at("triangles_read").get<std::uint64_t>(), whole.triangle_count());
+  // Each sphere a closed component of its own, found across the chunks' seams.
+  EXPECT_EQ(run.report.at("components").get<std::uint64_t>(), copies);
+  EXPECT_EQ(run.report.at("closed_components").get<std::uint64_t>(), copies);
 }
 
 // Writes `soup` as ASCII PLY, binary PLY of float vertices, or ASCII STL (formats MeshWriter

@@ -293,6 +293,25 @@ TEST(Preprocess, SpillingUnderASmallBudgetWritesTheSameIndex) {
   }
 }
 
+// Two indexes of one model hold the same tables (parts, components, interiors when `interiors`
+// says they are stored) and shards.
+void expect_same_index(const fs::path& a, const fs::path& b, bool interiors = true) {
+  const IndexReader ra(a), rb(b);
+  for (const std::string_view table : {"tet_shard", "component_part"})
+    EXPECT_EQ(ra.read_table_uint32(table), rb.read_table_uint32(table)) << table;
+  if (interiors) {
+    EXPECT_EQ(ra.read_table_uint32("interior_components"), rb.read_table_uint32("interior_components"));
+    EXPECT_EQ(ra.read_table_uint64("interior_offsets"), rb.read_table_uint64("interior_offsets"));
+  }
+  EXPECT_EQ(ra.read_table_uint8("component_closed"), rb.read_table_uint8("component_closed"));
+  EXPECT_EQ(ra.read_table_double("component_bounds"), rb.read_table_double("component_bounds"));
+  EXPECT_EQ(ra.read_table_uint64("part_triangles"), rb.read_table_uint64("part_triangles"));
+  EXPECT_EQ(ra.read_table_uint8("part_path_bytes"), rb.read_table_uint8("part_path_bytes"));
+  ASSERT_EQ(ra.shard_count(), rb.shard_count());
+  for (std::uint32_t s = 0; s < ra.shard_count(); ++s)
+    ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << "shard " << s;
+}
+
 // A file read in chunks (as one too large for the budget is) makes the index it makes read
 // whole: the same parts, components (closed or not), interiors and shards. CGAL's meshes,
 // closed and open, some overlapping, written by CGAL as one soup in PLY, STL and OBJ; about
@@ -359,21 +378,50 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
     for (const auto& entry : fs::directory_iterator(folder))
       EXPECT_EQ(entry.path().filename().string().find(".tetrapage-spill"), std::string::npos) << entry.path();
 
-    const IndexReader ra(folder / "whole.tpi"), rb(folder / "chunked.tpi");
-    for (const std::string_view table :
-         {"tet_shard", "component_part", "interior_components"})
-      EXPECT_EQ(ra.read_table_uint32(table), rb.read_table_uint32(table)) << table;
-    EXPECT_EQ(ra.read_table_uint64("interior_offsets"), rb.read_table_uint64("interior_offsets"));
-    EXPECT_EQ(ra.read_table_uint8("component_closed"), rb.read_table_uint8("component_closed"));
-    EXPECT_EQ(ra.read_table_double("component_bounds"), rb.read_table_double("component_bounds"));
-    EXPECT_EQ(ra.read_table_uint64("part_triangles"), rb.read_table_uint64("part_triangles"));
-    EXPECT_EQ(ra.read_table_uint8("part_path_bytes"), rb.read_table_uint8("part_path_bytes"));
-    const std::vector<std::uint8_t> closed = rb.read_table_uint8("component_closed");
+    expect_same_index(folder / "whole.tpi", folder / "chunked.tpi");
+    const std::vector<std::uint8_t> closed =
+        IndexReader(folder / "chunked.tpi").read_table_uint8("component_closed");
     EXPECT_GT(std::count(closed.begin(), closed.end(), 1), 0);
     EXPECT_GT(std::count(closed.begin(), closed.end(), 0), 0);
-    ASSERT_EQ(ra.shard_count(), rb.shard_count());
-    for (std::uint32_t s = 0; s < ra.shard_count(); ++s)
-      ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << "shard " << s;
+  }
+}
+
+// STEP and IGES files read in chunks (as an assembly too large to hold placed is: each instance
+// placed a chunk at a time from its shape's one tessellation) make the index they make read
+// whole. OCCT's samples, closed and open, and a manifest in cm placing one three times, turned.
+TEST(Preprocess, ACadFileReadInChunksWritesTheSameIndex) {
+  const fs::path occt = "/usr/share/opencascade/data";
+  const fs::path folder = test_folder("cad-chunks");
+  const fs::path screw = occt / "step" / "screw.step";
+  ASSERT_TRUE(fs::exists(screw)) << "occt-misc (make deps) holds OpenCASCADE's samples";
+  std::ofstream(folder / "screws.json") << nlohmann::json{
+      {"units", "cm"},
+      {"parts",
+       {{{"name", "screw"}, {"file", screw.string()}, {"units", "mm"},
+         {"instances", {{{"translation", {0.0, 0.0, 0.0}}},
+                        {{"rotation", {0.9, 0.1, 0.3, 0.2}}, {"translation", {5.0, 0.0, 0.0}}},
+                        {{"translation", {0.0, 5.0, 0.0}}}}}}}}};
+  for (const fs::path& input :
+       {occt / "step" / "linkrods.step", occt / "iges" / "bearing.iges", folder / "screws.json"}) {
+    SCOPED_TRACE(input.string());
+    PreprocessOptions whole;
+    whole.region_triangles = 2000;
+    whole.interiors = true;
+    const PreprocessSummary a = preprocess({input}, folder / "whole.tpi", whole);
+    EXPECT_EQ(a.files_read_in_chunks, 0u);
+    PreprocessOptions chunked = whole;
+    chunked.force_spill = true;
+    const PreprocessSummary b = preprocess({input}, folder / "chunked.tpi", chunked);
+    EXPECT_EQ(b.files_read_in_chunks, 1u);
+    EXPECT_EQ(a.parts, b.parts);
+    EXPECT_EQ(a.triangles_read, b.triangles_read);
+    EXPECT_EQ(a.degenerate_dropped, b.degenerate_dropped);
+    EXPECT_EQ(a.components, b.components);
+    EXPECT_EQ(a.closed_components, b.closed_components);
+    EXPECT_EQ(a.length_unit, b.length_unit);
+    EXPECT_EQ(a.tessellation_deflection, b.tessellation_deflection);
+    EXPECT_EQ(a.interiors, b.interiors);
+    expect_same_index(folder / "whole.tpi", folder / "chunked.tpi", a.interiors.starts_with("stored"));
   }
 }
 

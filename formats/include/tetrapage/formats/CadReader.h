@@ -7,7 +7,6 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <string_view>
 
@@ -45,9 +44,6 @@ struct TessellationOptions {
   std::uint64_t memory_limit = 0;
   /// Seconds the child may take before it is killed (0: no limit).
   double time_limit = 1800;
-  /// Called with the placed vertices and triangles once tessellated, before any is placed (in
-  /// the child when isolated): a caller whose memory cannot hold the soup throws InputError.
-  std::function<void(std::uint64_t vertices, std::uint64_t triangles)> before_placing;
 };
 
 /// Sets options.deflection from `text`: a percentage of each shape's bounding-box diagonal

@@ -143,6 +143,9 @@ class PieceLoader {
  public:
   /// Reads the piece's file. @throw as read_mesh; InputError for a file's unknown unit.
   explicit PieceLoader(const InputPiece& piece, const TessellationOptions& tessellation = {});
+  /// The piece's file read already: `source` and `report` as read_mesh gave them.
+  /// @throw InputError for the file's unknown unit, or an entry the manifest does not hold.
+  PieceLoader(const InputPiece& piece, TriangleSoup source, const ReadReport& report);
   ~PieceLoader();
   PieceLoader(PieceLoader&&) noexcept;
   PieceLoader& operator=(PieceLoader&&) noexcept;
@@ -168,14 +171,15 @@ class PieceLoader {
   std::unique_ptr<Impl> impl_;
 };
 
-/// A placement of a piece whose file is read in chunks (read_mesh_in_chunks; formats whose
-/// readers state no unit): each chunk placed as PieceLoader::place places the whole file, so that
-/// the placed chunks, in order, are that copy's placed soup triangle for triangle.
+/// A placement of a piece whose file is read in chunks (read_mesh_in_chunks): each chunk placed
+/// as PieceLoader::place places the whole file, so that the placed chunks, in order, are that
+/// copy's placed soup triangle for triangle.
 class PlacedChunks {
  public:
-  /// Placement `copy` (< piece.copies()) of a piece a manifest places.
-  /// @throw InputError for an entry the manifest does not hold.
-  PlacedChunks(const InputPiece& piece, std::size_t copy);
+  /// Placement `copy` (< piece.copies()) of a piece a manifest places, whose file states the
+  /// unit `file_unit` ("" for none, as the mesh formats; "mm" for STEP and IGES).
+  /// @throw InputError for an entry the manifest does not hold, or an unknown unit.
+  PlacedChunks(const InputPiece& piece, std::size_t copy, const std::string& file_unit = {});
   ~PlacedChunks();
   PlacedChunks(const PlacedChunks&) = delete;
   PlacedChunks& operator=(const PlacedChunks&) = delete;
@@ -195,6 +199,9 @@ class PlacedChunks {
   TriangleSoup finish(const TriangleSoup& file_parts);
   /// The triangles the placement flattened and dropped so far.
   std::uint64_t dropped() const;
+  /// What the placement scales lengths by at most (a tessellation's deflection, from the
+  /// file's unit to the top manifest's).
+  double largest_scale() const;
 
  private:
   struct Impl;

@@ -67,8 +67,10 @@ struct SoupChunks {
 /// time: the chunks appended in order are read_mesh's soup (the same corners, parts and order;
 /// the same report). Returns the parts (part_names, part_paths) and no triangle. OBJ, OFF and
 /// PLY hold their vertex table while they are read, an STL a chunk's vertices; a PLY's part
-/// table, which follows the faces, is read first in a pass of its own. The formats
-/// MeshReadEstimate::chunked does not name are read whole and handed over as one chunk.
+/// table, which follows the faces, is read first in a pass of its own. A STEP or IGES file
+/// holds its distinct shapes and places its instances a chunk at a time (TessellatedFile).
+/// The other formats MeshReadEstimate::chunked does not name are read whole and handed over
+/// as one chunk.
 /// @throw as read_mesh, and whatever `take` throws.
 TriangleSoup read_mesh_in_chunks(const std::filesystem::path& path, ReadReport* report,
                                  const SoupChunks& chunks,
@@ -96,7 +98,7 @@ void load_readers_for(std::span<const std::filesystem::path> inputs);
 /// know: the counts a PLY or OFF header or a binary STL states, else the file's size at the
 /// fewest bytes a triangle took in the files measured (an OBJ, an ASCII STL, a glTF written
 /// with fewer digits or fewer vertices shared holds more). STEP and IGES are known once
-/// tessellated (TessellationOptions::before_placing).
+/// tessellated (TessellatedFile::placed_triangles).
 struct MeshReadEstimate {
   std::uint64_t vertices = 0;   ///< the soup's vertex entries (an STL's three a triangle)
   std::uint64_t triangles = 0;  ///< a face a triangle unless the file shows more
