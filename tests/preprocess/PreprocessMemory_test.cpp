@@ -143,7 +143,12 @@ void expect_within_promise(const ChildRun& run, std::uint64_t memory) {
   EXPECT_EQ(run.report.at("promised_peak_bytes").get<std::uint64_t>(), promise);
   if (!test::kResidentMemoryIsTheProgramsOwn) return;
   EXPECT_LE(peak, promise) << run.report.dump(2);
-  if (run.max_rss_bytes <= run.parent_rss_bytes) return;  // the fork's copy, not the command
+  // The child's ru_maxrss is the larger of the command's peak and the forked copy of this
+  // process before it ran the command, which grows by the pages it touches until exec: within
+  // a few MiB of this process, it is the copy's (a test that built its input through OCCT holds
+  // more than the command's peak), and says nothing of the command.
+  constexpr std::uint64_t kForkCopySlack = std::uint64_t(8) << 20;
+  if (run.max_rss_bytes <= run.parent_rss_bytes + kForkCopySlack) return;
   EXPECT_LE(run.max_rss_bytes, promise);
   EXPECT_GE(peak, run.max_rss_bytes);
 }
