@@ -298,7 +298,7 @@ void prepare_child(int write_fd, pid_t parent, std::uint64_t address_space) {
   // The child inherits the caller's unwritten stdout buffer, and OCCT writes to stdout: the
   // caller's pending lines came out twice (`mesh info a.step b.step | cat`). The child answers
   // through its pipe alone.
-  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
+  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0 && null != STDOUT_FILENO) {
     ::dup2(null, STDOUT_FILENO);
     ::close(null);
   }

@@ -755,18 +755,25 @@ struct PieceLoader::Impl {
   double stretch = 0;  ///< the largest of the placements so far
 };
 
-PieceLoader::PieceLoader(const InputPiece& piece, const TessellationOptions& tessellation)
-    : impl_(std::make_unique<Impl>()) {
-  impl_->piece = piece;
-  if (!piece.manifest) {
-    impl_->source = read_mesh(piece.input, &impl_->report, tessellation);
-    return;
-  }
-  const PlacedEntry placed(*piece.manifest, piece.entries);  // a bad entry before the read
-  impl_->copies = placed.count();
-  impl_->source = read_mesh(placed.part().file, &impl_->report, tessellation);
-  impl_->scale = part_unit_scale(placed.part(), placed.owner().units, impl_->report.length_unit);
+namespace {
+
+// The piece's file read as read_mesh reads it (a bad entry refused before the read).
+std::pair<TriangleSoup, ReadReport> read_piece_file(const InputPiece& piece,
+                                                    const TessellationOptions& tessellation) {
+  std::pair<TriangleSoup, ReadReport> read;
+  const std::filesystem::path file =
+      piece.manifest ? PlacedEntry(*piece.manifest, piece.entries).part().file : piece.input;
+  read.first = read_mesh(file, &read.second, tessellation);
+  return read;
 }
+
+}  // namespace
+
+PieceLoader::PieceLoader(const InputPiece& piece, const TessellationOptions& tessellation)
+    : PieceLoader(piece, read_piece_file(piece, tessellation)) {}
+
+PieceLoader::PieceLoader(const InputPiece& piece, std::pair<TriangleSoup, ReadReport> read)
+    : PieceLoader(piece, std::move(read.first), read.second) {}
 
 PieceLoader::PieceLoader(const InputPiece& piece, TriangleSoup source, const ReadReport& report)
     : impl_(std::make_unique<Impl>()) {

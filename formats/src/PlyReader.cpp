@@ -773,6 +773,7 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chu
   if (layout.parts == nullptr) soup.begin_part(file.path().stem().string());
   PlyPartTable parts(file, soup, layout.parts != nullptr);
   const std::uint64_t faces = layout.face != nullptr ? layout.face->count : 0;
+  soup.reserve(layout.vertex->count, faces, file.size());
   if (chunks != nullptr && layout.parts != nullptr) {
     // The table follows the faces: read first.
     read_elements_first(file, soup, parts, kTablePass);
@@ -782,8 +783,14 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chu
   // Faces before their vertices (PLY allows it): the vertices read first when the faces go
   // out in chunks.
   const bool vertices_read_first = chunks != nullptr && !vertices_first(layout);
-  if (vertices_read_first) read_elements_first(file, soup, parts, kVerticesPass);
-  soup.reserve(layout.vertex->count, faces, file.size());
+  if (vertices_read_first) {
+    read_elements_first(file, soup, parts, kVerticesPass);
+    // The pass opened the path again: a file replaced meanwhile is not read as this one.
+    if (soup.vertex_count() != layout.vertex->count)
+      throw FormatError(file.name() + ": the file changed while it was read (" +
+                        std::to_string(soup.vertex_count()) + " vertices read where its header says " +
+                        std::to_string(layout.vertex->count) + ")");
+  }
   report.encoding = header.encoding == PlyEncoding::ascii               ? "ascii"
                     : header.encoding == PlyEncoding::binary_big_endian ? "binary_big_endian"
                                                                         : "binary_little_endian";

@@ -111,12 +111,15 @@ struct TessellatedFile::Impl {
   TessellationOptions options;
   CadContent content;
 
-  // Calls `place_one(part, prototype, placed)` for each instance in order that has triangles
-  // (a part each), with its vertices placed; instances of a shape that failed are skipped (and
-  // listed in the report) or fail.
-  template <class PlaceOne>
-  void place_each(TriangleSoup& parts, ReadReport& report, PlaceOne&& place_one) const {
+  // Places each instance in order that has triangles (a part each): `begin(part, placed)` with
+  // its vertices placed, then `keep(part, placed, t)` for each of its triangles the placement
+  // does not flatten (those are counted as dropped); instances of a shape that failed are
+  // skipped (and listed in the report) or fail. Returns the triangles kept.
+  template <class Begin, class Keep>
+  std::uint64_t place_each(TriangleSoup& parts, ReadReport& report, Begin&& begin,
+                           Keep&& keep) const {
     std::vector<Vec3> placed;
+    std::uint64_t kept = 0;
     for (const ShapeInstance& instance : content.instances) {
       const TessellatedShape& prototype = content.shapes[instance.shape];
       if (prototype.refused)
@@ -137,15 +140,22 @@ struct TessellatedFile::Impl {
       report.tessellation_deflection =
           std::max(report.tessellation_deflection,
                    prototype.deflection * largest_stretch(instance.placement));
-      place_one(parts.add_part(prototype.name, instance.path), prototype, placed);
+      const std::uint32_t part = parts.add_part(prototype.name, instance.path);
+      begin(part, placed);
+      for (const TriangleIndices& t : prototype.triangles) {
+        ++report.triangles_read;
+        if (flattened(placed, t)) {
+          ++report.degenerate_dropped;
+          continue;
+        }
+        keep(part, placed, t);
+        ++kept;
+      }
     }
-  }
-
-  void check_some_triangle(std::uint64_t kept) const {
     if (kept == 0) throw InputError(file + ": no triangle (no shape with faces was tessellated)");
+    return kept;
   }
 };
-
 TessellatedFile::TessellatedFile(const std::filesystem::path& path,
                                  const TessellationOptions& options, ReadReport& report)
     : impl_(std::make_unique<Impl>()) {
@@ -196,50 +206,47 @@ std::uint64_t TessellatedFile::held_bytes() const {
   return bytes;
 }
 
+std::uint64_t TessellatedFile::largest_shape_vertices() const {
+  std::uint64_t largest = 0;
+  for (const TessellatedShape& shape : impl_->content.shapes)
+    largest = std::max<std::uint64_t>(largest, shape.vertices.size());
+  return largest;
+}
+
 TriangleSoup TessellatedFile::place(ReadReport& report) const {
   TriangleSoup soup;
-  impl_->place_each(soup, report, [&](std::uint32_t part, const TessellatedShape& prototype,
-                                      const std::vector<Vec3>& placed) {
+  // Sized once: grown, the arrays would hold up to twice the soup.
+  soup.vertices.reserve(placed_vertices());
+  soup.triangles.reserve(placed_triangles());
+  soup.part_of.reserve(placed_triangles());
+  std::uint32_t base = 0;
+  const auto begin = [&](std::uint32_t part, const std::vector<Vec3>& placed) {
     if (soup.vertices.size() + placed.size() > std::numeric_limits<std::uint32_t>::max())
       throw InputError(impl_->file + ": more vertices than a soup can index at part '" +
-                       soup.part_paths[part] + "'");
-    const auto base = static_cast<std::uint32_t>(soup.vertices.size());
+                       soup.part_path(part) + "'");
+    base = static_cast<std::uint32_t>(soup.vertices.size());
     soup.vertices.insert(soup.vertices.end(), placed.begin(), placed.end());
-    for (const TriangleIndices& t : prototype.triangles) {
-      ++report.triangles_read;
-      if (flattened(placed, t)) {
-        ++report.degenerate_dropped;
-        continue;
-      }
-      soup.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-      soup.part_of.push_back(part);
-    }
-  });
-  impl_->check_some_triangle(soup.triangle_count());
+  };
+  const auto keep = [&](std::uint32_t part, const std::vector<Vec3>&, const TriangleIndices& t) {
+    soup.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    soup.part_of.push_back(part);
+  };
+  impl_->place_each(soup, report, begin, keep);
   return soup;
 }
 
 TriangleSoup TessellatedFile::place_in_chunks(const SoupChunks& chunks, ReadReport& report) const {
   TriangleSoup parts;
   ChunkFiller filler(chunks);
-  std::uint64_t kept = 0;
-  impl_->place_each(parts, report, [&](std::uint32_t part, const TessellatedShape& prototype,
-                                       const std::vector<Vec3>& placed) {
+  const auto begin = [&](std::uint32_t, const std::vector<Vec3>& placed) {
     if (chunks.on_vertex)
       for (const Vec3& vertex : placed) chunks.on_vertex(vertex);
     filler.begin_instance(placed.size());
-    for (const TriangleIndices& t : prototype.triangles) {
-      ++report.triangles_read;
-      if (flattened(placed, t)) {
-        ++report.degenerate_dropped;
-        continue;
-      }
-      filler.add(placed, t, part);
-      ++kept;
-    }
-  });
+  };
+  const auto keep = [&](std::uint32_t part, const std::vector<Vec3>& placed,
+                        const TriangleIndices& t) { filler.add(placed, t, part); };
+  impl_->place_each(parts, report, begin, keep);
   filler.hand_over();
-  impl_->check_some_triangle(kept);
   return parts;
 }
 

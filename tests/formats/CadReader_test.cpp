@@ -351,6 +351,30 @@ TEST(CadReader, APartThatFailsToTessellateIsNamedOrSkipped) {
   EXPECT_EQ(soup.triangle_count(), 12u);  // a box's six faces, two triangles each
 }
 
+// A shape that fails to tessellate, skipped, is skipped alike when the instances are placed in
+// chunks: the same parts, triangles and list of skipped parts; not skipped, both reads fail.
+TEST(CadReader, ABadPartPlacedInChunksIsSkippedOrRefusedAsWhole) {
+  const auto path = write_with_bad_part(test::scratch_folder("bad_chunks"));
+  std::vector<std::array<Vec3, 3>> corners;
+  SoupChunks chunks;
+  chunks.triangles = 5;
+  chunks.take = [&](TriangleSoup&& chunk) {
+    for (std::size_t t = 0; t < chunk.triangle_count(); ++t) corners.push_back(chunk.corners(t));
+  };
+  EXPECT_THROW(read_mesh_in_chunks(path, nullptr, chunks), InputError);
+  corners.clear();
+  TessellationOptions skip;
+  skip.skip_bad_parts = true;
+  ReadReport whole_report, report;
+  const TriangleSoup whole = read_mesh(path, &whole_report, skip);
+  const TriangleSoup names = read_mesh_in_chunks(path, &report, chunks, skip);
+  EXPECT_EQ(names.part_names, whole.part_names);
+  EXPECT_EQ(report.skipped_parts, whole_report.skipped_parts);
+  ASSERT_EQ(report.skipped_parts.size(), 1u);
+  ASSERT_EQ(corners.size(), whole.triangle_count());
+  for (std::size_t t = 0; t < corners.size(); ++t) EXPECT_EQ(corners[t], whole.corners(t));
+}
+
 TEST(CadReader, DamagedFilesAreRefusedNamingTheFile) {
   const auto folder = test::scratch_folder("damaged");
   const auto screw = kOcctData / "step" / "screw.step";

@@ -388,7 +388,8 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
 
 // STEP and IGES files read in chunks (as an assembly too large to hold placed is: each instance
 // placed a chunk at a time from its shape's one tessellation) make the index they make read
-// whole. OCCT's samples, closed and open, and a manifest in cm placing one three times, turned.
+// whole. OCCT's samples, closed and open, and a manifest in cm placing one (in the mm its reader
+// states) three times, turned and scaled: the unit and the deflection come from the file.
 TEST(Preprocess, ACadFileReadInChunksWritesTheSameIndex) {
   const fs::path occt = "/usr/share/opencascade/data";
   const fs::path folder = test_folder("cad-chunks");
@@ -397,10 +398,10 @@ TEST(Preprocess, ACadFileReadInChunksWritesTheSameIndex) {
   std::ofstream(folder / "screws.json") << nlohmann::json{
       {"units", "cm"},
       {"parts",
-       {{{"name", "screw"}, {"file", screw.string()}, {"units", "mm"},
+       {{{"name", "screw"}, {"file", screw.string()},
          {"instances", {{{"translation", {0.0, 0.0, 0.0}}},
                         {{"rotation", {0.9, 0.1, 0.3, 0.2}}, {"translation", {5.0, 0.0, 0.0}}},
-                        {{"translation", {0.0, 5.0, 0.0}}}}}}}}};
+                        {{"scale", 2.0}, {"translation", {0.0, 5.0, 0.0}}}}}}}}};
   for (const fs::path& input :
        {occt / "step" / "linkrods.step", occt / "iges" / "bearing.iges", folder / "screws.json"}) {
     SCOPED_TRACE(input.string());

@@ -32,6 +32,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tetrapage/formats/CadReader.h"
@@ -167,6 +168,7 @@ class PieceLoader {
   ReadReport report() const;
 
  private:
+  PieceLoader(const InputPiece& piece, std::pair<TriangleSoup, ReadReport> read);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -31,6 +31,8 @@ class TessellatedFile {
   std::uint64_t placed_triangles() const;
   /// What the distinct shapes hold in memory (their vertices, triangles and names).
   std::uint64_t held_bytes() const;
+  /// The vertices of the largest shape: what placing one instance holds beside the shapes.
+  std::uint64_t largest_shape_vertices() const;
 
   /// Every instance placed into one soup: read_cad's soup.
   /// @throw InputError for a shape that failed to tessellate (unless options.skip_bad_parts),
@@ -38,8 +40,10 @@ class TessellatedFile {
   TriangleSoup place(ReadReport& report) const;
   /// Every instance placed, handed to `chunks.take` a chunk at a time (SoupChunks' contract:
   /// the chunks appended in order are place()'s soup, every placed vertex given to on_vertex);
-  /// holds one instance's placed vertices beside a chunk. Returns the parts and no triangle.
-  /// @throw as place, and whatever `take` throws.
+  /// holds one instance's placed vertices (and 8 B a vertex to number them in a chunk) beside
+  /// a chunk. Returns the parts and no triangle.
+  /// @throw as place (a chunk has its own vertices: no limit on the placed vertices), and
+  ///        whatever `take` throws.
   TriangleSoup place_in_chunks(const SoupChunks& chunks, ReadReport& report) const;
 
  private:
