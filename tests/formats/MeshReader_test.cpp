@@ -984,8 +984,7 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
     // read back through one block (the least cache), then held whole.
     for (const std::size_t size : {std::size_t(1), std::size_t(3), std::size_t(1000)}) {
       SCOPED_TRACE(file.filename().string() + ", chunks of " + std::to_string(size));
-      std::vector<std::array<Vec3, 3>> corners;
-      std::vector<std::uint32_t> part_of;
+      test::HandedOver handed;
       SoupChunks chunks;
       chunks.triangles = size;
       if (size < 1000) {
@@ -998,21 +997,11 @@ TEST(MeshReader, ChunksAppendedAreTheWholeRead) {
         const std::size_t most = file.filename() == "polygon.stl" ? size + 2 : size;
         EXPECT_LE(chunk.triangle_count(), most);
         EXPECT_EQ(chunk.part_of.size(), chunk.triangle_count());
-        for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
-          corners.push_back(chunk.corners(t));
-          part_of.push_back(chunk.part_of[t]);
-        }
+        handed.add(chunk);
       };
       ReadReport report;
       const TriangleSoup names = read_mesh_in_chunks(file, &report, chunks);
-      EXPECT_EQ(names.triangle_count(), 0u);
-      EXPECT_EQ(names.part_names, whole.part_names);
-      EXPECT_EQ(names.part_paths, whole.part_paths);
-      ASSERT_EQ(corners.size(), whole.triangle_count());
-      for (std::size_t t = 0; t < corners.size(); ++t) {
-        ASSERT_EQ(corners[t], whole.corners(t)) << "triangle " << t;
-        ASSERT_EQ(part_of[t], whole.part_of[t]) << "triangle " << t;
-      }
+      test::expect_whole_read(names, handed, whole);
       EXPECT_EQ(report.triangles_read, whole_report.triangles_read);
       EXPECT_EQ(report.degenerate_dropped, whole_report.degenerate_dropped);
       EXPECT_EQ(report.dropped_positions, whole_report.dropped_positions);

@@ -107,6 +107,31 @@ inline std::vector<std::array<Vec3, 3>> triangle_corners(const TriangleSoup& sou
   return corners;
 }
 
+/// What a read in chunks handed over, appended: each triangle's corners and part.
+struct HandedOver {
+  std::vector<std::array<Vec3, 3>> corners;
+  std::vector<std::uint32_t> part_of;
+  void add(const TriangleSoup& chunk) {
+    for (std::size_t t = 0; t < chunk.triangle_count(); ++t) {
+      corners.push_back(chunk.corners(t));
+      part_of.push_back(chunk.part_of[t]);
+    }
+  }
+};
+
+/// A read in chunks (the parts it returned, `names`, and what it handed over) is `whole`.
+inline void expect_whole_read(const TriangleSoup& names, const HandedOver& handed,
+                              const TriangleSoup& whole) {
+  EXPECT_EQ(names.triangle_count(), 0u);
+  EXPECT_EQ(names.part_names, whole.part_names);
+  EXPECT_EQ(names.part_paths, whole.part_paths);
+  ASSERT_EQ(handed.corners.size(), whole.triangle_count());
+  for (std::size_t t = 0; t < handed.corners.size(); ++t) {
+    ASSERT_EQ(handed.corners[t], whole.corners(t)) << "triangle " << t;
+    ASSERT_EQ(handed.part_of[t], whole.part_of[t]) << "triangle " << t;
+  }
+}
+
 /// Rounds to the nearest float. Through a volatile on purpose: GCC 12.2 at -O2/-O3 vectorises
 /// {double(float(a)), double(float(b)), ...} and drops the rounding of the vector lanes
 /// (wrong code, seen on Debian's 12.2.0-14).

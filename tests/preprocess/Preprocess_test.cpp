@@ -312,6 +312,20 @@ void expect_same_index(const fs::path& a, const fs::path& b, bool interiors = tr
     ASSERT_EQ(ra.read_shard(s), rb.read_shard(s)) << "shard " << s;
 }
 
+// `input` preprocessed twice, read whole and (forced) in chunks, into whole.tpi and
+// chunked.tpi of `folder`, with interiors and regions of `region_triangles`.
+std::pair<PreprocessSummary, PreprocessSummary> preprocess_whole_and_in_chunks(
+    const fs::path& input, const fs::path& folder, std::uint32_t region_triangles) {
+  PreprocessOptions whole;
+  whole.region_triangles = region_triangles;
+  whole.interiors = true;
+  const PreprocessSummary a = preprocess({input}, folder / "whole.tpi", whole);
+  EXPECT_EQ(a.files_read_in_chunks, 0u);
+  PreprocessOptions chunked = whole;
+  chunked.force_spill = true;
+  return {a, preprocess({input}, folder / "chunked.tpi", chunked)};
+}
+
 // A file read in chunks (as one too large for the budget is) makes the index it makes read
 // whole: the same parts, components (closed or not), interiors and shards. CGAL's meshes,
 // closed and open, some overlapping, written by CGAL as one soup in PLY, STL and OBJ; about
@@ -358,14 +372,7 @@ TEST(Preprocess, AFileReadInChunksWritesTheSameIndex) {
       ASSERT_TRUE(CGAL::IO::write_polygon_soup(input.string(), points, polygons,
                                                CGAL::parameters::use_binary_mode(true)));
     }
-    PreprocessOptions whole;
-    whole.region_triangles = 4000;
-    whole.interiors = true;
-    const PreprocessSummary a = preprocess({input}, folder / "whole.tpi", whole);
-    EXPECT_EQ(a.files_read_in_chunks, 0u);
-    PreprocessOptions chunked = whole;
-    chunked.force_spill = true;
-    const PreprocessSummary b = preprocess({input}, folder / "chunked.tpi", chunked);
+    const auto [a, b] = preprocess_whole_and_in_chunks(input, folder, 4000);
     const bool assembly = std::string(extension) == ".json";
     EXPECT_EQ(b.files_read_in_chunks, assembly ? 2u : 1u);
     EXPECT_EQ(a.parts, b.parts);
@@ -405,14 +412,7 @@ TEST(Preprocess, ACadFileReadInChunksWritesTheSameIndex) {
   for (const fs::path& input :
        {occt / "step" / "linkrods.step", occt / "iges" / "bearing.iges", folder / "screws.json"}) {
     SCOPED_TRACE(input.string());
-    PreprocessOptions whole;
-    whole.region_triangles = 2000;
-    whole.interiors = true;
-    const PreprocessSummary a = preprocess({input}, folder / "whole.tpi", whole);
-    EXPECT_EQ(a.files_read_in_chunks, 0u);
-    PreprocessOptions chunked = whole;
-    chunked.force_spill = true;
-    const PreprocessSummary b = preprocess({input}, folder / "chunked.tpi", chunked);
+    const auto [a, b] = preprocess_whole_and_in_chunks(input, folder, 2000);
     EXPECT_EQ(b.files_read_in_chunks, 1u);
     EXPECT_EQ(a.parts, b.parts);
     EXPECT_EQ(a.triangles_read, b.triangles_read);
