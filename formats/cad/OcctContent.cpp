@@ -41,6 +41,7 @@
 #include "CadIsolation.h"
 #include "CadModule.h"
 #include "StepPrescan.h"
+#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/Progress.h"
@@ -159,42 +160,74 @@ class AssemblyWalk {
   std::map<std::string, std::size_t> by_entry_;
 };
 
-// The triangles OCCT's mesher will make of `shape` at `fine`, estimated before it runs: a mesh
-// at `coarse` whose curved faces' counts are scaled by coarse / fine (a curved surface's count
-// grows as 1 / deflection, a plane's does not). The coarse mesh is removed afterwards.
-double estimate_triangles(const TopoDS_Shape& shape, double coarse, double fine, double angular) {
+// What OCCT's mesher holds for a face meshed into `triangles`: measured on a sphere of radius
+// 10 mm (one face), 300 MB at 100,000 triangles, 1.0 GB at 250,000, and past 21 GB at 2.5M
+// (stopped): 3 KB a triangle, times (triangles / 100,000)^0.34 past that.
+double mesher_bytes(double triangles) {
+  constexpr double kBytesPerTriangle = 3072, kLinearUpTo = 1e5, kGrowth = 0.34;
+  return kBytesPerTriangle * triangles * std::max(1.0, std::pow(triangles / kLinearUpTo, kGrowth));
+}
+
+// The triangles OCCT's mesher will make of a shape at a finer deflection, and the memory it
+// will hold for them, estimated before it runs.
+struct MeshEstimate {
+  double triangles = 0, bytes = 0;
+};
+
+// The estimate of `shape` at `fine`: a mesh at `coarse` whose curved faces' counts are scaled
+// by coarse / fine (a curved surface's count grows as 1 / deflection, a plane's does not). The
+// coarse mesh is removed afterwards.
+MeshEstimate estimate_mesh(const TopoDS_Shape& shape, double coarse, double fine, double angular) {
   BRepMesh_IncrementalMesh mesher(shape, coarse, Standard_False, angular, Standard_False);
-  double estimate = 0;
+  MeshEstimate estimate;
   for (TopExp_Explorer faces(shape, TopAbs_FACE); faces.More(); faces.Next()) {
     const TopoDS_Face& face = TopoDS::Face(faces.Current());
     TopLoc_Location location;
     const Handle(Poly_Triangulation) mesh = BRep_Tool::Triangulation(face, location);
     if (mesh.IsNull()) continue;
     const bool plane = BRepAdaptor_Surface(face, Standard_False).GetType() == GeomAbs_Plane;
-    estimate += double(mesh->NbTriangles()) * (plane ? 1.0 : coarse / fine);
+    const double triangles = double(mesh->NbTriangles()) * (plane ? 1.0 : coarse / fine);
+    estimate.triangles += triangles;
+    estimate.bytes += mesher_bytes(triangles);
   }
   BRepTools::Clean(shape);
   return estimate;
 }
 
 // Refuses (in out.error) a deflection finer than the default whose estimated triangles exceed
-// the limit: the mesher would run for minutes and take gigabytes before failing.
+// the limit, or whose mesher would exceed the reading's memory (--cad-memory; without it, half
+// the machine's, for the caller and everything else): it would run for minutes and take
+// gigabytes before failing.
 bool within_triangle_limit(const TopoDS_Shape& shape, double diagonal,
                            const TessellationOptions& options, TessellatedShape& out) {
   const double coarse = TessellationOptions{}.deflection * diagonal;
   if (options.max_triangles == 0 || !(out.deflection < coarse)) return true;
-  const double estimate =
-      estimate_triangles(shape, coarse, out.deflection, options.angular_deflection);
+  const MeshEstimate mesh = estimate_mesh(shape, coarse, out.deflection, options.angular_deflection);
+  const double estimate = mesh.triangles;
   if (options.show_progress)
     std::fprintf(stderr, "tetrapage: %s: about %.3g triangles at a deflection of %g mm\n",
                  out.name.c_str(), estimate, out.deflection);
-  if (estimate <= double(options.max_triangles)) return true;
-  char text[256];
-  std::snprintf(
-      text, sizeof text,
-      "would make about %.3g triangles at a deflection of %g mm, more than the limit of %llu "
-      "(a larger --deflection makes fewer; --max-cad-triangles raises the limit)",
-      estimate, out.deflection, static_cast<unsigned long long>(options.max_triangles));
+  const std::uint64_t memory =
+      options.memory_limit != 0 ? options.memory_limit : machine_memory() / 2;
+  char text[320];
+  if (estimate > double(options.max_triangles)) {
+    std::snprintf(
+        text, sizeof text,
+        "would make about %.3g triangles at a deflection of %g mm, more than the limit of %llu "
+        "(a larger --deflection makes fewer; --max-cad-triangles raises the limit)",
+        estimate, out.deflection, static_cast<unsigned long long>(options.max_triangles));
+  } else if (mesh.bytes > double(memory)) {
+    std::snprintf(
+        text, sizeof text,
+        "would make about %.3g triangles at a deflection of %g mm, for which OpenCASCADE's "
+        "mesher needs about %s, above the reading's memory of %s (a larger --deflection "
+        "makes fewer; --cad-memory raises the memory)",
+        estimate, out.deflection,
+        format_byte_size(std::uint64_t(mesh.bytes)).c_str(),
+        format_byte_size(memory).c_str());
+  } else {
+    return true;
+  }
   out.error = text;
   out.refused = true;
   return false;

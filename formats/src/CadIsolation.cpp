@@ -263,12 +263,6 @@ CadContent read_content(PipeReader& in) {
   throw Error(message);
 }
 
-std::uint64_t machine_memory() {
-  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
-  return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page)
-                               : (std::uint64_t(8) << 30);
-}
-
 // This process's address space (VmSize), which the child inherits.
 std::uint64_t address_space_bytes() {
   std::ifstream status("/proc/self/status");
@@ -361,6 +355,12 @@ bool memory_limit_applies() {
 #else
   return true;
 #endif
+}
+
+std::uint64_t machine_memory() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page)
+                               : (std::uint64_t(8) << 30);
 }
 
 CadContent read_in_child(const std::string& file, const IsolationLimits& limits,

@@ -55,6 +55,10 @@ struct IsolationLimits {
 CadContent read_in_child(const std::string& file, const IsolationLimits& limits,
                          const std::function<CadContent()>& read);
 
+/// The machine's physical memory, in bytes (8 GiB when the system does not say): the child's
+/// memory when no limit is given.
+std::uint64_t machine_memory();
+
 /// Whether the address-space limit is applied: not under AddressSanitizer or ThreadSanitizer,
 /// whose shadow memory reserves terabytes.
 bool memory_limit_applies();

@@ -252,6 +252,28 @@ TEST(CadHostile, AHugeTessellationIsRefusedByItsEstimate) {
   EXPECT_THROW(read_cad(kOcctData / "step" / "screw.step", options), InputError);
 }
 
+// Within the triangle limit, OCCT's mesher holds 3 KB and more a triangle of a finely meshed
+// face (a 10 mm sphere at 4e-5 mm grew past 21 GB): a deflection whose mesher would exceed
+// --cad-memory is refused by its estimate, before the mesher runs.
+TEST(CadHostile, AMesherBeyondTheReadingsMemoryIsRefusedByItsEstimate) {
+  const auto folder = fresh_folder("mesher-memory");
+  const auto screw = kOcctData / "step" / "screw.step";
+  if (!std::filesystem::exists(screw)) GTEST_SKIP() << screw << " not installed";
+  const auto start = std::chrono::steady_clock::now();
+  const test::CliResult refused = test::run_cli_in(
+      folder, "mesh info " + screw.string() + " --deflection 1e-4 --cad-memory 512M", 120);
+  EXPECT_EQ(refused.status, 1) << refused.err;
+  EXPECT_NE(refused.err.find("screw.step"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("mesher needs about"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("--cad-memory"), std::string::npos) << refused.err;
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(60)) << "refused before meshing";
+  TessellationOptions options;
+  options.deflection = 1e-4;
+  options.relative_deflection = false;
+  options.memory_limit = std::uint64_t(512) << 20;
+  EXPECT_THROW(read_cad(screw, options), InputError);
+}
+
 // Reading the same STEP and IGES files again and again leaves the caller's resident memory
 // flat: what OpenCASCADE keeps (its caches, the leaks LSan reports in its libraries) stays in
 // the child, and our side of the read keeps nothing.
