@@ -64,15 +64,18 @@ bool flattened(const std::vector<Vec3>& placed, const TriangleIndices& t) {
 }
 
 // A chunk of placed instances being filled: each triangle's corners numbered in the chunk as
-// they are first used (a stamp per prototype vertex, so that a new chunk needs no clearing).
+// they are first used. A prototype vertex's slot holds while its stamp is the current one; the
+// stamp moves on with each instance and each chunk, so that neither clears the tables.
 class ChunkFiller {
  public:
   explicit ChunkFiller(const SoupChunks& chunks) : chunks_(chunks) {}
 
   void begin_instance(std::size_t prototype_vertices) {
+    if (stamp_of_.size() < prototype_vertices) {
+      stamp_of_.resize(prototype_vertices, 0);
+      slot_.resize(prototype_vertices);
+    }
     ++stamp_;
-    slot_.assign(prototype_vertices, 0);
-    stamp_of_.assign(prototype_vertices, 0);
   }
 
   void add(const std::vector<Vec3>& placed, const TriangleIndices& t, std::uint32_t part) {
@@ -100,8 +103,9 @@ class ChunkFiller {
  private:
   const SoupChunks& chunks_;
   TriangleSoup chunk_;
-  std::vector<std::uint32_t> slot_, stamp_of_;
-  std::uint32_t stamp_ = 0;
+  std::vector<std::uint32_t> slot_;
+  std::vector<std::uint64_t> stamp_of_;  // 64 bits: instances and chunks never wrap it
+  std::uint64_t stamp_ = 0;
 };
 
 }  // namespace

@@ -553,7 +553,7 @@ LoadedSoup load_tessellated(const InputPiece& piece, PieceEstimate estimate,
   read.vertices = tessellated->placed_vertices();
   read.triangles = tessellated->placed_triangles();
   // Placing holds the shapes and one instance's placed vertices (24 B each) beside the soup,
-  // or, in chunks, beside a chunk with 8 B more a vertex to number the chunk's.
+  // or, in chunks, beside a chunk with 12 B more a vertex to number the chunk's.
   const std::uint64_t shapes = tessellated->held_bytes();
   const std::uint64_t instance = 24 * tessellated->largest_shape_vertices();
   read.reading_bytes = read.soup_bytes() + shapes + instance;
@@ -564,7 +564,7 @@ LoadedSoup load_tessellated(const InputPiece& piece, PieceEstimate estimate,
     return load_placed(piece, std::make_unique<PieceLoader>(piece, std::move(soup), report),
                        options, threads);
   }
-  read.chunked_bytes = shapes + instance + 8 * tessellated->largest_shape_vertices();
+  read.chunked_bytes = shapes + instance + 12 * tessellated->largest_shape_vertices();
   read.vertex_table_bytes = 0;
   const std::uint64_t bytes = plan_stream(read, room).bytes;
   if (bytes > room) {

@@ -238,14 +238,16 @@ TEST(CadReader, AnAssemblyGivesEveryInstanceWithItsNamePathAndPlacement) {
 // The instances of a STEP or IGES file placed a chunk at a time (read_mesh_in_chunks, for an
 // assembly too large to hold placed) are the whole read's: the same corners, parts, paths and
 // report, every placed vertex given to on_vertex, no chunk larger than asked, and a chunk's
-// vertices only those its triangles use. OCCT's samples and the written rack (each instance of
-// a shape placed from the one tessellation), in chunks of 1, 7 and 1000.
+// vertices only those its triangles use. OCCT's samples, FreeCAD's IDF parts (open shells) and
+// the written rack (each instance of a shape placed from the one tessellation), in chunks of 1,
+// 7 and 1000.
 TEST(CadReader, InstancesPlacedInChunksAreTheWholeRead) {
   const auto folder = test::scratch_folder("chunks");
   std::vector<std::filesystem::path> files = {write_rack(folder, "MM").path,
                                               write_rack(folder, "M").path};
   for (const auto& sample : {kOcctData / "step" / "linkrods.step", kOcctData / "step" / "screw.step",
-                             kOcctData / "iges" / "bearing.iges"})
+                             kOcctData / "iges" / "bearing.iges", kFreecadIdf / "SOT23.stp",
+                             kFreecadIdf / "0603_SMD.stp"})
     if (std::filesystem::exists(sample)) files.push_back(sample);
   for (const auto& file : files) {
     ReadReport whole_report;

@@ -250,8 +250,10 @@ fs::path write_spheres(const fs::path& path, std::size_t copies) {
 
 // A STEP assembly whose instances, placed, need more than 16M + 64 MiB (a sphere tessellated
 // once, placed for about 2M triangles) is read in chunks within the promise: its instances
-// placed a chunk at a time from the one tessellation, never held placed. On ddbb396 it was
-// refused with the figure ("raise --memory to ...").
+// placed a chunk at a time from the one tessellation, never held placed. Placed whole it
+// needs its 2M-triangle soup and components' tables (163 MiB in the ingest under --memory 4G,
+// docs/BENCHMARKS.md), more than the promise: ddbb396, which could only place it whole,
+// refused it up front.
 TEST(PreprocessMemory, AStepAssemblyTooLargeToHoldPlacedIsReadInChunksWithinTheBudget) {
   const fs::path folder = test_folder("step-chunks");
   const std::uint64_t per_sphere = read_mesh(write_spheres(folder / "one.step", 1)).triangle_count();

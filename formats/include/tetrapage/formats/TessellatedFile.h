@@ -40,7 +40,7 @@ class TessellatedFile {
   TriangleSoup place(ReadReport& report) const;
   /// Every instance placed, handed to `chunks.take` a chunk at a time (SoupChunks' contract:
   /// the chunks appended in order are place()'s soup, every placed vertex given to on_vertex);
-  /// holds one instance's placed vertices (and 8 B a vertex to number them in a chunk) beside
+  /// holds one instance's placed vertices (and 12 B a vertex to number them in a chunk) beside
   /// a chunk. Returns the parts and no triangle.
   /// @throw as place (a chunk has its own vertices: no limit on the placed vertices), and
   ///        whatever `take` throws.
