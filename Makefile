@@ -91,7 +91,7 @@ sanitize: configure
 # input stays in $(FUZZ_BUILD)/fuzz/crashes/TARGET/. CI (.ci/run) runs every target a minute.
 FUZZ_BUILD ?= build-fuzz
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS ?= ply obj stl off manifest pose answers obstacles index index_data step_scan
+FUZZ_TARGETS ?= ply obj stl off gltf glb manifest pose answers obstacles index index_data step_scan
 fuzz: deps fuzz-deps
 	CC=clang-14 CXX=clang++-14 cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g" "-DCMAKE_C_FLAGS_RELWITHDEBINFO=-O2 -g" \

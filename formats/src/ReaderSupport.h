@@ -245,5 +245,9 @@ TriangleSoup read_ply(InputFile& file, ReadReport& report, const SoupChunks* chu
 TriangleSoup read_off(InputFile& file, ReadReport& report, const SoupChunks* chunks = nullptr);
 /// Any format Assimp knows; one part per mesh node instance.
 TriangleSoup read_assimp(const std::filesystem::path& path, ReadReport& report);
+/// A glTF 2.0 file (.gltf, .glb) read by our own reader (GltfReader.cpp), or nothing when
+/// Assimp reads it (GltfDocument::needs_assimp: glTF 1.0, Draco, sparse accessors, ...).
+std::optional<TriangleSoup> read_gltf(const std::filesystem::path& path, ReadReport& report,
+                                      const SoupChunks* chunks);
 
 }  // namespace tetrapage::detail

@@ -797,9 +797,9 @@ TEST(AssimpReader, RawGroupsAreReadWholeOrRefused) {
 }
 
 // ---------------------------------------------------------------------------------------
-// glTF through Assimp
+// glTF (our reader: GltfReader_test.cpp compares it with Assimp's)
 
-TEST(AssimpReader, GltfNodeHierarchyTransformsAndInstances) {
+TEST(GltfReader, NodeHierarchyTransformsAndInstances) {
   const auto folder = scratch_folder("gltf_nodes");
   const auto path = folder / "scene.gltf";
   // One triangle mesh used by two nodes: "base" (translation (10,0,0), scale 2) with a child
@@ -831,7 +831,7 @@ TEST(AssimpReader, GltfNodeHierarchyTransformsAndInstances) {
   const TriangleSoup soup = read_mesh(path, &report);
   ASSERT_EQ(soup.part_count(), 3u);
   ASSERT_EQ(soup.triangle_count(), 3u);
-  EXPECT_EQ(report.format, "assimp:gltf");
+  EXPECT_EQ(report.format, "gltf");
   EXPECT_EQ(report.bytes, std::filesystem::file_size(path));
   // Expected world corners per node name: base: 2p + (10,0,0); arm: 2(p + (0,1,0)) + (10,0,0);
   // copy: p.

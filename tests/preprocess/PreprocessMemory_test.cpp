@@ -205,19 +205,43 @@ TEST(PreprocessMemory, AFileTooLargeToReadWholeIsReadInChunksWithinTheBudget) {
   EXPECT_EQ(run.report.at("triangles_read").get<std::uint64_t>(), read_mesh(input).triangle_count());
 }
 
-// A 1M-triangle GLB (read whole, through Assimp) needs more than 16M + 64 MiB: refused before
-// it is read, with the figure, leaving no output and no spill; at the --memory the message
-// names, it runs within the promise (the estimate is an upper bound of what reading it takes).
+// A 2M-triangle GLB, which Assimp read whole (more than 16M + 64 MiB: it was refused), is read
+// by our glTF reader in chunks within the promise.
+TEST(PreprocessMemory, AGlbTooLargeToReadWholeIsReadInChunksWithinTheBudget) {
+  const fs::path folder = test_folder("glb_chunks");
+  const fs::path input = make_terrain(folder / "terrain.glb", 2'000'000);
+  const ChildRun run = run_preprocess(input, folder / "terrain.tpi", "16M");
+  expect_within_promise(run, std::uint64_t(16) << 20);
+  EXPECT_EQ(run.report.value("files_read_in_chunks", 0), 1) << run.report.dump(2);
+  EXPECT_EQ(run.report.at("triangles_read").get<std::uint64_t>(), read_mesh(input).triangle_count());
+}
+
+// Assimp's RAW text: a triangle a line, its nine coordinates.
+fs::path write_raw(const fs::path& path, const TriangleSoup& soup) {
+  std::ofstream out(path);
+  out.precision(9);
+  for (std::size_t t = 0; t < soup.triangle_count(); ++t) {
+    for (const Vec3& p : soup.corners(t)) out << p[0] << ' ' << p[1] << ' ' << p[2] << ' ';
+    out << '\n';
+  }
+  return path;
+}
+
+// A 500k-triangle RAW file (read whole, through Assimp) needs more than 16M + 64 MiB: refused
+// before it is read, with the figure, leaving no output and no spill; at the --memory the
+// message names, it runs within the promise (the estimate is an upper bound of what reading it
+// takes).
 TEST(PreprocessMemory, AFileTooLargeForTheBudgetIsRefusedBeforeItIsRead) {
   const fs::path folder = test_folder("refused");
-  const fs::path input = make_terrain(folder / "terrain.glb", 1'000'000);
+  const fs::path input = write_raw(folder / "terrain.raw", read_mesh(make_terrain(folder / "terrain.ply", 500'000)));
+  fs::remove(folder / "terrain.ply");
   PreprocessOptions options;
   options.memory_bytes = std::uint64_t(16) << 20;
   const std::string message = refusal({input}, folder / "terrain.tpi", options);
   EXPECT_NE(message.find("'" + input.string() + "' holds about 1,"), std::string::npos) << message;
   EXPECT_NE(message.find("above --memory 16.0 MiB + 64.0 MiB"), std::string::npos) << message;
   for (const auto& entry : fs::directory_iterator(folder))
-    EXPECT_EQ(entry.path().filename(), "terrain.glb") << "left behind: " << entry.path();
+    EXPECT_EQ(entry.path().filename(), "terrain.raw") << "left behind: " << entry.path();
   const std::string raised = raised_memory(message);
   ASSERT_FALSE(raised.empty()) << message;
   const ChildRun run = run_preprocess(input, folder / "terrain.tpi", raised.c_str());

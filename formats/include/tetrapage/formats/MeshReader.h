@@ -1,8 +1,10 @@
 #pragma once
 /// @file MeshReader.h
 /// Reading meshes into a TriangleSoup. OBJ, PLY and OFF go through streaming readers of our
-/// own that keep double coordinates; STL (float by definition) too; glTF/GLB and the other
-/// formats Assimp knows go through Assimp, which Debian builds in single precision.
+/// own that keep double coordinates; STL and glTF 2.0 (floats by definition) too, a glTF's
+/// node transforms composed in double; what our glTF reader does not read (glTF 1.0, an
+/// extension changing the geometry, sparse accessors) and the other formats Assimp knows go
+/// through Assimp, which Debian builds in single precision.
 
 #include <filesystem>
 #include <functional>
@@ -67,8 +69,10 @@ struct SoupChunks {
 /// time: the chunks appended in order are read_mesh's soup (the same corners, parts and order;
 /// the same report). Returns the parts (part_names, part_paths) and no triangle. OBJ, OFF and
 /// PLY hold their vertex table while they are read, an STL a chunk's vertices; a PLY's part
-/// table, which follows the faces, is read first in a pass of its own. A STEP or IGES file
-/// holds its distinct shapes and places its instances a chunk at a time (TessellatedFile).
+/// table, which follows the faces, is read first in a pass of its own. A glTF holds its JSON's
+/// tables and its vertex table, reading each primitive through a block of its buffer. A STEP
+/// or IGES file holds its distinct shapes and places its instances a chunk at a time
+/// (TessellatedFile).
 /// The other formats MeshReadEstimate::chunked does not name are read whole and handed over
 /// as one chunk.
 /// @throw as read_mesh, and whatever `take` throws.
@@ -96,9 +100,10 @@ void load_readers_for(std::span<const std::filesystem::path> inputs);
 
 /// What reading a mesh file whole will hold, told before reading it from what is cheap to
 /// know: the counts a PLY or OFF header or a binary STL states, else the file's size at the
-/// fewest bytes a triangle took in the files measured (an OBJ, an ASCII STL, a glTF written
-/// with fewer digits or fewer vertices shared holds more). STEP and IGES are known once
-/// tessellated (TessellatedFile::placed_triangles).
+/// fewest bytes a triangle took in the files measured (an OBJ, an ASCII STL, a file Assimp
+/// reads written with fewer digits or fewer vertices shared holds more); a glTF our reader reads
+/// is counted from its JSON. STEP and IGES are known once tessellated
+/// (TessellatedFile::placed_triangles).
 struct MeshReadEstimate {
   std::uint64_t vertices = 0;   ///< the soup's vertex entries (an STL's three a triangle)
   std::uint64_t triangles = 0;  ///< a face a triangle unless the file shows more
