@@ -1,5 +1,5 @@
-// Read throughput of our mesh readers (OBJ, binary STL, binary and ASCII PLY, OFF) and of the
-// Assimp path on the same files (plus GLB), on one generated grid surface of ~2M triangles.
+// Read throughput of our mesh readers (OBJ, binary STL, binary and ASCII PLY, OFF, GLB) and of
+// the Assimp path on the same files, on one generated grid surface of ~2M triangles.
 //
 //   tetrapage_bench_formats [--triangles=N] [--keep] [benchmark flags]
 //
@@ -180,6 +180,7 @@ int main(int argc, char** argv) {
       {"read/ours/ply_binary", "grid.ply", false},
       {"read/ours/ply_ascii", "grid_ascii.ply", false},
       {"read/ours/off", "grid.off", false},
+      {"read/ours/glb", "grid.glb", false},
       {"read/assimp/obj", "grid.obj", true},
       {"read/assimp/stl_binary", "grid.stl", true},
       {"read/assimp/stl_ascii", "grid_ascii.stl", true},

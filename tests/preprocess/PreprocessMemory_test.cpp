@@ -216,6 +216,38 @@ TEST(PreprocessMemory, AGlbTooLargeToReadWholeIsReadInChunksWithinTheBudget) {
   EXPECT_EQ(run.report.at("triangles_read").get<std::uint64_t>(), read_mesh(input).triangle_count());
 }
 
+// A terrain of about 10,000 triangles as one glTF mesh (a data URI) placed by `nodes` nodes, a
+// unit apart: a file of 250 KB that places 10,000 x `nodes` triangles.
+fs::path make_placed_gltf(const fs::path& path, std::size_t nodes) {
+  make_terrain(path, 10'000);
+  nlohmann::json document = nlohmann::json::parse(std::ifstream(path));
+  nlohmann::json placed = nlohmann::json::array(), roots = nlohmann::json::array();
+  for (std::size_t n = 0; n < nodes; ++n) {
+    placed.push_back({{"mesh", 0}, {"translation", {double(n % 20), double(n / 20), 0.0}}});
+    roots.push_back(n);
+  }
+  document["nodes"] = placed;
+  document["scenes"] = nlohmann::json::array({{{"nodes", roots}}});
+  document["scene"] = 0;
+  std::ofstream(path) << document;
+  return path;
+}
+
+// 300 placements of a 10k-triangle mesh in a 258 KB glTF: 3M triangles, which reading whole
+// holds at about 226 MiB. Counted from the JSON (by its size, 24 B a triangle, it was 10,700
+// triangles, read whole through Assimp), it is read in chunks within the promise of
+// --memory 16M.
+TEST(PreprocessMemory, AGltfPlacingOneMeshManyTimesIsReadInChunksWithinTheBudget) {
+  const fs::path folder = test_folder("gltf_placed");
+  const fs::path input = make_placed_gltf(folder / "tiles.gltf", 300);
+  ASSERT_LT(fs::file_size(input), std::uintmax_t(1) << 20);
+  const ChildRun run = run_preprocess(input, folder / "tiles.tpi", "16M");
+  expect_within_promise(run, std::uint64_t(16) << 20);
+  EXPECT_EQ(run.report.value("files_read_in_chunks", 0), 1) << run.report.dump(2);
+  EXPECT_EQ(run.report.at("triangles_read").get<std::uint64_t>(), read_mesh(input).triangle_count());
+  EXPECT_GT(run.report.at("triangles_read").get<std::uint64_t>(), 2'900'000u);
+}
+
 // Assimp's RAW text: a triangle a line, its nine coordinates.
 fs::path write_raw(const fs::path& path, const TriangleSoup& soup) {
   std::ofstream out(path);
