@@ -11,6 +11,7 @@
 
 #include <array>
 #include <assimp/Importer.hpp>
+#include <map>
 #include <set>
 #include <vector>
 
@@ -152,6 +153,7 @@ CadContent import_scene(const std::filesystem::path& path) {
   const std::string stem = path.stem().string();
   CadContent content;
   std::set<std::string> used_names;
+  std::map<std::string, std::uint64_t> next_suffix;
   std::uint64_t vertices = 0;
   for (std::size_t i = 0; i < instances.size(); ++i) {
     const aiNode* node = instances[i].node;
@@ -162,9 +164,13 @@ CadContent import_scene(const std::filesystem::path& path) {
       name = stem + "/" + node_name;
     }
     // Instances of one node name (or unnamed nodes) still get distinct part names.
-    const std::string base_name = name;
-    for (int k = 2; used_names.count(name) > 0; ++k) name = base_name + "#" + std::to_string(k);
-    used_names.insert(name);
+    if (!used_names.insert(name).second) {
+      // Each name's next suffix is kept: n nodes of one name take linear time.
+      std::uint64_t& k = next_suffix.try_emplace(name, 2).first->second;
+      const std::string base_name = name + "#";
+      while (!used_names.insert(base_name + std::to_string(k)).second) ++k;
+      name = base_name + std::to_string(k++);
+    }
     TessellatedShape part;
     part.name = name;
     for (unsigned m = 0; m < node->mNumMeshes; ++m) add_mesh(path, scene, node, m, instances[i].transform, part);

@@ -5,13 +5,22 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstring>
+#include <map>
+#include <set>
 #include <string_view>
 
 #include <nlohmann/json.hpp>
 
-#include "InputFile.h"
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+
 #include "PathSupport.h"
+#include "ReaderSupport.h"
 #include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/QuotedInput.h"
@@ -34,35 +43,40 @@ std::uint32_t little_u32(const char* bytes) {
 
 struct Container {
   std::string json;
+  std::uint64_t file_bytes = 0;
   std::uint64_t bin_offset = 0, bin_length = 0;
   bool has_bin = false;
   bool version_one = false;  // a glTF 1.0 GLB
 };
 
-// A .glb: a 12-byte header (magic, version, length), the JSON chunk, an optional BIN chunk.
-Container read_glb(InputFile& file) {
-  const std::string name = file.name();
+// A .glb: a 12-byte header (magic, version, length), the JSON chunk, then chunks of which the
+// first BIN one is the buffer; others are skipped unread (a reader must ignore them).
+Container read_glb(const ReadOnlyFile& file, const std::string& name) {
   Container out;
-  const std::span<const char> header = file.take(12);
-  if (header.size() < 12 || std::memcmp(header.data(), "glTF", 4) != 0)
+  out.file_bytes = file.size();
+  char header[12];
+  if (file.size() < 12)
+    throw FormatError(name + ": not a GLB file (shorter than its 12-byte header)");
+  file.read_at(0, 12, header);
+  if (std::memcmp(header, "glTF", 4) != 0)
     throw FormatError(name + ": not a GLB file (no 'glTF' magic in its first 4 bytes)");
-  const std::uint32_t version = little_u32(header.data() + 4);
+  const std::uint32_t version = little_u32(header + 4);
   if (version == 1) {
     out.version_one = true;
     return out;
   }
   if (version != 2)
     throw FormatError(name + ": GLB version " + std::to_string(version) + " (readable: 1 and 2)");
-  const std::uint64_t length = little_u32(header.data() + 8);
+  const std::uint64_t length = little_u32(header + 8);
   if (length > file.size())
     throw FormatError(name + ": the GLB header states " + std::to_string(length) +
                       " bytes, the file has " + std::to_string(file.size()));
   std::uint64_t at = 12;
   for (int chunk = 0; at + 8 <= length; ++chunk) {
-    const std::span<const char> chunk_header = file.take(8);
-    if (chunk_header.size() < 8) break;
-    const std::uint64_t chunk_length = little_u32(chunk_header.data());
-    const std::string_view type(chunk_header.data() + 4, 4);
+    char chunk_header[8];
+    file.read_at(at, 8, chunk_header);
+    const std::uint64_t chunk_length = little_u32(chunk_header);
+    const std::string_view type(chunk_header + 4, 4);
     at += 8;
     if (chunk_length > length - at)
       throw FormatError(name + ": GLB chunk " + std::to_string(chunk) + " states " +
@@ -72,15 +86,13 @@ Container read_glb(InputFile& file) {
         throw FormatError(name + ": the GLB's first chunk is not its JSON");
       if (chunk_length > kLargestJson)
         throw FormatError(name + ": the GLB's JSON chunk is larger than 1 GiB");
-      const std::span<const char> text = file.take(static_cast<std::size_t>(chunk_length));
-      out.json.assign(text.data(), text.size());
-    } else if (type == std::string_view("BIN\0", 4) && !out.has_bin) {
+      out.json.resize(static_cast<std::size_t>(chunk_length));
+      file.read_at(at, out.json.size(), out.json.data());
+    } else if (type == std::string_view("BIN\0", 4)) {
       out.has_bin = true;
       out.bin_offset = at;
       out.bin_length = chunk_length;
-      break;  // read through its own file handle when an accessor needs it
-    } else {
-      file.take(static_cast<std::size_t>(chunk_length));  // chunks of unknown types are skipped
+      break;  // read through its own block when an accessor needs it
     }
     at += chunk_length;
   }
@@ -89,15 +101,61 @@ Container read_glb(InputFile& file) {
 }
 
 Container read_container(const fs::path& path, bool binary) {
-  InputFile file(path, std::size_t(1) << 20);
-  if (binary) return read_glb(file);
+  const ReadOnlyFile file(path);
+  if (binary) return read_glb(file, path.string());
   if (file.size() > kLargestJson)
     throw FormatError(path.string() + ": a .gltf larger than 1 GiB (its JSON is held whole)");
   Container out;
-  const std::span<const char> text = file.take(static_cast<std::size_t>(file.size()));
-  out.json.assign(text.data(), text.size());
+  out.file_bytes = file.size();
+  out.json.resize(static_cast<std::size_t>(file.size()));
+  file.read_at(0, out.json.size(), out.json.data());
   return out;
 }
+
+// What nlohmann's document of a JSON text holds, from the text's shape alone (a linear scan, no
+// allocation): a value is 16 B in its array's or object's storage (up to 48 while an array
+// grows: old and new), an object's map 64 B and each member's tree node with its key 96 B, an
+// array's vector 32 B, a string 48 B beside its characters past 15; and the text itself, held
+// while parsed.
+std::uint64_t document_bytes(std::string_view text) {
+  std::uint64_t objects = 0, arrays = 0, strings = 0, scalars = 0, members = 0, long_strings = 0;
+  bool in_string = false, escaped = false, in_scalar = false;
+  std::uint64_t string_length = 0;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) {
+        escaped = false;
+      } else if (c == '\\') {
+        escaped = true;
+      } else if (c == '"') {
+        in_string = false;
+        if (string_length > 15) long_strings += string_length + 1;
+      }
+      ++string_length;
+      continue;
+    }
+    const bool scalar =
+        std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '+' || c == '.';
+    if (scalar && !in_scalar) ++scalars;
+    in_scalar = scalar;
+    if (scalar) continue;
+    if (c == '{') ++objects;
+    if (c == '[') ++arrays;
+    if (c == ':') ++members;
+    if (c == '"') {
+      in_string = true;
+      string_length = 0;
+      ++strings;
+    }
+  }
+  const std::uint64_t value_strings = strings > members ? strings - members : 0;
+  const std::uint64_t values = objects + arrays + scalars + value_strings;
+  return text.size() + 48 * values + 64 * objects + 96 * members + 32 * arrays +
+         48 * value_strings + long_strings;
+}
+
+// A document that would hold more than this is refused before it is parsed.
+constexpr std::uint64_t kLargestDocument = std::uint64_t(4) << 30;
 
 // Field access that names the object at fault.
 class Fields {
@@ -110,6 +168,10 @@ class Fields {
     if (!object_.is_object()) return nullptr;
     const auto it = object_.find(key);
     return it == object_.end() ? nullptr : &*it;
+  }
+  std::uint64_t required_unsigned(const char* key) const {
+    if (!has(key)) fail(std::string("has no ") + key);
+    return unsigned_or(key, 0);
   }
   std::uint64_t unsigned_or(const char* key, std::uint64_t fallback) const {
     const Json* value = find(key);
@@ -190,8 +252,13 @@ Transform local_transform(const Fields& node) {
     return out;
   }
   const auto t = node.numbers_or<3>("translation", {0, 0, 0});
-  const auto q = node.numbers_or<4>("rotation", {0, 0, 0, 1});  // x, y, z, w
+  auto q = node.numbers_or<4>("rotation", {0, 0, 0, 1});  // x, y, z, w
   const auto s = node.numbers_or<3>("scale", {1, 1, 1});
+  // Unit by the format; normalised, so that a rounded or careless one still only rotates.
+  const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(norm > 0) || !std::isfinite(norm))
+    node.fail("its rotation is not a quaternion of finite, non-zero length");
+  for (double& c : q) c /= norm;
   const double x = q[0], y = q[1], z = q[2], w = q[3];
   const double r[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - z * w),     2 * (x * z + y * w),
                        2 * (x * y + z * w),     1 - 2 * (x * x + z * z), 2 * (y * z - x * w),
@@ -269,13 +336,16 @@ class DocumentParser {
     out_.binary = lower_extension(path_) == ".glb";
     Container container = read_container(path_, out_.binary);
     if (container.version_one) return needing_assimp("a glTF 1.0 GLB");
+    out_.stored_bytes = container.file_bytes;
     out_.json_bytes = container.json.size();
-    // Values nested deeper than 64 levels are dropped while parsing: none of what is read here
-    // nests so deep, and a hostile file's nesting costs nothing.
-    const Json::parser_callback_t shallow = [](int level, Json::parse_event_t, Json&) {
-      return level <= 64;
-    };
-    const Json root = Json::parse(container.json, shallow, false);
+    out_.parse_bytes = document_bytes(container.json);
+    if (out_.parse_bytes > kLargestDocument)
+      throw FormatError(name_ + ": its JSON (" + std::to_string(out_.json_bytes) +
+                        " bytes) would take about " + std::to_string(out_.parse_bytes >> 20) +
+                        " MiB as a document, above 4 GiB");
+    // No parser callback: nlohmann's parser keeps its own stack (a file may nest deeply), and
+    // its callback parser rescans a container after every value (quadratic time).
+    const Json root = Json::parse(container.json, nullptr, false);
     container.json = std::string();
     if (root.is_discarded() || !root.is_object())
       throw FormatError(name_ + ": its JSON cannot be parsed (not a glTF)");
@@ -285,14 +355,16 @@ class DocumentParser {
         asset != nullptr ? Fields(name_, *asset, "asset").string_or("version", "") : "";
     if (version.rfind("2.", 0) != 0) return needing_assimp("glTF version " + quoted_input(version));
     for (const Json& extension : top.array("extensionsRequired"))
-      if (!extension.is_string() || !changes_no_geometry(extension.get<std::string>()))
+      if (!extension.is_string() || !changes_no_geometry(extension.get_ref<const std::string&>()))
         return needing_assimp("the required extension " +
-                              (extension.is_string() ? quoted_input(extension.get<std::string>())
-                                                     : std::string("?")));
+                              (extension.is_string()
+                                   ? quoted_input(extension.get_ref<const std::string&>())
+                                   : std::string("?")));
     read_buffers(top, container);
     read_views(top);
     read_accessors(top);
     read_instances(top);
+    if (!out_.needs_assimp.empty()) return needing_assimp(out_.needs_assimp);
     return std::move(out_);
   }
 
@@ -309,8 +381,7 @@ class DocumentParser {
     for (std::size_t b = 0; b < buffers.size(); ++b) {
       const Fields buffer(name_, buffers[b], "buffer " + std::to_string(b));
       GltfBuffer out;
-      out.length = buffer.unsigned_or("byteLength", ~std::uint64_t(0));
-      if (out.length == ~std::uint64_t(0)) buffer.fail("has no byteLength");
+      out.length = buffer.required_unsigned("byteLength");
       const Json* uri = buffer.find("uri");
       if (uri == nullptr) {
         if (!out_.binary || b != 0 || !container.has_bin)
@@ -323,18 +394,25 @@ class DocumentParser {
       } else if (!uri->is_string()) {
         buffer.fail("its uri is not a string");
       } else {
-        locate(uri->get<std::string>(), buffer, out);
+        locate(uri->get_ref<const std::string&>(), buffer, out);
       }
       out_.buffers.push_back(std::move(out));
     }
   }
 
-  // A buffer's URI: a base64 data URI, else a file beside the glTF.
+  // A buffer's URI: a base64 data URI, else a file beside the glTF (a relative path: one
+  // beginning with '/' would read any file the process may read as geometry).
   void locate(const std::string& uri, const Fields& buffer, GltfBuffer& out) {
     if (uri.rfind("data:", 0) == 0) {
       const std::size_t comma = uri.find(',');
       if (comma == std::string::npos || uri.rfind(";base64", comma) == std::string::npos)
         buffer.fail("its data URI is not base64");
+      // Four characters carry three bytes: the URI's length bounds the buffer before decoding.
+      const std::uint64_t most = (uri.size() - comma - 1) / 4 * 3 + 2;
+      if (most < out.length)
+        buffer.fail("states " + std::to_string(out.length) + " bytes, its data URI holds at most " +
+                    std::to_string(most));
+      out_.stored_bytes += out.length;
       if (!load_embedded_) return;
       out.bytes = decode_base64(std::string_view(uri).substr(comma + 1), buffer);
       if (out.bytes.size() < out.length)
@@ -344,7 +422,11 @@ class DocumentParser {
     }
     if (uri.find("://") != std::string::npos)
       buffer.fail("names " + quoted_input(uri) + ", which is not a file");
-    fs::path file = path_.parent_path() / decoded_uri(uri);
+    const std::string decoded = decoded_uri(uri);
+    if (uri.front() == '/' || decoded.front() == '/')
+      buffer.fail("names " + quoted_input(uri) +
+                  ", an absolute path (a buffer's URI is relative to the glTF)");
+    fs::path file = path_.parent_path() / decoded;
     std::error_code error;
     if (!fs::exists(file, error)) file = path_.parent_path() / uri;  // as Assimp opens it
     require_regular_file(file);
@@ -355,6 +437,7 @@ class DocumentParser {
     if (size < out.length)
       buffer.fail("states " + std::to_string(out.length) + " bytes, '" + file.string() +
                   "' holds " + std::to_string(size));
+    if (files_.insert(fs::weakly_canonical(file, error)).second) out_.stored_bytes += size;
     out.file = std::move(file);
   }
 
@@ -365,7 +448,7 @@ class DocumentParser {
       GltfView out;
       out.buffer = view.index("buffer", out_.buffers.size());
       out.offset = view.unsigned_or("byteOffset", 0);
-      out.length = view.unsigned_or("byteLength", 0);
+      out.length = view.required_unsigned("byteLength");
       out.stride = view.unsigned_or("byteStride", 0);
       if (out.stride > 255) view.fail("byteStride " + std::to_string(out.stride) + " above 255");
       const std::uint64_t buffer_length = out_.buffers[out.buffer].length;
@@ -376,17 +459,14 @@ class DocumentParser {
     }
   }
 
+  // Every accessor as the file states it; those a placed primitive uses are checked there.
   void read_accessors(const Fields& top) {
     const Json& accessors = top.array("accessors");
-    sparse_.assign(accessors.size(), false);
     for (std::size_t a = 0; a < accessors.size(); ++a) {
       const Fields accessor(name_, accessors[a], "accessor " + std::to_string(a));
       GltfAccessor out;
-      if (accessor.has("sparse") || !accessor.has("bufferView")) {
-        sparse_[a] = true;  // Assimp's, if a primitive uses it
-      } else {
-        out.view = accessor.index("bufferView", out_.views.size());
-      }
+      out.has_view = accessor.has("bufferView") && !accessor.has("sparse");
+      if (out.has_view) out.view = accessor.index("bufferView", out_.views.size());
       out.offset = accessor.unsigned_or("byteOffset", 0);
       out.count = accessor.unsigned_or("count", 0);
       out.component_type = static_cast<std::uint32_t>(
@@ -396,54 +476,47 @@ class DocumentParser {
     }
   }
 
-  // The scene's nodes depth first (an explicit stack: a file may nest deeply), each node met
-  // once (a node reached twice makes no tree: refused, as it could place itself forever).
+  // The scene's nodes depth first (an explicit stack: a file may nest deeply). A node is marked
+  // when it is pushed, so that a node reached twice (no tree: it could place itself forever) is
+  // refused before the stack grows past the node count.
   void read_instances(const Fields& top) {
     const Json& nodes = top.array("nodes");
-    const std::vector<std::uint64_t> roots = scene_roots(top, nodes);
+    out_.node_count = nodes.size();
     std::vector<bool> met(nodes.size(), false);
     struct Pending {
       std::uint64_t node;
       Transform parent;
     };
     std::vector<Pending> pending;
-    for (auto r = roots.rbegin(); r != roots.rend(); ++r) pending.push_back({*r, kIdentity});
+    const auto push = [&](const Fields& from, std::uint64_t node, const Transform& parent) {
+      if (met[node])
+        from.fail("node " + std::to_string(node) +
+                  " is reached twice in the scene (its nodes make no tree)");
+      met[node] = true;
+      pending.push_back({node, parent});
+    };
+    const std::vector<std::uint64_t> roots = scene_roots(top, nodes);
+    for (auto r = roots.rbegin(); r != roots.rend(); ++r) push(top, *r, kIdentity);
     std::vector<std::pair<std::uint64_t, Transform>> placed;
     while (!pending.empty()) {
       const Pending next = pending.back();
       pending.pop_back();
       const Fields node(name_, nodes[next.node], "node " + std::to_string(next.node));
-      if (met[next.node]) node.fail("is reached twice in the scene (its nodes make no tree)");
-      met[next.node] = true;
       const Transform transform = multiply(next.parent, local_transform(node));
       if (node.has("mesh")) placed.emplace_back(next.node, transform);
       const Json& children = node.array("children");
       for (std::size_t c = children.size(); c-- > 0;)
-        pending.push_back({node.checked_index(children[c], nodes.size(), "child"), transform});
+        push(node, node.checked_index(children[c], nodes.size(), "child"), transform);
     }
-    const Json& meshes = top.array("meshes");
-    const std::string stem = path_.stem().string();
-    for (std::size_t i = 0; i < placed.size(); ++i) {
-      const Fields node(name_, nodes[placed[i].first], "node " + std::to_string(placed[i].first));
-      GltfInstance instance;
-      const std::string node_name = node.string_or("name", "");
-      instance.name =
-          placed.size() == 1
-              ? stem
-              : stem + "/" + (node_name.empty() ? "node" + std::to_string(i) : node_name);
-      instance.transform = placed[i].second;
-      const std::uint64_t mesh = node.index("mesh", meshes.size());
-      read_primitives(Fields(name_, meshes[mesh], "mesh " + std::to_string(mesh)), instance);
-      if (!out_.needs_assimp.empty()) return;
-      if (!instance.primitives.empty()) out_.instances.push_back(std::move(instance));
-    }
+    place(top, nodes, placed);
   }
 
-  // The scene `scene` names, else the first; a file without scenes places every root node.
+  // The root nodes of the scene `scene` names, else of the first; a file without scenes places
+  // every node no other node lists as a child.
   std::vector<std::uint64_t> scene_roots(const Fields& top, const Json& nodes) {
     const Json& scenes = top.array("scenes");
-    std::vector<std::uint64_t> roots;
     const std::uint64_t s = top.has("scene") ? top.index("scene", scenes.size()) : 0;
+    std::vector<std::uint64_t> roots;
     if (!scenes.empty()) {
       const Fields scene(name_, scenes[s], "scene " + std::to_string(s));
       for (const Json& root : scene.array("nodes"))
@@ -461,15 +534,52 @@ class DocumentParser {
     return roots;
   }
 
-  void read_primitives(const Fields& mesh, GltfInstance& instance) {
+  // The placed mesh nodes as instances, each mesh's primitives read once (a mesh no node
+  // places is not read), and the placed vertices counted against what a soup indexes.
+  void place(const Fields& top, const Json& nodes,
+             const std::vector<std::pair<std::uint64_t, Transform>>& placed) {
+    const Json& meshes = top.array("meshes");
+    out_.meshes.resize(meshes.size());
+    std::vector<bool> read(meshes.size(), false);
+    const std::string stem = path_.stem().string();
+    std::uint64_t vertices = 0;
+    for (std::size_t i = 0; i < placed.size(); ++i) {
+      const Fields node(name_, nodes[placed[i].first], "node " + std::to_string(placed[i].first));
+      GltfInstance instance;
+      instance.mesh = node.index("mesh", meshes.size());
+      if (!read[instance.mesh]) {
+        read[instance.mesh] = true;
+        read_primitives(
+            Fields(name_, meshes[instance.mesh], "mesh " + std::to_string(instance.mesh)),
+            out_.meshes[instance.mesh]);
+        if (!out_.needs_assimp.empty()) return;
+      }
+      const std::vector<GltfPrimitive>& primitives = out_.meshes[instance.mesh].primitives;
+      if (primitives.empty()) continue;
+      for (const GltfPrimitive& primitive : primitives)
+        vertices += out_.accessors[primitive.positions].count;
+      if (vertices > max_vertices)
+        throw InputError(name_ + ": its scene places more than " + std::to_string(max_vertices) +
+                         " vertices, more than a soup can index");
+      const std::string node_name = node.string_or("name", "");
+      instance.name =
+          placed.size() == 1
+              ? stem
+              : stem + "/" + (node_name.empty() ? "node" + std::to_string(i) : node_name);
+      instance.transform = placed[i].second;
+      out_.instances.push_back(std::move(instance));
+    }
+  }
+
+  void read_primitives(const Fields& mesh, GltfMesh& out) {
     const Json& primitives = mesh.array("primitives");
     for (std::size_t p = 0; p < primitives.size(); ++p) {
       const Fields primitive(name_, primitives[p], "primitive " + std::to_string(p));
-      GltfPrimitive out;
-      out.mode =
-          static_cast<std::uint32_t>(std::min<std::uint64_t>(primitive.unsigned_or("mode", 4), 7));
-      if (out.mode < 4) continue;  // points and lines bound no surface
-      if (out.mode > 6) primitive.fail("mode " + std::to_string(out.mode) + " (glTF's are 0 to 6)");
+      GltfPrimitive read;
+      const std::uint64_t mode = primitive.unsigned_or("mode", 4);
+      if (mode < 4) continue;  // points and lines bound no surface
+      if (mode > 6) primitive.fail("mode " + std::to_string(mode) + " (glTF's are 0 to 6)");
+      read.mode = static_cast<std::uint32_t>(mode);
       if (const Json* extensions = primitive.find("extensions");
           extensions != nullptr && extensions->is_object())
         for (const auto& [name, value] : extensions->items())
@@ -480,38 +590,122 @@ class DocumentParser {
       const Json* attributes = primitive.find("attributes");
       if (attributes == nullptr || !attributes->is_object() || !attributes->contains("POSITION"))
         continue;
-      out.positions = Fields(name_, *attributes, "primitive " + std::to_string(p) + " attributes")
-                          .index("POSITION", out_.accessors.size());
-      if (primitive.has("indices")) out.indices = primitive.index("indices", out_.accessors.size());
-      if (sparse_[out.positions] || (out.indices && sparse_[*out.indices])) {
+      read.positions = Fields(name_, *attributes, "primitive " + std::to_string(p) + " attributes")
+                           .index("POSITION", out_.accessors.size());
+      if (primitive.has("indices"))
+        read.indices = primitive.index("indices", out_.accessors.size());
+      if (!out_.accessors[read.positions].has_view ||
+          (read.indices && !out_.accessors[*read.indices].has_view)) {
         out_.needs_assimp = "a sparse accessor or one without a bufferView";
         return;
       }
-      instance.primitives.push_back(out);
+      check_positions(read.positions);
+      if (read.indices) check_indices(*read.indices);
+      if (out_.accessors[read.positions].count > 0) out.primitives.push_back(read);
     }
+  }
+
+  void check_positions(std::uint64_t a) {
+    const GltfAccessor& accessor = out_.accessors[a];
+    if (accessor.type != "VEC3" || accessor.component_type != 5126)
+      throw FormatError(name_ + ": accessor " + std::to_string(a) +
+                        ": POSITION is not VEC3 of floats (componentType 5126)");
+    check_range(a, 12);
+  }
+  void check_indices(std::uint64_t a) {
+    const GltfAccessor& accessor = out_.accessors[a];
+    const std::uint32_t type = accessor.component_type;
+    if (accessor.type != "SCALAR" || (type != 5121 && type != 5123 && type != 5125))
+      throw FormatError(
+          name_ + ": accessor " + std::to_string(a) +
+          ": indices are not SCALAR unsigned integers (componentType 5121, 5123 or 5125)");
+    check_range(a, type == 5121 ? 1 : type == 5123 ? 2 : 4);
+  }
+  // The accessor's elements lie within its view (count * stride may not fit 64 bits: compared
+  // by division), so that every count the document holds is backed by bytes of a buffer.
+  void check_range(std::uint64_t a, std::uint64_t element_bytes) {
+    GltfAccessor& accessor = out_.accessors[a];
+    const GltfView& view = out_.views[accessor.view];
+    const std::uint64_t stride = view.stride != 0 ? view.stride : element_bytes;
+    const std::string where = name_ + ": accessor " + std::to_string(a);
+    if (stride < element_bytes)
+      throw FormatError(where + ": byteStride " + std::to_string(stride) + " below its element's " +
+                        std::to_string(element_bytes) + " bytes");
+    const std::uint64_t room = view.length >= accessor.offset ? view.length - accessor.offset : 0;
+    if (accessor.count > 0 &&
+        (room < element_bytes || (accessor.count - 1) > (room - element_bytes) / stride))
+      throw FormatError(where + ": " + std::to_string(accessor.count) + " elements of " +
+                        std::to_string(element_bytes) + " bytes (stride " + std::to_string(stride) +
+                        ") from byte " + std::to_string(accessor.offset) +
+                        " pass the end of its bufferView (" + std::to_string(view.length) +
+                        " bytes)");
+    accessor.stride = stride;
   }
 
   const fs::path& path_;
   const std::string name_;
   const bool load_embedded_;
   GltfDocument out_;
-  std::vector<bool> sparse_;
+  std::set<fs::path> files_;  // the external buffers' files, each counted once
 };
 
 }  // namespace
+
+ReadOnlyFile::ReadOnlyFile(const fs::path& path) : path_(path) {
+  // Non-blocking: opening a FIFO would otherwise wait for a writer forever.
+  descriptor_ = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (descriptor_ < 0)
+    throw IoError("cannot open '" + path.string() + "': " + std::strerror(errno));
+  struct stat status {};
+  if (::fstat(descriptor_, &status) != 0 || !S_ISREG(status.st_mode)) {
+    ::close(descriptor_);
+    descriptor_ = -1;
+    require_regular_file(path);  // throws, naming what it is
+    throw IoError("cannot read '" + path.string() + "': not a regular file");
+  }
+  size_ = static_cast<std::uint64_t>(status.st_size);
+}
+
+ReadOnlyFile::~ReadOnlyFile() {
+  if (descriptor_ >= 0) ::close(descriptor_);
+}
+
+void ReadOnlyFile::read_at(std::uint64_t offset, std::size_t count, char* out) const {
+  std::size_t got = 0;
+  while (got < count) {
+    const ssize_t n =
+        ::pread(descriptor_, out + got, count - got, static_cast<off_t>(offset + got));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw IoError("cannot read '" + path_.string() + "': " + std::strerror(errno));
+    if (n == 0)
+      throw FormatError(path_.string() + ": ends before byte " + std::to_string(offset + count) +
+                        " (changed while read?)");
+    got += static_cast<std::size_t>(n);
+  }
+}
 
 GltfDocument read_gltf_document(const fs::path& path, bool load_embedded) {
   return DocumentParser(path, load_embedded).parse();
 }
 
+std::uint64_t gltf_parse_bytes(const fs::path& path) noexcept {
+  try {
+    const Container container = read_container(path, lower_extension(path) == ".glb");
+    return document_bytes(container.json);
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
 GltfCounts count_placed(const GltfDocument& document) {
   GltfCounts counts;
-  for (const GltfBuffer& buffer : document.buffers) {
-    counts.buffer_bytes += buffer.length;
+  counts.stored_bytes = document.stored_bytes;
+  for (const GltfBuffer& buffer : document.buffers)
     if (buffer.file.empty()) counts.embedded_bytes += buffer.length;
-  }
+  // Each count is backed by its view's bytes and the placed vertices fit 32 bits (checked by
+  // the parse): no sum below wraps.
   for (const GltfInstance& instance : document.instances) {
-    for (const GltfPrimitive& primitive : instance.primitives) {
+    for (const GltfPrimitive& primitive : document.meshes[instance.mesh].primitives) {
       const std::uint64_t vertices = document.accessors[primitive.positions].count;
       const std::uint64_t corners =
           primitive.indices ? document.accessors[*primitive.indices].count : vertices;
@@ -523,16 +717,17 @@ GltfCounts count_placed(const GltfDocument& document) {
 }
 
 std::uint64_t held_bytes(const GltfDocument& document) {
-  std::uint64_t bytes = document.buffers.size() * sizeof(GltfBuffer) +
-                        document.views.size() * sizeof(GltfView) +
-                        document.accessors.size() * sizeof(GltfAccessor);
+  std::uint64_t bytes =
+      document.buffers.size() * sizeof(GltfBuffer) + document.views.size() * sizeof(GltfView) +
+      document.accessors.size() * sizeof(GltfAccessor) + document.meshes.size() * sizeof(GltfMesh);
   for (const GltfBuffer& buffer : document.buffers) bytes += buffer.file.native().capacity();
-  // A part's name in the instance, the soup's names and paths and the builder's set (a tree
-  // node of 64 B beside its string).
-  constexpr std::uint64_t kPartBytes = 3 * sizeof(std::string) + 64;
+  for (const GltfMesh& mesh : document.meshes)
+    bytes += mesh.primitives.capacity() * sizeof(GltfPrimitive);
+  // A part's name in the instance, the soup's names and paths and the builder's set and
+  // suffix table (tree nodes of 64 B beside their strings).
+  constexpr std::uint64_t kPartBytes = 4 * sizeof(std::string) + 128;
   for (const GltfInstance& instance : document.instances)
-    bytes += sizeof(GltfInstance) + instance.primitives.capacity() * sizeof(GltfPrimitive) +
-             kPartBytes + 4 * instance.name.capacity();
+    bytes += sizeof(GltfInstance) + kPartBytes + 5 * instance.name.capacity();
   return bytes;
 }
 

@@ -62,25 +62,28 @@ std::string decoded_uri(const std::string& uri) {
 }
 
 // Every "uri" string member anywhere in a glTF document: buffers and images (glTF 2 lists them
-// in arrays, glTF 1 in objects keyed by id), shaders (glTF 1) and extensions alike.
-void add_uris(const nlohmann::json& value, std::vector<std::string>& uris) {
-  if (value.is_object()) {
-    for (const auto& [key, member] : value.items()) {
-      if (key == "uri" && member.is_string()) uris.push_back(member.get<std::string>());
-      add_uris(member, uris);
+// in arrays, glTF 1 in objects keyed by id), shaders (glTF 1) and extensions alike. Walked with
+// a stack of its own: a document may nest deeply.
+void add_uris(const nlohmann::json& document, std::vector<std::string>& uris) {
+  std::vector<const nlohmann::json*> pending{&document};
+  while (!pending.empty()) {
+    const nlohmann::json& value = *pending.back();
+    pending.pop_back();
+    if (value.is_object()) {
+      for (const auto& [key, member] : value.items()) {
+        if (key == "uri" && member.is_string()) uris.push_back(member.get<std::string>());
+        pending.push_back(&member);
+      }
+    } else if (value.is_array()) {
+      for (const auto& member : value) pending.push_back(&member);
     }
-  } else if (value.is_array()) {
-    for (const auto& member : value) add_uris(member, uris);
   }
 }
 
 // The files a glTF's URIs name (data URIs and other schemes are not files).
 void add_gltf_files(const fs::path& path, bool binary, std::vector<fs::path>& files) {
-  // Values nested deeper than 64 levels are dropped: add_uris recurses, and no glTF nests so.
-  const nlohmann::json::parser_callback_t shallow = [](int level, nlohmann::json::parse_event_t, nlohmann::json&) {
-    return level <= 64;
-  };
-  const nlohmann::json document = nlohmann::json::parse(gltf_json(path, binary), shallow, false);
+  // No parser callback: nlohmann's callback parser rescans a container after each of its values.
+  const nlohmann::json document = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
   if (!document.is_object()) return;
   std::vector<std::string> uris;
   add_uris(document, uris);

@@ -232,27 +232,30 @@ bool header_counts(const std::filesystem::path& path, MeshFormat format, MeshRea
 }
 
 // A glTF our reader reads: its placed counts from the JSON. It holds the JSON's text and its
-// document while parsing it, its decoded data URIs and a block of the buffer beside the soup,
-// or, in chunks, beside the vertex table and a chunk. A document value (16 B in nlohmann's,
-// twice that in an array grown to its size) takes at least 2 bytes of text ("0,"): at most 17
-// bytes a byte of JSON with the text (measured: 7.3 for 100k nodes with names and transforms,
-// 10.8 for arrays of small integers). False when Assimp reads the file or the JSON cannot be
-// read (its read says why).
-constexpr std::uint64_t kJsonBytesPerByte = 17;
-bool gltf_counts(const std::filesystem::path& path, std::uint64_t bytes, MeshReadEstimate& out) {
+// document while parsing it (GltfDocument::parse_bytes, told by the text's shape), the walk's
+// stack and placed nodes (272 B a node), with its tables and decoded data URIs, which stay, and
+// a block of the buffer beside the soup, or, in chunks, beside the vertex table and a chunk. A JSON whose
+// document alone would pass kLargestParsed is not parsed here: estimated by its size, its parse
+// bytes say what reading it needs. False when Assimp reads the file or the JSON cannot be read
+// (its read says why).
+constexpr std::uint64_t kLargestParsed = std::uint64_t(1) << 30;
+bool gltf_counts(const std::filesystem::path& path, MeshReadEstimate& out) {
   try {
+    if (detail::gltf_parse_bytes(path) > kLargestParsed) return false;
     const detail::GltfDocument document = detail::read_gltf_document(path, false);
     if (!document.needs_assimp.empty()) return false;
     const detail::GltfCounts counts = detail::count_placed(document);
     out.vertices = counts.vertices;
     out.triangles = counts.triangles;
     out.counted = true;
-    const std::uint64_t held = kJsonBytesPerByte * document.json_bytes + detail::held_bytes(document) +
-                               counts.embedded_bytes + kReadBlockBytes;
-    // Reserved from the counts up to a third of the file's bytes (a header may lie); more (a
-    // mesh placed many times) grows, old and new arrays together.
-    const std::uint64_t growth = counts.vertices > (bytes + counts.buffer_bytes) / 3 ? 2 : 1;
-    out.reading_bytes = growth * out.soup_bytes() + held;
+    const std::uint64_t parse = document.parse_bytes + 272 * document.node_count;
+    const std::uint64_t held = parse + detail::held_bytes(document) + counts.embedded_bytes + kReadBlockBytes;
+    // Reserved from the counts up to a third (vertices) and a quarter (triangles) of the bytes
+    // stored (counts may lie); more (a mesh placed many times) grows, old and new arrays
+    // together; the degenerate filter's shrink copies the triangles (16 B each with parts).
+    const bool grows = counts.vertices > counts.stored_bytes / 3 || counts.triangles > counts.stored_bytes / 4;
+    const std::uint64_t growth = grows ? 2 : 1;
+    out.reading_bytes = growth * out.soup_bytes() + 16 * counts.triangles + held;
     out.chunked = true;
     out.chunked_bytes = held;
     out.vertex_table_bytes = growth * 24 * counts.vertices;
@@ -277,7 +280,8 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
     return out;
   }
   const std::uint64_t bytes = file_size_or_zero(path);
-  if ((format == MeshFormat::gltf || format == MeshFormat::glb) && gltf_counts(path, bytes, out)) return out;
+  const bool gltf = format == MeshFormat::gltf || format == MeshFormat::glb;
+  if (gltf && gltf_counts(path, out)) return out;
   if (!header_counts(path, format, out)) {
     const SizeRule rule = size_rule(format);
     out.triangles = bytes / rule.bytes_per_triangle + 1;
@@ -299,6 +303,8 @@ MeshReadEstimate estimate_mesh_read(const std::filesystem::path& path) noexcept 
   // Assimp's scene beside the soup: float vertices, faces and their index arrays, the file's
   // buffers (a 1M-triangle GLB peaked 73 MiB with its components).
   if (assimp) out.reading_bytes += 12 * out.vertices + 32 * out.triangles + bytes;
+  // A glTF's JSON parsed (by our reader or Assimp's: at least nlohmann's document).
+  if (gltf) out.reading_bytes += detail::gltf_parse_bytes(path);
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <span>
@@ -71,10 +72,11 @@ class SoupBuilder {
   std::uint32_t begin_part(std::string name, std::string path = {}) {
     if (path.empty()) path = name;
     if (!used_paths_.insert(path).second) {
+      // Each path's next suffix is kept: n parts of one name take linear time, not quadratic.
+      std::uint64_t& k = next_suffix_.try_emplace(path, 2).first->second;
       const std::string taken = path + '#';
-      int k = 2;
       while (!used_paths_.insert(taken + std::to_string(k)).second) ++k;
-      path = taken + std::to_string(k);
+      path = taken + std::to_string(k++);
     }
     if (path == name) path.clear();  // keeps part_paths empty while every path is the name
     part_ = soup_.add_part(std::move(name), std::move(path));
@@ -158,6 +160,7 @@ class SoupBuilder {
   TriangleSoup soup_;
   std::uint32_t part_ = 0;
   std::set<std::string> used_paths_;
+  std::map<std::string, std::uint64_t> next_suffix_;  // a repeated path's next "#k"
   bool vertices_unshared_ = false;
   bool in_polygon_ = false;
   std::uint64_t vertex_base_ = 0;        // vertices let go with earlier chunks
