@@ -310,23 +310,6 @@ std::vector<char> decode_base64(std::string_view text, const Fields& where) {
   return out;
 }
 
-// A URI's percent escapes decoded ("a%20b.bin" -> "a b.bin").
-std::string decoded_uri(const std::string& uri) {
-  std::string path;
-  for (std::size_t i = 0; i < uri.size(); ++i) {
-    const auto hex = [&](std::size_t k) {
-      return std::isxdigit(static_cast<unsigned char>(uri[k])) != 0;
-    };
-    if (uri[i] == '%' && i + 2 < uri.size() && hex(i + 1) && hex(i + 2)) {
-      path += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-      i += 2;
-    } else {
-      path += uri[i];
-    }
-  }
-  return path;
-}
-
 class DocumentParser {
  public:
   DocumentParser(const fs::path& path, bool load_embedded)
@@ -619,7 +602,7 @@ class DocumentParser {
       throw FormatError(
           name_ + ": accessor " + std::to_string(a) +
           ": indices are not SCALAR unsigned integers (componentType 5121, 5123 or 5125)");
-    check_range(a, type == 5121 ? 1 : type == 5123 ? 2 : 4);
+    check_range(a, index_bytes(type));
   }
   // The accessor's elements lie within its view (count * stride may not fit 64 bits: compared
   // by division), so that every count the document holds is backed by bytes of a buffer.
@@ -684,14 +667,34 @@ void ReadOnlyFile::read_at(std::uint64_t offset, std::size_t count, char* out) c
   }
 }
 
+// A URI's percent escapes decoded ("a%20b.bin" -> "a b.bin").
+std::string decoded_uri(const std::string& uri) {
+  std::string path;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    const auto hex = [&](std::size_t k) {
+      return std::isxdigit(static_cast<unsigned char>(uri[k])) != 0;
+    };
+    if (uri[i] == '%' && i + 2 < uri.size() && hex(i + 1) && hex(i + 2)) {
+      path += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+      i += 2;
+    } else {
+      path += uri[i];
+    }
+  }
+  return path;
+}
+
+std::string read_gltf_json(const fs::path& path) {
+  return read_container(path, lower_extension(path) == ".glb").json;
+}
+
 GltfDocument read_gltf_document(const fs::path& path, bool load_embedded) {
   return DocumentParser(path, load_embedded).parse();
 }
 
 std::uint64_t gltf_parse_bytes(const fs::path& path) noexcept {
   try {
-    const Container container = read_container(path, lower_extension(path) == ".glb");
-    return document_bytes(container.json);
+    return document_bytes(read_gltf_json(path));
   } catch (const std::exception&) {
     return 0;
   }

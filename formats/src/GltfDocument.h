@@ -101,6 +101,18 @@ GltfDocument read_gltf_document(const std::filesystem::path& path, bool load_emb
 /// text without parsing it; for a GLB the JSON chunk's. 0 when the file cannot be read.
 std::uint64_t gltf_parse_bytes(const std::filesystem::path& path) noexcept;
 
+/// The JSON text of a .gltf, or of a .glb's JSON chunk (a glTF 1.0 GLB: empty).
+/// @throw IoError, FormatError as read_gltf_document for the container.
+std::string read_gltf_json(const std::filesystem::path& path);
+
+/// A URI's percent escapes decoded ("a%20b.bin" -> "a b.bin").
+std::string decoded_uri(const std::string& uri);
+
+/// The bytes of an index of componentType 5121, 5123 or 5125.
+inline std::size_t index_bytes(std::uint32_t component_type) {
+  return component_type == 5121 ? 1 : component_type == 5123 ? 2 : 4;
+}
+
 /// The vertex and triangle entries the instances place (degenerate ones included).
 struct GltfCounts {
   std::uint64_t vertices = 0, triangles = 0;

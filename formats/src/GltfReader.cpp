@@ -53,22 +53,6 @@ class BufferReader {
   std::uint64_t block_start_ = 0, block_length_ = 0, ahead_end_ = 0;
 };
 
-std::size_t component_bytes(std::uint32_t type) {
-  switch (type) {
-    case 5120:
-    case 5121:
-      return 1;
-    case 5122:
-    case 5123:
-      return 2;
-    case 5125:
-    case 5126:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
 // An accessor's elements in order, where each lies in its buffer (the document checked that
 // they lie within its view, and set its stride).
 class AccessorElements {
@@ -129,7 +113,7 @@ void for_each_corner(const GltfDocument& document, const GltfPrimitive& primitiv
   }
   const GltfAccessor& indices = document.accessors[*primitive.indices];
   const std::string where = accessor_where(file, *primitive.indices);
-  const std::size_t size = component_bytes(indices.component_type);
+  const std::size_t size = index_bytes(indices.component_type);
   AccessorElements elements(document, *primitive.indices, size, reader);
   for (std::uint64_t i = 0; i < elements.count(); ++i) {
     const char* bytes = elements.element(i);

@@ -10,7 +10,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "GltfDocument.h"
 #include "PathSupport.h"
+#include "tetrapage/formats/Error.h"
 #include "tetrapage/formats/FileChecks.h"
 #include "tetrapage/formats/Manifest.h"
 
@@ -19,46 +21,18 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// A glTF's JSON larger than this is not parsed here (its reader refuses it, or reads it
-// without external files worth guarding).
+// A .gltf larger than this is not parsed here (its size is its data URIs: no file names).
 constexpr std::uintmax_t kLargestGltfJson = std::uintmax_t(64) << 20;
 
-// The JSON text of a .gltf, or the JSON chunk of a .glb; empty when it cannot be had.
-std::string gltf_json(const fs::path& path, bool binary) {
+// The JSON of a glTF, or nothing when it cannot be had (its reader then says why).
+std::string gltf_json(const fs::path& path) {
   std::error_code error;
-  if (!fs::is_regular_file(path, error)) return {};
-  std::ifstream in(path, std::ios::binary);
-  if (!binary) {
-    if (fs::file_size(path, error) > kLargestGltfJson || error) return {};
-    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  }
-  // GLB: a 12-byte header, then the JSON chunk's length and type.
-  unsigned char header[20];
-  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return {};
-  std::uint32_t length = 0;
-  std::memcpy(&length, header + 12, 4);  // little-endian, as the machine
-  if (std::memcmp(header, "glTF", 4) != 0 || std::memcmp(header + 16, "JSON", 4) != 0 ||
-      length > kLargestGltfJson)
+  if (detail::lower_extension(path) == ".gltf" && fs::file_size(path, error) > kLargestGltfJson) return {};
+  try {
+    return detail::read_gltf_json(path);
+  } catch (const Error&) {
     return {};
-  std::string text(length, '\0');
-  if (!in.read(text.data(), std::streamsize(length))) return {};
-  return text;
-}
-
-// A URI's percent escapes decoded ("a%20b.bin" -> "a b.bin").
-std::string decoded_uri(const std::string& uri) {
-  std::string path;
-  for (std::size_t i = 0; i < uri.size(); ++i) {
-    if (uri[i] == '%' && i + 2 < uri.size() &&
-        std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
-        std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
-      path += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-      i += 2;
-    } else {
-      path += uri[i];
-    }
   }
-  return path;
 }
 
 // Every "uri" string member anywhere in a glTF document: buffers and images (glTF 2 lists them
@@ -81,9 +55,9 @@ void add_uris(const nlohmann::json& document, std::vector<std::string>& uris) {
 }
 
 // The files a glTF's URIs name (data URIs and other schemes are not files).
-void add_gltf_files(const fs::path& path, bool binary, std::vector<fs::path>& files) {
+void add_gltf_files(const fs::path& path, std::vector<fs::path>& files) {
   // No parser callback: nlohmann's callback parser rescans a container after each of its values.
-  const nlohmann::json document = nlohmann::json::parse(gltf_json(path, binary), nullptr, false);
+  const nlohmann::json document = nlohmann::json::parse(gltf_json(path), nullptr, false);
   if (!document.is_object()) return;
   std::vector<std::string> uris;
   add_uris(document, uris);
@@ -91,14 +65,14 @@ void add_gltf_files(const fs::path& path, bool binary, std::vector<fs::path>& fi
     if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos) continue;
     // Readers differ on percent escapes (Assimp 5.2 opens the URI as written): both count.
     files.push_back(path.parent_path() / uri);
-    if (const std::string decoded = decoded_uri(uri); decoded != uri) files.push_back(path.parent_path() / decoded);
+    if (const std::string decoded = detail::decoded_uri(uri); decoded != uri) files.push_back(path.parent_path() / decoded);
   }
 }
 
 void add_mesh_files(const fs::path& path, std::vector<fs::path>& files) {
   files.push_back(path);
   const std::string extension = detail::lower_extension(path);
-  if (extension == ".gltf" || extension == ".glb") add_gltf_files(path, extension == ".glb", files);
+  if (extension == ".gltf" || extension == ".glb") add_gltf_files(path, files);
 }
 
 void add_manifest_files(const Manifest& manifest, std::set<const Manifest*>& seen,
