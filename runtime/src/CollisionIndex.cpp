@@ -124,6 +124,9 @@ void CollisionIndex::read_components(const std::string& where) {
     if (!(box.lo[0] <= box.hi[0] && box.lo[1] <= box.hi[1] && box.lo[2] <= box.hi[2]))
       throw FormatError(where + schema::table_path(schema::table::component_bounds) +
                         " holds an empty or non-finite box for component " + std::to_string(c));
+    if (component_part_[c] != kNoPart)
+      for (int a = 0; a < 3; ++a)
+        shortest_component_extent_[a] = std::min(shortest_component_extent_[a], box.hi[a] - box.lo[a]);
   }
 }
 

@@ -28,6 +28,7 @@ PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, Placed
       options_(options),
       solid_query_(solid_query),
       all_(options.mode == QueryMode::all_contacts),
+      may_enclose_(model.closed && index.may_hold_a_component(box)),
       box_(box),
       result_(result),
       counters_(result.counters) {
@@ -108,11 +109,15 @@ void PhaseTwo::test_candidate(const Source& source, const geometry::Triangle& en
       magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation[a]));
   const double grow = shapes_.reach() + magnitude * 0x1p-40;
   for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
-  if ((shapes_.own_frame() &&
-       (!geometry::boxes_overlap(query, model_.box) || shapes_.beyond_hull(query))) ||
-      (shapes_.ball_prunes() &&
-       geometry::triangle_outside_ball(framed, model_.ball_centre, model_.ball_radius + grow)) ||
-      !geometry::triangle_intersects_box(environment, box_))
+  // In the object's own frame its box, hull and ball prune; the triangle against the world box
+  // then pruned about one candidate in a thousand on the benchmark flights, for a twentieth of
+  // the step's time: it is asked only of the solids, which have no own frame.
+  if (shapes_.own_frame()
+          ? !geometry::boxes_overlap(query, model_.box) || shapes_.beyond_hull(query)
+          : !geometry::triangle_intersects_box(environment, box_))
+    return;
+  if (shapes_.ball_prunes() &&
+      geometry::triangle_outside_ball(framed, model_.ball_centre, model_.ball_radius + grow))
     return;
   ++counters_.candidates;
   if (solid_query_) {
@@ -131,7 +136,7 @@ void PhaseTwo::note_if_enclosed(const Shard& shard, std::uint32_t local,
                                 const geometry::Triangle& environment) {
   // A component whose box lies in the object's may lie wholly inside it (checked once the
   // step has found no contact).
-  if (!model_.closed || result_.collides) return;
+  if (!may_enclose_ || result_.collides) return;
   const std::uint32_t component = shard.component_id(local);
   if (index_.component_part(component) != CollisionIndex::kNoPart &&
       geometry::box_contains(box_, index_.component_bounds(component)) &&
@@ -168,6 +173,8 @@ void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
     const PruningShapes::NodeReach reach = shapes_.reach_of(b, triangles);
     in_leaf_inside_object = leaves_hold_triangles && reach == PruningShapes::NodeReach::inside;
     counters_.leaves_inside_object += in_leaf_inside_object;
+    // Such a leaf's triangles matter only as part of a component inside the object.
+    if (in_leaf_inside_object && (!may_enclose_ || result_.collides)) return false;
     return reach != PruningShapes::NodeReach::apart;
   };
   if (shapes_.prune_inner())

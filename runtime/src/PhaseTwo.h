@@ -74,6 +74,9 @@ class PhaseTwo {
   const QueryOptions& options_;
   const bool solid_query_;
   const bool all_;
+  /// Some component of a part could lie wholly inside the object (closed, and some
+  /// component fits in the box): only then do the triangles that meet only its inside count.
+  const bool may_enclose_;
   const geometry::Box& box_;
   QueryResult& result_;
   StepCounters& counters_;

@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <random>
 
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/Manifest.h"
@@ -388,24 +389,68 @@ TEST(Interiors, LeavesInsideAClosedObjectAreOnlyNotedAndTheAnswersStayTheOracles
   FlyingObject flying(index, big);
   std::uint64_t leaves_inside = 0;
   int wrong = 0, swallowed = 0;
-  for (const double y : {0.3, 0.5, 0.7}) {
-    for (const Pose& pose : line_poses({0.05, y, 0.5}, {0.95, y, 0.5}, 300, 11)) {
-      const auto expected = oracle.query(pose);
-      const QueryResult got = flying.query(pose);
-      leaves_inside += got.counters.leaves_inside_object;
-      if (expected.obstacle_inside && !expected.surfaces_touch) {
-        ++swallowed;
-        EXPECT_EQ(got.containment, Containment::obstacle_inside_object);
-      }
-      if (got.collides != expected.collides && ++wrong <= 5)
-        ADD_FAILURE() << "y " << y << ": runtime " << got.collides << ", oracle "
-                      << expected.collides;
+  // Three lines through the scene's copies, and one over the small box at 1.2-1.22, which the
+  // object swallows whole for part of the way.
+  std::vector<Pose> poses;
+  for (const double y : {0.3, 0.5, 0.7})
+    for (const Pose& pose : line_poses({0.05, y, 0.5}, {0.95, y, 0.5}, 300, 11))
+      poses.push_back(pose);
+  for (const Pose& pose : line_poses({1.0, 1.21, 1.21}, {1.4, 1.21, 1.21}, 300, 13))
+    poses.push_back(pose);
+  for (const Pose& pose : poses) {
+    const auto expected = oracle.query(pose);
+    const QueryResult got = flying.query(pose);
+    leaves_inside += got.counters.leaves_inside_object;
+    if (expected.obstacle_inside && !expected.surfaces_touch) {
+      ++swallowed;
+      EXPECT_EQ(got.containment, Containment::obstacle_inside_object);
     }
+    if (got.collides != expected.collides && ++wrong <= 5)
+      ADD_FAILURE() << "pose " << pose.translation[0] << " " << pose.translation[1] << ": runtime "
+                    << got.collides << ", oracle " << expected.collides;
   }
   EXPECT_EQ(wrong, 0);
   EXPECT_GT(leaves_inside, 0u) << "no leaf lay inside the box: the test no longer reaches the path";
+  EXPECT_GT(swallowed, 0) << "no copy lay wholly inside the box: containment is not reached";
   RecordProperty("leaves_inside_object", std::to_string(leaves_inside));
   RecordProperty("swallowed", swallowed);
+}
+
+TEST(Interiors, ABoxThatHoldsNoComponentIsToldSoAndNoFittingComponentIsMissed) {
+  // A step whose box fits no component of a part skips the leaves inside the object: the
+  // index's shortcut must never say "none" when some component's box lies in the box (checked
+  // against every component's box, one by one), and must say it for boxes shorter than all.
+  const Model& m = model();
+  const CollisionIndex index(m.index);
+  ASSERT_GT(index.component_count(), 2u);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> centre(-0.2, 1.2), half(0.0, 0.4);
+  int fitting = 0, told_none = 0;
+  for (int i = 0; i < 4000; ++i) {
+    geometry::Box box;
+    for (int a = 0; a < 3; ++a) {
+      const double c = centre(random), h = half(random);
+      box.lo[a] = c - h, box.hi[a] = c + h;
+    }
+    bool fits = false;
+    for (std::uint32_t c = 0; c < index.component_count() && !fits; ++c)
+      fits = index.component_part(c) != CollisionIndex::kNoPart &&
+             geometry::box_contains(box, index.component_bounds(c));
+    const bool may = index.may_hold_a_component(box);
+    if (fits) {
+      ++fitting;
+      EXPECT_TRUE(may) << "box " << i << " holds a component";
+    }
+    told_none += !may;
+  }
+  EXPECT_GT(fitting, 0);
+  EXPECT_GT(told_none, 0);
+  // A box exactly a component's own box holds it.
+  for (std::uint32_t c = 0; c < index.component_count(); ++c) {
+    if (index.component_part(c) != CollisionIndex::kNoPart) {
+      EXPECT_TRUE(index.may_hold_a_component(index.component_bounds(c))) << "component " << c;
+    }
+  }
 }
 
 TEST(Interiors, AnIndexWithoutInteriorsAnswersUnknown) {

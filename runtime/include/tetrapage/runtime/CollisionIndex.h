@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -114,6 +115,14 @@ class CollisionIndex {
     return component < component_closed_.size() && component_closed_[component] != 0;
   }
   const geometry::Box& component_bounds(std::uint32_t component) const { return component_bounds_[component]; }
+  /// False when no component of a part fits inside `box` (along some axis `box` is shorter
+  /// than every such component): a step with that box needs no triangle that meets only the
+  /// object's inside. Exact: rounded extents keep their order.
+  bool may_hold_a_component(const geometry::Box& box) const {
+    for (int a = 0; a < 3; ++a)
+      if (box.hi[a] - box.lo[a] < shortest_component_extent_[a]) return false;
+    return true;
+  }
 
   /// The model's parts: names, instance paths and triangle counts (a contact's
   /// environment_part indexes them).
@@ -173,6 +182,10 @@ class CollisionIndex {
   std::vector<std::uint32_t> component_part_;
   std::vector<std::uint8_t> component_closed_;
   std::vector<geometry::Box> component_bounds_;
+  /// Per axis, the shortest extent of a part's component (infinite when none).
+  Vec3 shortest_component_extent_{std::numeric_limits<double>::infinity(),
+                                  std::numeric_limits<double>::infinity(),
+                                  std::numeric_limits<double>::infinity()};
   IndexParts parts_;
   mutable std::once_flag shard_id_ranges_read_;
   mutable std::vector<std::uint64_t> shard_id_ranges_;  // read on first use

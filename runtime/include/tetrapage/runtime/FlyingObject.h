@@ -105,13 +105,15 @@ struct StepCounters {
   std::uint32_t tets_overlapping = 0;
   std::uint32_t shards_touched = 0;  ///< shards whose bounds met the object's box
   std::uint32_t shard_misses = 0;    ///< shards paged in synchronously by this step
-  /// phase I: shard triangles that meet the object's world box (exactly) and whose boxes, in
-  /// the object's frame, meet its own box (a triangle stored in several of the step's shards
-  /// counts once in a double-precision index), except those of leaves_inside_object
+  /// phase I: shard triangles whose boxes meet the object's world box and, in the object's
+  /// frame, its own box (a solid's: that meet the world box exactly; a triangle stored in
+  /// several of the step's shards counts once in a double-precision index), except those of
+  /// leaves_inside_object
   std::uint64_t candidates = 0;
   /// phase I: R-tree leaves whose box meets no triangle's box of the closed object and lies
   /// inside it (or where the object's interior grid cannot tell): their triangles can touch no
-  /// object triangle and are only noted for containment, not counted as candidates
+  /// object triangle and are only noted for containment, not counted as candidates (nor read,
+  /// when no component of a part fits in the step's box)
   std::uint32_t leaves_inside_object = 0;
   /// phase I: shard triangles skipped because another of the step's shards held them already
   /// (a triangle crossing regions; double-precision indexes, whose copies are identical)
