@@ -110,8 +110,8 @@ void PhaseTwo::test_candidate(const Source& source, const geometry::Triangle& en
   const double grow = shapes_.reach() + magnitude * 0x1p-40;
   for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
   // In the object's own frame its box, hull and ball prune; the triangle against the world box
-  // then pruned about one candidate in a thousand on the benchmark flights, for a twentieth of
-  // the step's time: it is asked only of the solids, which have no own frame.
+  // then pruned no visible share (the elk over the terrain: 28.5 candidates a near step with or
+  // without it) for 5 % of the step's instructions: it is asked only of the solids.
   if (shapes_.own_frame()
           ? !geometry::boxes_overlap(query, model_.box) || shapes_.beyond_hull(query)
           : !geometry::triangle_intersects_box(environment, box_))
@@ -136,7 +136,7 @@ void PhaseTwo::note_if_enclosed(const Shard& shard, std::uint32_t local,
                                 const geometry::Triangle& environment) {
   // A component whose box lies in the object's may lie wholly inside it (checked once the
   // step has found no contact).
-  if (!may_enclose_ || result_.collides) return;
+  if (!inside_counts()) return;
   const std::uint32_t component = shard.component_id(local);
   if (index_.component_part(component) != CollisionIndex::kNoPart &&
       geometry::box_contains(box_, index_.component_bounds(component)) &&
@@ -174,7 +174,7 @@ void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
     in_leaf_inside_object = leaves_hold_triangles && reach == PruningShapes::NodeReach::inside;
     counters_.leaves_inside_object += in_leaf_inside_object;
     // Such a leaf's triangles matter only as part of a component inside the object.
-    if (in_leaf_inside_object && (!may_enclose_ || result_.collides)) return false;
+    if (in_leaf_inside_object && !inside_counts()) return false;
     return reach != PruningShapes::NodeReach::apart;
   };
   if (shapes_.prune_inner())

@@ -61,6 +61,9 @@ class PhaseTwo {
                    std::uint32_t object_triangle);
   void note_if_enclosed(const Shard& shard, std::uint32_t local,
                         const geometry::Triangle& environment);
+  // Triangles that meet only the object's inside still count: some component may lie in it,
+  // and no contact has been found.
+  bool inside_counts() const { return may_enclose_ && !result_.collides; }
 
   const CollisionIndex& index_;
   const ObjectModel& model_;
