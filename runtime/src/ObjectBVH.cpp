@@ -1,6 +1,7 @@
 #include "tetrapage/runtime/geometry/ObjectBVH.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -66,6 +67,8 @@ ObjectBVH::ObjectBVH(std::span<const Vec3> vertices, std::span<const TriangleInd
   triangles_.reserve(triangles.size());
   original_.reserve(triangles.size());
   build(items, source, 0, items.size(), 1);
+  wide_nodes_.reserve(nodes_.size() / 3 + 1);
+  collapse(0);
   position_of_.resize(triangles.size());
   for (std::size_t p = 0; p < original_.size(); ++p) position_of_[original_[p]] = std::uint32_t(p);
 }
@@ -174,8 +177,55 @@ std::uint32_t ObjectBVH::build(std::vector<BuildItem>& items, const std::vector<
   return node_index;
 }
 
+std::uint32_t ObjectBVH::collapse(std::uint32_t node) {
+  // Open the largest inner node among the children (by its box's area) until four are found:
+  // each opened node is replaced by its two children in place, so the order stays left to right.
+  std::array<std::uint32_t, 4> slots{};
+  std::uint32_t used = 0;
+  if (nodes_[node].count > 0) {
+    slots[used++] = node;
+  } else {
+    slots[used++] = node + 1;
+    slots[used++] = nodes_[node].first;
+  }
+  const auto area = [this](std::uint32_t n) {
+    const Node& b = nodes_[n];
+    return half_area(Box{{b.lo[0], b.lo[1], b.lo[2]}, {b.hi[0], b.hi[1], b.hi[2]}});
+  };
+  while (used < 4) {
+    std::uint32_t open = used;
+    for (std::uint32_t c = 0; c < used; ++c)
+      if (nodes_[slots[c]].count == 0 && (open == used || area(slots[c]) > area(slots[open])))
+        open = c;
+    if (open == used) break;  // all leaves
+    const std::uint32_t opened = slots[open];
+    for (std::uint32_t c = used; c > open + 1; --c) slots[c] = slots[c - 1];
+    slots[open] = opened + 1;
+    slots[open + 1] = nodes_[opened].first;
+    ++used;
+  }
+  const auto index = std::uint32_t(wide_nodes_.size());
+  wide_nodes_.emplace_back();
+  WideNode wide{};
+  wide.children = used;
+  for (std::uint32_t c = 0; c < 4; ++c) {
+    for (int k = 0; k < 3; ++k) {
+      // Unused slots are masked out by `children`; their boxes are empty besides.
+      wide.lo[k][c] = c < used ? nodes_[slots[c]].lo[k] : std::numeric_limits<float>::infinity();
+      wide.hi[k][c] = c < used ? nodes_[slots[c]].hi[k] : -std::numeric_limits<float>::infinity();
+    }
+    if (c >= used) continue;
+    const Node& child = nodes_[slots[c]];
+    wide.first[c] = child.count > 0 ? child.first : collapse(slots[c]);
+    wide.count[c] = child.count;
+  }
+  wide_nodes_[index] = wide;
+  return index;
+}
+
 std::size_t ObjectBVH::memory_bytes() const {
-  return nodes_.capacity() * sizeof(Node) + triangles_.capacity() * sizeof(Triangle) +
+  return nodes_.capacity() * sizeof(Node) + wide_nodes_.capacity() * sizeof(WideNode) +
+         triangles_.capacity() * sizeof(Triangle) +
          (original_.capacity() + position_of_.capacity()) * sizeof(std::uint32_t);
 }
 

@@ -220,6 +220,45 @@ TEST(ObjectBVH, RejectsBadObjectsNamingTheElement) {
   }
 }
 
+TEST(ObjectBVH, BoxQueriesOnObjectsOfOneToTwentyTrianglesVisitWhatBruteForceKeeps) {
+  // The wide nodes of small hierarchies: a root that is a leaf, roots with two or three
+  // children, partly filled nodes. Each triangle visited once, none missed.
+  Disagreements disagreements("BVH box query on a small object");
+  std::uint64_t visited_total = 0;
+  for (std::uint32_t size = 1; size <= 20; ++size) {
+    Generator g{std::uint64_t(500 + size)};
+    TriangleSoup object;
+    for (std::uint32_t t = 0; t < size; ++t) {
+      const auto first = std::uint32_t(object.vertices.size());
+      const Vec3 at{g.uniform(-10, 10), g.uniform(-10, 10), g.uniform(-10, 10)};
+      for (int c = 0; c < 3; ++c)
+        object.vertices.push_back(
+            {at[0] + g.uniform(-2, 2), at[1] + g.uniform(-2, 2), at[2] + g.uniform(-2, 2)});
+      object.triangles.push_back({first, first + 1, first + 2});
+    }
+    const ObjectBVH bvh(object);
+    for (std::uint64_t q = 0; q < 200; ++q) {
+      Box box;
+      for (int k = 0; k < 3; ++k) {
+        const double a = g.uniform(-14, 14), b = g.uniform(-14, 14);
+        box.lo[k] = std::min(a, b), box.hi[k] = std::max(a, b);
+      }
+      std::vector<std::uint32_t> visited, expected;
+      bvh.for_each_in_box(box, [&](std::uint32_t t) { return visited.push_back(t), true; });
+      for (std::uint32_t t = 0; t < size; ++t)
+        if (boxes_overlap(box_of(bvh.triangle(t)), box)) expected.push_back(t);
+      std::sort(visited.begin(), visited.end());
+      visited_total += visited.size();
+      if (visited != expected)
+        disagreements.add(q, std::to_string(visited.size()) + " visited, " +
+                                 std::to_string(expected.size()) + " expected, " +
+                                 std::to_string(size) + " triangles");
+    }
+  }
+  disagreements.expect_none(4000);
+  EXPECT_GT(visited_total, 1000u) << "the queries must reach triangles";
+}
+
 TEST(ObjectBVH, HandlesDegenerateLayouts) {
   // Every triangle at the same place (no split possible), and a long line of triangles.
   TriangleSoup same;

@@ -19,6 +19,10 @@
 #include <utility>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/FloatRounding.h"
@@ -78,31 +82,38 @@ class ObjectBVH {
       q.lo[k] = float_below(box.lo[k]);
       q.hi[k] = float_above(box.hi[k]);
     }
-    auto overlaps = [&q](const Node& n) {
-      return n.lo[0] <= q.hi[0] && q.lo[0] <= n.hi[0] && n.lo[1] <= q.hi[1] && q.lo[1] <= n.hi[1] &&
-             n.lo[2] <= q.hi[2] && q.lo[2] <= n.hi[2];
-    };
+    const WideQuery query(q);
     std::uint64_t visited = 0, tests = 0;
-    std::uint32_t stack[kMaxStack];
+    // A leaf's triangles, or a wide node (count 0).
+    struct Entry {
+      std::uint32_t first, count;
+    };
+    Entry stack[kMaxWideStack];
     int top = 0;
-    if (overlaps(nodes_[0])) stack[top++] = 0;
+    // Pushed last to first, so that the children are visited in the binary hierarchy's order.
+    const auto push_children = [&](const WideNode& node) {
+      for (unsigned mask = query.overlapping(node); mask != 0;) {
+        const int c = 31 - __builtin_clz(mask);
+        mask &= ~(1u << c);
+        stack[top++] = {node.first[c], node.count[c]};
+      }
+    };
+    push_children(wide_nodes_[0]);
     while (top > 0) {
-      const Node& node = nodes_[stack[--top]];
-      const std::uint32_t index = std::uint32_t(&node - nodes_.data());
+      const Entry entry = stack[--top];
       ++visited;
-      if (node.count > 0) {
-        for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-          ++tests;
-          const Box own = box_of(triangles_[i]);
-          if (boxes_overlap(box, own) && near(own) && !visit(original_[i])) {
-            top = 0;
-            break;
-          }
-        }
+      if (entry.count == 0) {
+        push_children(wide_nodes_[entry.first]);
         continue;
       }
-      if (overlaps(nodes_[node.first])) stack[top++] = node.first;
-      if (overlaps(nodes_[index + 1])) stack[top++] = index + 1;
+      for (std::uint32_t i = entry.first; i < entry.first + entry.count; ++i) {
+        ++tests;
+        const Box own = box_of(triangles_[i]);
+        if (boxes_overlap(box, own) && near(own) && !visit(original_[i])) {
+          top = 0;
+          break;
+        }
+      }
     }
     if (counters) {
       counters->nodes_visited += visited;
@@ -238,16 +249,71 @@ class ObjectBVH {
     float lo[3], hi[3];
   };
   static constexpr int kMaxStack = 128;  // the build bounds the depth well below this
+  /// Up to four children of the binary hierarchy's nodes, their boxes (its float boxes) as
+  /// structure of arrays, so that a box query tests the four at once. Collapsed from the binary
+  /// hierarchy with the children in its left-to-right order: a query visits the triangles in
+  /// the same order as a descent of the binary one.
+  struct WideNode {
+    float lo[3][4];
+    float hi[3][4];
+    std::uint32_t first[4];  ///< a leaf's first triangle position, or a wide node
+    std::uint32_t count[4];  ///< a leaf's triangles (> 0), or 0 for a wide node
+    std::uint32_t children;  ///< 1 to 4: the slots used, from the first
+  };
+  /// Each level of the wide hierarchy leaves at most three siblings pending.
+  static constexpr int kMaxWideStack = 3 * kMaxStack + 4;
+  /// A box query's bounds, broadcast once for the tests of four children at a time.
+  class WideQuery {
+   public:
+    explicit WideQuery(const FloatBox& q) {
+#if defined(__SSE2__)
+      for (int k = 0; k < 3; ++k) lo_[k] = _mm_set1_ps(q.lo[k]), hi_[k] = _mm_set1_ps(q.hi[k]);
+#else
+      q_ = q;
+#endif
+    }
+    /// Bit c set for each used child c whose box overlaps the query's (NaN overlaps nothing).
+    unsigned overlapping(const WideNode& node) const {
+      const unsigned used = (1u << node.children) - 1;
+#if defined(__SSE2__)
+      __m128 in = _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(node.lo[0]), hi_[0]),
+                             _mm_cmple_ps(lo_[0], _mm_loadu_ps(node.hi[0])));
+      for (int k = 1; k < 3; ++k)
+        in = _mm_and_ps(in, _mm_and_ps(_mm_cmple_ps(_mm_loadu_ps(node.lo[k]), hi_[k]),
+                                       _mm_cmple_ps(lo_[k], _mm_loadu_ps(node.hi[k]))));
+      return unsigned(_mm_movemask_ps(in)) & used;
+#else
+      unsigned mask = 0;
+      for (int c = 0; c < 4; ++c) {
+        bool in = true;
+        for (int k = 0; k < 3; ++k)
+          in = in && node.lo[k][c] <= q_.hi[k] && q_.lo[k] <= node.hi[k][c];
+        mask |= unsigned(in) << c;
+      }
+      return mask & used;
+#endif
+    }
+
+   private:
+#if defined(__SSE2__)
+    __m128 lo_[3], hi_[3];
+#else
+    FloatBox q_;
+#endif
+  };
   struct BuildItem;
 
   std::uint32_t build(std::vector<BuildItem>& items, const std::vector<Triangle>& source,
                       std::size_t begin, std::size_t end, std::size_t depth);
+  /// The wide node over binary node `node`'s descendants (itself, when it is a leaf).
+  std::uint32_t collapse(std::uint32_t node);
 
   template <class Visitor>
   void traverse(const Triangle& query, const Accuracy& accuracy, QueryCounters* counters,
                 Visitor&& visit) const;
 
   std::vector<Node> nodes_;
+  std::vector<WideNode> wide_nodes_;        ///< box queries; the root first
   std::vector<Triangle> triangles_;         ///< in leaf order
   std::vector<std::uint32_t> original_;     ///< input index of each position
   std::vector<std::uint32_t> position_of_;  ///< position of each input index
