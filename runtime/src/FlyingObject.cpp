@@ -184,8 +184,7 @@ void FlyingObject::test_region(const geometry::Box& box, const QueryOptions& opt
                                    index.tet_filter().planes_may_meet(region.tet(k), box));
   };
   region.prefetch_needed(needs);
-  PhaseTwo phase_two(index, *model_, parts.object, shapes, parts.solid, parts.coherence,
-                     parts.containment, parts.met_triangles, parts.contact_triangles, options, solid_query, box, result);
+  PhaseTwo phase_two(parts.step_context(index, *model_, result), options, solid_query, box);
   // One clock pair around the loop (a free step is a few microseconds; a clock read per shard
   // cost a tenth of it): the tests' time is the loop's less the acquisitions'.
   for (std::size_t k = 0; k < region.size() && !phase_two.stopped(); ++k) {
@@ -219,8 +218,7 @@ void FlyingObject::test_obstacles_alone(const geometry::Box& box, const QueryOpt
   Parts& parts = *parts_;
   if (!parts.obstacles || parts.obstacles->size() == 0) return;
   parts.shapes.prepare(*model_, parts.object, box, reach, own_frame, solid_query, shapes_box(box));
-  PhaseTwo phase_two(*index_, *model_, parts.object, parts.shapes, parts.solid, parts.coherence,
-                     parts.containment, parts.met_triangles, parts.contact_triangles, options, solid_query, box, result);
+  PhaseTwo phase_two(parts.step_context(*index_, *model_, result), options, solid_query, box);
   phase_two.test_dynamic_parts(*parts.obstacles, parts.obstacle);
   phase_two.finish();
   parts.containment.check_dynamic(box, parts.object, parts.obstacle, solid_query, result);

@@ -31,10 +31,18 @@ struct FlyingObject::Parts {
   DistanceSearch distance;       ///< the closest pair, and the last one (coherence)
   QueryResult touch;             ///< scratch: the collision step of a distance query
   std::shared_ptr<const DynamicObstacles> obstacles;  ///< merged into every query, or null
-  std::uint64_t obstacles_version = 0;
-  std::uint64_t obstacles_shows = 0;  ///< the overlay's shows() then
-  PlacedObject obstacle;  ///< scratch: a dynamic obstacle placed (rebound to each in turn)  ///<
-                          ///< the overlay's version the free box was found with
+  std::uint64_t obstacles_version = 0;  ///< the overlay's version the free box was found with
+  std::uint64_t obstacles_shows = 0;    ///< the overlay's shows() then
+  PlacedObject obstacle;  ///< scratch: a dynamic obstacle placed (rebound to each in turn)
+
+  /// The parts a step's test of its candidates uses, answering into `result`.
+  StepContext step_context(const CollisionIndex& index, const ObjectModel& model,
+                           QueryResult& result) {
+    return {index,       model,         object,
+            shapes,      solid,         coherence,
+            containment, met_triangles, contact_triangles,
+            result};
+  }
 };
 
 }  // namespace tetrapage

@@ -11,27 +11,24 @@
 
 namespace tetrapage {
 
-PhaseTwo::PhaseTwo(const CollisionIndex& index, const ObjectModel& model, PlacedObject& object,
-                   const PruningShapes& shapes, ObjectSolid& solid, const Coherence& coherence,
-                   ContainmentCheck& containment, TriangleIdSet& met_triangles,
-                   ContactTriangles& contact_triangles, const QueryOptions& options,
-                   bool solid_query, const geometry::Box& box, QueryResult& result)
-    : index_(index),
-      model_(model),
-      object_(object),
-      shapes_(shapes),
-      solid_(solid),
-      coherence_(coherence),
-      containment_(containment),
-      met_triangles_(met_triangles),
-      contact_triangles_(contact_triangles),
+PhaseTwo::PhaseTwo(const StepContext& step, const QueryOptions& options, bool solid_query,
+                   const geometry::Box& box)
+    : index_(step.index),
+      model_(step.model),
+      object_(step.object),
+      shapes_(step.shapes),
+      solid_(step.solid),
+      coherence_(step.coherence),
+      containment_(step.containment),
+      met_triangles_(step.met_triangles),
+      contact_triangles_(step.contact_triangles),
       options_(options),
       solid_query_(solid_query),
       all_(options.mode == QueryMode::all_contacts),
-      may_enclose_(model.closed && index.may_hold_a_component(box)),
+      may_enclose_(step.model.closed && step.index.may_hold_a_component(box)),
       box_(box),
-      result_(result),
-      counters_(result.counters) {
+      result_(step.result),
+      counters_(step.result.counters) {
   solid_.built = false;
   // A triangle stored in several of the step's shards is tested once: exact and double copies
   // are the input's coordinates, the same in every shard (rounded float copies each round to

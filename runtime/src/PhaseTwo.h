@@ -26,15 +26,26 @@ namespace tetrapage {
 /// tested it (its id and corners): the contacts' geometry then needs no lookup by id.
 using ContactTriangles = std::vector<std::pair<std::uint64_t, geometry::Triangle>>;
 
+/// What one step's test of its candidates reads and writes: the index and the object, the
+/// step's placed shapes and scratch, and its answer.
+struct StepContext {
+  const CollisionIndex& index;
+  const ObjectModel& model;
+  PlacedObject& object;
+  const PruningShapes& shapes;
+  ObjectSolid& solid;  ///< built on the first candidate that needs it
+  const Coherence& coherence;
+  ContainmentCheck& containment;
+  TriangleIdSet& met_triangles;
+  ContactTriangles& contact_triangles;
+  QueryResult& result;
+};
+
 class PhaseTwo {
  public:
-  /// The parts one step reads: the phase I box `box`, the object asked as a solid when
-  /// `solid_query` (built on the first candidate that needs it), results into `result`.
-  PhaseTwo(const CollisionIndex& index, const ObjectModel& model, PlacedObject& object,
-           const PruningShapes& shapes, ObjectSolid& solid, const Coherence& coherence,
-           ContainmentCheck& containment, TriangleIdSet& met_triangles,
-           ContactTriangles& contact_triangles, const QueryOptions& options, bool solid_query,
-           const geometry::Box& box, QueryResult& result);
+  /// The step's test with phase I box `box`, the object asked as a solid when `solid_query`.
+  PhaseTwo(const StepContext& step, const QueryOptions& options, bool solid_query,
+           const geometry::Box& box);
 
   /// The shard's candidates, but for those of the parts `overlay` hides (when given).
   void test_shard(const Shard& shard, const DynamicObstacles* overlay = nullptr);
