@@ -5,6 +5,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "Bindings.h"
+#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/IndexSummary.h"
 
 namespace tetrapage::python {
 
@@ -39,32 +41,15 @@ Index open_index(const std::filesystem::path& path, py::handle memory, bool pref
 }
 
 py::dict inspect(const Index& self) {
-  const CollisionIndex& index = *self.index;
-  const IndexHeader& header = index.header();
-  py::dict info;
-  info["path"] = index.path();
-  info["version"] = header.version;
-  info["precision"] = header.precision;
-  info["storage"] = storage_statement(header);
-  info["length_unit"] = header.length_unit;
-  info["input_triangles"] = header.input_triangles;
-  info["stored_triangles"] = header.stored_triangles;
-  info["regions"] = header.region_count;
-  info["shards"] = index.shard_count();
-  info["total_shard_bytes"] = index.total_shard_bytes();
-  std::uint64_t largest_shard = 0;
-  for (std::uint32_t s = 0; s < index.shard_count(); ++s)
-    largest_shard = std::max(largest_shard, index.shard_bytes(s));
-  info["largest_shard_bytes"] = largest_shard;
-  info["memory_budget_bytes"] = index.options().memory_budget_bytes;
-  info["max_rounding_distance"] = header.max_rounding_distance;
-  info["tessellation_deflection"] = header.tessellation_deflection;
-  info["bounds"] = box_array(header.bounds.lo, header.bounds.hi);
-  info["parts"] = index.parts().count();
-  info["components"] = index.component_count();
-  info["interiors"] = index.has_interiors();
-  info["created_by"] = header.created_by;
-  info["source"] = header.source;
+  // The summary `tetrapage inspect --report` writes (read from a reader of its own: the
+  // index's serves its shard cache), and what this opening of the index adds.
+  std::string summary;
+  {
+    py::gil_scoped_release unlocked;
+    summary = IndexSummary::of(IndexReader(self.index->path())).to_json();
+  }
+  py::dict info = py::module_::import("json").attr("loads")(summary);
+  info["memory_budget_bytes"] = self.index->options().memory_budget_bytes;
   return info;
 }
 
@@ -119,13 +104,14 @@ thread, may share one Index.)")
       .def_property_readonly(
           "has_interiors", [](const Index& i) { return i.index->has_interiors(); },
           "Whether containment (an object inside a closed part) is answered.")
-      .def(
-          "object", &make_object, py::arg("mesh"), py::arg("triangles") = py::none(),
-          R"(A FlyingObject: object(model) with a tetrapage.Model (immediate), object(mesh) with a
+      .def("object", &make_object, py::arg("mesh"), py::arg("triangles") = py::none(),
+           R"(A FlyingObject: object(model) with a tetrapage.Model (immediate), object(mesh) with a
 tetrapage.Mesh, or object(vertices, triangles) with an (N, 3) float array and an (M, 3) integer
 array, in the index's coordinates. Building a model (its BVH and hull) takes tens of milliseconds
 for 10,000 triangles and releases the GIL: threads flying one shape share one Model.)")
-      .def("inspect", &inspect, "What `tetrapage inspect` shows, as a dict.")
+      .def("inspect", &inspect,
+           "What `tetrapage inspect --report` writes (the same keys), and the index's "
+           "memory_budget_bytes, as a dict.")
       .def(
           "preload",
           [](const Index& i) {

@@ -21,13 +21,18 @@ def test_touching_is_decided_exactly(cube_index):
 def test_the_summary_and_the_inspection_describe_the_model(cube_index):
     index = tetrapage.Index(cube_index, memory="64M")
     info = index.inspect()
-    assert info["input_triangles"] == 14 and index.triangles == 14
+    assert info["triangles"] == 14 and index.triangles == 14
     assert [p.name for p in index.parts] == ["cube", "plate"]
     assert [p.triangles for p in index.parts] == [12, 2]
     np.testing.assert_array_equal(index.bounds, [[0, 0, 0], [1, 1, 3]])
     assert index.memory == 64 << 20 and index.has_interiors
     assert index.precision == "exact" and info["precision"] == "exact"
     assert index.shard_bytes.sum() == index.total_shard_bytes > 0
+    # The summary `tetrapage inspect --report` writes, under its names.
+    assert info["parts"] == 2 and info["shards"] == len(index.shard_bytes)
+    assert 0 < info["shard_stored_bytes"] and 0 < info["shard_decoded_bytes"]
+    assert info["interiors"] is True and info["memory_budget_bytes"] == 64 << 20
+    assert info["grid_shards"] + info["rtree_shards"] == info["shards"]
     # The default budget is every command's.
     assert tetrapage.Index(cube_index).memory == tetrapage.DEFAULT_MEMORY == 1 << 30
 

@@ -254,5 +254,35 @@ TEST_F(CommandReports, PreprocessAndInspectStateStorageAndInteriorsFiguresWhereT
               "inspect of a float index");
 }
 
+TEST_F(CommandReports, InspectStatesWhatThePreprocessReportedUnderTheSummarysNames) {
+  // The preprocess counted as it wrote; inspect reads the file back (IndexSummary, the figures
+  // Python's Index.inspect() returns under the same names).
+  std::ifstream in(folder_ / "preprocess-double.json");
+  const json preprocess = json::parse(in);
+  const json inspect = report_of("inspect double.tpi --stabbing-segments 0");
+  EXPECT_EQ(inspect.at("triangles"), preprocess.at("triangles_read"));
+  EXPECT_EQ(inspect.at("stored_triangles"), preprocess.at("stored_triangles"));
+  EXPECT_EQ(inspect.at("tets"), preprocess.at("regions"));
+  EXPECT_EQ(inspect.at("grid_shards"), preprocess.at("grid_shards"));
+  EXPECT_EQ(inspect.at("rtree_shards"), preprocess.at("rtree_shards"));
+  EXPECT_EQ(inspect.at("shards").get<std::uint64_t>(),
+            preprocess.at("regions").get<std::uint64_t>() -
+                preprocess.at("empty_regions").get<std::uint64_t>());
+  EXPECT_EQ(inspect.at("parts"), preprocess.at("parts"));
+  EXPECT_EQ(inspect.at("precision"), "double");
+  EXPECT_EQ(inspect.at("interiors"), true);
+  EXPECT_GT(inspect.at("shard_decoded_bytes").get<std::uint64_t>(), 0u);
+  EXPECT_EQ(inspect.at("grid_stored_bytes").get<std::uint64_t>() +
+                inspect.at("rtree_stored_bytes").get<std::uint64_t>(),
+            inspect.at("shard_stored_bytes").get<std::uint64_t>());
+  EXPECT_GE(inspect.at("closed_components").get<std::uint64_t>(), 1u);
+  EXPECT_LE(inspect.at("closed_components"), inspect.at("components"));
+  expect_keys(inspect, {"interior_tets_inside", "interior_tets_undecided", "part_list", "bounds"},
+              true, "inspect of an index with interiors");
+  expect_keys(report_of("inspect float.tpi --stabbing-segments 0"),
+              {"interior_tets_inside", "interior_tets_undecided"}, false,
+              "inspect of an index without interiors");
+}
+
 }  // namespace
 }  // namespace tetrapage

@@ -18,6 +18,7 @@
 #include "tetrapage/formats/IndexParts.h"
 #include "tetrapage/formats/IndexReader.h"
 #include "tetrapage/formats/IndexSchema.h"
+#include "tetrapage/formats/IndexSummary.h"
 #include "tetrapage/formats/Manifest.h"
 #include "tetrapage/formats/MeshReader.h"
 #include "tetrapage/formats/Progress.h"
@@ -153,76 +154,65 @@ struct InteriorFigures {
 
 // The connected components (their part and closedness) and what the interiors tables hold
 // (preprocess --interiors): tets inside a closed component, undecided tets.
-InteriorFigures component_figures(const IndexReader& reader, std::size_t tets) {
-  const auto closed = reader.read_table_uint8(schema::table::component_closed);
-  const auto part = reader.read_table_uint32(schema::table::component_part);
-  std::uint64_t closed_count = 0, parts = 0;
-  for (const auto c : closed) closed_count += c != 0;
-  for (const auto p : part) parts = std::max<std::uint64_t>(parts, std::uint64_t(p) + 1);
+InteriorFigures component_figures(const IndexReader& reader, const IndexSummary& summary) {
   char line[512];
-  std::snprintf(line, sizeof line, "components: %zu in %llu parts (%llu closed, %llu open)", closed.size(),
-                (unsigned long long)parts, (unsigned long long)closed_count,
-                (unsigned long long)(closed.size() - closed_count));
+  std::snprintf(line, sizeof line, "components: %llu in %llu parts (%llu closed, %llu open)",
+                (unsigned long long)summary.components, (unsigned long long)summary.parts,
+                (unsigned long long)summary.closed_components,
+                (unsigned long long)(summary.components - summary.closed_components));
   std::string text = line;
-  nlohmann::json json{{"components", closed.size()}, {"closed_components", closed_count},
-                      {"open_components", closed.size() - closed_count}};
-  const auto names = reader.table_names();
-  if (std::find(names.begin(), names.end(), schema::table::interior_offsets) == names.end()) {
-    json["interiors"] = {{"stored", false}};
+  nlohmann::json json = nlohmann::json::object();
+  if (!summary.interiors)
     return {text + "\ninteriors: not stored (objects inside obstacles go unseen)", json};
-  }
   const auto offsets = reader.read_table_uint64(schema::table::interior_offsets);
   const auto inside_of = reader.read_table_uint32(schema::table::interior_components);
   std::uint64_t inside = 0, undecided = 0;
-  for (std::size_t t = 0; t + 1 < offsets.size() && t < tets; ++t) {
+  for (std::size_t t = 0; t + 1 < offsets.size() && t < summary.tets; ++t) {
     if (offsets[t + 1] == offsets[t]) continue;
     if (offsets[t + 1] - offsets[t] == 1 && offsets[t] < inside_of.size() && inside_of[offsets[t]] == 0xffffffffu) ++undecided;
     else ++inside;
   }
   std::snprintf(line, sizeof line, "\ninteriors: %llu tets with their reference point inside a closed component, %llu undecided",
                 (unsigned long long)inside, (unsigned long long)undecided);
-  json["interiors"] = {{"stored", true}, {"tets_inside", inside}, {"tets_undecided", undecided}};
+  json = {{"interior_tets_inside", inside}, {"interior_tets_undecided", undecided}};
   return {text + line, json};
 }
 
 void run_inspect(const InspectArguments& args) {
   check_outputs_writable({args.report}, {args.index});
   const IndexReader reader(args.index);
-  const IndexHeader& header = reader.header();
+  const IndexSummary summary = IndexSummary::of(reader);
   const TetMesh mesh = reader.read_mesh();
-  const auto shard_kind = reader.read_table_uint8(schema::table::shard_kind);
-  const auto shard_triangles = reader.read_table_uint32(schema::table::shard_triangles);
-  std::uint64_t decoded = 0, stored = 0, kinds[2] = {0, 0}, kind_bytes[2] = {0, 0};
-  std::uint32_t largest = 0, most_triangles = 0;
-  for (std::uint32_t s = 0; s < reader.shard_count(); ++s) {
-    const std::uint64_t stored_bytes = reader.stored_shard_size(s);  // a chunk lookup each
-    decoded += reader.shard_size(s);
-    stored += stored_bytes;
-    const int kind = shard_kind.at(s) == 0 ? 0 : 1;
-    ++kinds[kind];
-    kind_bytes[kind] += stored_bytes;
-    if (reader.shard_size(s) > reader.shard_size(largest)) largest = s;
-    most_triangles = std::max(most_triangles, shard_triangles.at(s));
-  }
-  const double triangles = double(std::max<std::uint64_t>(1, header.input_triangles));
+  const double triangles = double(std::max<std::uint64_t>(1, summary.triangles));
   std::printf("index %s: format version %u, %s coordinates, %s on disk\n", args.index.c_str(),
-              header.version, header.precision.c_str(), format_byte_size(reader.file_bytes()).c_str());
-  std::printf("model: %llu triangles, bounds [%g %g %g]-[%g %g %g]\n", (unsigned long long)header.input_triangles,
-              header.bounds.lo[0], header.bounds.lo[1], header.bounds.lo[2], header.bounds.hi[0], header.bounds.hi[1],
-              header.bounds.hi[2]);
-  std::printf("%s\n", storage_statement(header).c_str());
-  std::printf("coarse mesh: %zu vertices, %zu tets (%zu empty)\n", mesh.vertices.size(), mesh.tet_count(),
-              mesh.tet_count() - reader.shard_count());
-  std::printf("shards: %u (grid %llu, rtree %llu), %llu stored triangles (duplication %.3f), largest %s (%u triangles max)\n",
-              reader.shard_count(), (unsigned long long)kinds[0], (unsigned long long)kinds[1],
-              (unsigned long long)header.stored_triangles, double(header.stored_triangles) / triangles,
-              format_byte_size(reader.shard_size(largest)).c_str(), most_triangles);
-  std::printf("bytes: shards on disk %s (%.1f B/triangle; grid %s, rtree %s), decoded %s (%.1f B/triangle)\n",
-              format_byte_size(stored).c_str(), double(stored) / triangles, format_byte_size(kind_bytes[0]).c_str(),
-              format_byte_size(kind_bytes[1]).c_str(), format_byte_size(decoded).c_str(),
-              double(decoded) / triangles);
+              summary.version, summary.precision.c_str(),
+              format_byte_size(summary.file_bytes).c_str());
+  std::printf("model: %llu triangles, bounds [%g %g %g]-[%g %g %g]\n",
+              (unsigned long long)summary.triangles, summary.bounds.lo[0], summary.bounds.lo[1],
+              summary.bounds.lo[2], summary.bounds.hi[0], summary.bounds.hi[1],
+              summary.bounds.hi[2]);
+  std::printf("%s\n", summary.storage.c_str());
+  std::printf("coarse mesh: %zu vertices, %llu tets (%llu empty)\n", mesh.vertices.size(),
+              (unsigned long long)summary.tets,
+              (unsigned long long)(summary.tets - summary.shards));
+  std::printf(
+      "shards: %llu (grid %llu, rtree %llu), %llu stored triangles (duplication %.3f), largest %s "
+      "(%u triangles max)\n",
+      (unsigned long long)summary.shards, (unsigned long long)summary.grid_shards,
+      (unsigned long long)summary.rtree_shards, (unsigned long long)summary.stored_triangles,
+      double(summary.stored_triangles) / triangles,
+      format_byte_size(summary.largest_shard_bytes).c_str(), summary.largest_shard_triangles);
+  std::printf(
+      "bytes: shards on disk %s (%.1f B/triangle; grid %s, rtree %s), decoded %s (%.1f "
+      "B/triangle)\n",
+      format_byte_size(summary.shard_stored_bytes).c_str(),
+      double(summary.shard_stored_bytes) / triangles,
+      format_byte_size(summary.grid_stored_bytes).c_str(),
+      format_byte_size(summary.rtree_stored_bytes).c_str(),
+      format_byte_size(summary.shard_decoded_bytes).c_str(),
+      double(summary.shard_decoded_bytes) / triangles);
   const nlohmann::json part_json = part_figures(reader, args.parts_listed);
-  const InteriorFigures interiors = component_figures(reader, mesh.tet_count());
+  const InteriorFigures interiors = component_figures(reader, summary);
   std::printf("%s\n", interiors.text.c_str());
   std::optional<StabbingNumbers> stabbing;
   if (args.stabbing_segments > 0) {
@@ -231,7 +221,7 @@ void run_inspect(const InspectArguments& args) {
     StabbingOptions options;
     options.segments = args.stabbing_segments;
     options.seed = args.stabbing_seed;
-    stabbing = measure_stabbing_numbers(faces, header.bounds, options);
+    stabbing = measure_stabbing_numbers(faces, summary.bounds, options);
     std::printf("stabbing number (study 4.2.1: %llu random segments in the model box, tets met per unit length): "
                 "walk %.3f, Embree %.3f; %.2f tets per segment of mean length %.4g; %llu segments differ (%.2f s)\n",
                 (unsigned long long)stabbing->segments, stabbing->walk, stabbing->embree,
@@ -245,21 +235,9 @@ void run_inspect(const InspectArguments& args) {
       std::printf("stabbing: %llu segments left the mesh\n", (unsigned long long)stabbing->incomplete_walks);
   }
   if (!args.report.empty()) {
-    nlohmann::json report{{"index", args.index.string()},
-                          {"version", header.version},
-                          {"precision", header.precision},
-                          {"file_bytes", reader.file_bytes()},
-                          {"triangles", header.input_triangles},
-                          {"stored_triangles", header.stored_triangles},
-                          {"tets", mesh.tet_count()},
-                          {"shards", reader.shard_count()},
-                          {"grid_shards", kinds[0]},
-                          {"rtree_shards", kinds[1]},
-                          {"shard_stored_bytes", stored},
-                          {"shard_decoded_bytes", decoded},
-                          {"components", interiors.json},
-                          {"model", part_json}};
-    if (header.precision == "float") report["max_rounding_distance"] = header.max_rounding_distance;
+    nlohmann::json report = nlohmann::json::parse(summary.to_json());
+    report.update(interiors.json);
+    report["part_list"] = part_json.at("part_list");
     if (stabbing) {
       report["stabbing_segments"] = stabbing->segments;
       report["stabbing_number_walk"] = stabbing->walk;
