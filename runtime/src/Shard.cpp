@@ -222,92 +222,129 @@ bool shard_format::grid_cell_range(double lo, double cell_size, std::uint32_t ce
   return true;
 }
 
-Shard Shard::decode(std::span<const std::byte> payload, std::string_view context,
-                    DecodeChecks checks, std::pmr::memory_resource* memory) {
+/// Shard::decode's steps, one per part of the payload (docs/SHARD-FORMAT.md), in payload order:
+/// each reads its section into the shard and checks it.
+class Shard::Decoder {
+ public:
+  Decoder(std::span<const std::byte> payload, std::string_view context, DecodeChecks checks,
+          Shard& shard)
+      : payload_(payload),
+        in_(payload, context),
+        check_boxes_(checks == DecodeChecks::full),
+        shard_(shard) {}
+
+  void read_header();
+  void read_section_offsets();
+  void read_vertices();
+  void read_triangles();
+  void read_ids_and_parts();
+  void read_grid();
+  void read_rtree();
+
+ private:
+  struct RtreeChecks;
+  std::size_t begin_of(shard_format::Section s) const { return std::size_t(offset_[s]); }
+  std::size_t end_of(shard_format::Section s) const { return std::size_t(offset_[s + 1]); }
+  void check_grid_axes(std::uint64_t& cells) const;
+  void read_grid_references();
+  void read_rtree_node(std::uint32_t i, std::size_t at, RtreeChecks& checks);
+  void round_node_boxes_outward(const std::vector<double>& relative);
+  void check_parents_enclose_children(const std::vector<geometry::Box>& boxes) const;
+
+  std::span<const std::byte> payload_;
+  const Reader in_;
+  const bool check_boxes_;
+  Shard& shard_;
+  std::uint8_t vertex_index_bytes_ = 0, id_bytes_ = 0, part_index_bytes_ = 0, reference_bytes_ = 0;
+  std::uint32_t part_count_ = 0, structure_count_ = 0, reference_count_ = 0;
+  std::array<std::uint64_t, shard_format::section_count + 1> offset_{};
+  /// The stored vertices, kept for the R-tree's leaf checks (cheaper than each triangle's box
+  /// there: a vertex is shared by about six triangles).
+  std::vector<geometry::Point> stored_;
+};
+
+void Shard::Decoder::read_header() {
   namespace sf = shard_format;
-  const Reader in(payload, context);
-  if (payload.size() < sf::kHeaderBytes)
-    in.fail("payload size", payload.size(),
-            "shorter than the " + std::to_string(sf::kHeaderBytes) + "-byte header");
-  if (!std::equal(sf::kMagic.begin(), sf::kMagic.end(), payload.begin()))
-    in.fail("magic", in.at<std::uint32_t>(0), "not a shard payload: expected 'TPSH'");
-  const auto version = in.at<std::uint16_t>(4);
+  if (payload_.size() < sf::kHeaderBytes)
+    in_.fail("payload size", payload_.size(),
+             "shorter than the " + std::to_string(sf::kHeaderBytes) + "-byte header");
+  if (!std::equal(sf::kMagic.begin(), sf::kMagic.end(), payload_.begin()))
+    in_.fail("magic", in_.at<std::uint32_t>(0), "not a shard payload: expected 'TPSH'");
+  const auto version = in_.at<std::uint16_t>(4);
   if (version != sf::kVersion)
-    in.fail("version", version, "this reader knows version " + std::to_string(sf::kVersion));
-
-  const bool check_boxes = checks == DecodeChecks::full;
-  Shard shard(memory != nullptr ? memory : std::pmr::get_default_resource());
-  const auto kind = in.at<std::uint8_t>(6);
-  if (kind > 1) in.fail("kind", unsigned(kind), "0 grid or 1 rtree");
-  shard.kind_ = ShardKind(kind);
-  const auto precision = in.at<std::uint8_t>(7);
-  if (precision > 1) in.fail("precision", unsigned(precision), "0 float32 or 1 float64");
-  shard.precision_ = StoredPrecision(precision);
-  const auto vertex_index_bytes = in.at<std::uint8_t>(8);
-  const auto id_bytes = in.at<std::uint8_t>(9);
-  const auto part_index_bytes = in.at<std::uint8_t>(10);
-  const auto reference_bytes = in.at<std::uint8_t>(11);
-  const auto vertex_count = in.at<std::uint32_t>(12);
-  const auto triangle_count = in.at<std::uint32_t>(16);
-  const auto part_count = in.at<std::uint32_t>(20);
-  const auto structure_count = in.at<std::uint32_t>(24);
-  const auto reference_count = in.at<std::uint32_t>(28);
-  shard.id_base_ = in.at<std::uint64_t>(32);
+    in_.fail("version", version, "this reader knows version " + std::to_string(sf::kVersion));
+  const auto kind = in_.at<std::uint8_t>(6);
+  if (kind > 1) in_.fail("kind", unsigned(kind), "0 grid or 1 rtree");
+  shard_.kind_ = ShardKind(kind);
+  const auto precision = in_.at<std::uint8_t>(7);
+  if (precision > 1) in_.fail("precision", unsigned(precision), "0 float32 or 1 float64");
+  shard_.precision_ = StoredPrecision(precision);
+  vertex_index_bytes_ = in_.at<std::uint8_t>(8);
+  id_bytes_ = in_.at<std::uint8_t>(9);
+  part_index_bytes_ = in_.at<std::uint8_t>(10);
+  reference_bytes_ = in_.at<std::uint8_t>(11);
+  const auto vertex_count = in_.at<std::uint32_t>(12);
+  const auto triangle_count = in_.at<std::uint32_t>(16);
+  part_count_ = in_.at<std::uint32_t>(20);
+  structure_count_ = in_.at<std::uint32_t>(24);
+  reference_count_ = in_.at<std::uint32_t>(28);
+  shard_.id_base_ = in_.at<std::uint64_t>(32);
   for (int k = 0; k < 3; ++k) {
-    shard.origin_[k] = in.at<double>(40 + 8 * k);
-    shard.grid_cells_[k] = in.at<std::uint32_t>(64 + 4 * k);
-    shard.grid_lo_[k] = in.at<double>(80 + 8 * k);
-    shard.grid_cell_size_[k] = in.at<double>(104 + 8 * k);
+    shard_.origin_[k] = in_.at<double>(40 + 8 * k);
+    shard_.grid_cells_[k] = in_.at<std::uint32_t>(64 + 4 * k);
+    shard_.grid_lo_[k] = in_.at<double>(80 + 8 * k);
+    shard_.grid_cell_size_[k] = in_.at<double>(104 + 8 * k);
   }
-  if (!finite(shard.origin_)) in.fail("origin is not finite");
-  if (triangle_count == 0) in.fail("triangle_count", 0, "a shard holds at least one triangle");
-  if (vertex_count == 0) in.fail("vertex_count", 0, "a shard holds at least one vertex");
-  if (vertex_index_bytes != (vertex_count <= 65536 ? 2 : 4))
-    in.fail("vertex_index_bytes", unsigned(vertex_index_bytes),
-            "2 when vertex_count <= 65536, else 4; vertex_count = " + std::to_string(vertex_count));
-  if (id_bytes != 4 && id_bytes != 8) in.fail("id_bytes", unsigned(id_bytes), "4 or 8");
-  if (part_count == 0) in.fail("part_count", 0, "at least one part");
+  if (!finite(shard_.origin_)) in_.fail("origin is not finite");
+  if (triangle_count == 0) in_.fail("triangle_count", 0, "a shard holds at least one triangle");
+  if (vertex_count == 0) in_.fail("vertex_count", 0, "a shard holds at least one vertex");
+  if (vertex_index_bytes_ != (vertex_count <= 65536 ? 2 : 4))
+    in_.fail(
+        "vertex_index_bytes", unsigned(vertex_index_bytes_),
+        "2 when vertex_count <= 65536, else 4; vertex_count = " + std::to_string(vertex_count));
+  if (id_bytes_ != 4 && id_bytes_ != 8) in_.fail("id_bytes", unsigned(id_bytes_), "4 or 8");
+  if (part_count_ == 0) in_.fail("part_count", 0, "at least one part");
   const unsigned expected_part_bytes =
-      part_count == 1 ? 0 : (part_count <= 256 ? 1 : (part_count <= 65536 ? 2 : 4));
-  if (part_index_bytes != expected_part_bytes)
-    in.fail("part_index_bytes", unsigned(part_index_bytes),
-            "expected " + std::to_string(expected_part_bytes) + " for part_count " +
-                std::to_string(part_count));
-  shard.part_index_bytes_ = part_index_bytes;
-  shard.triangle_count_ = triangle_count;
-  shard.vertex_count_ = vertex_count;
+      part_count_ == 1 ? 0 : (part_count_ <= 256 ? 1 : (part_count_ <= 65536 ? 2 : 4));
+  if (part_index_bytes_ != expected_part_bytes)
+    in_.fail("part_index_bytes", unsigned(part_index_bytes_),
+             "expected " + std::to_string(expected_part_bytes) + " for part_count " +
+                 std::to_string(part_count_));
+  shard_.part_index_bytes_ = part_index_bytes_;
+  shard_.triangle_count_ = triangle_count;
+  shard_.vertex_count_ = vertex_count;
+}
 
-  std::array<std::uint64_t, sf::section_count + 1> offset{};
+void Shard::Decoder::read_section_offsets() {
+  namespace sf = shard_format;
   for (std::size_t s = 0; s <= sf::section_count; ++s) {
-    offset[s] = in.at<std::uint64_t>(128 + 8 * s);
-    const std::uint64_t previous = s == 0 ? sf::kHeaderBytes : offset[s - 1];
-    if (offset[s] < previous || offset[s] > payload.size())
-      in.fail(
-          std::string("offset of section ") + section_name(s), offset[s],
-          "must lie in [" + std::to_string(previous) + ", " + std::to_string(payload.size()) + "]");
+    offset_[s] = in_.at<std::uint64_t>(128 + 8 * s);
+    const std::uint64_t previous = s == 0 ? sf::kHeaderBytes : offset_[s - 1];
+    if (offset_[s] < previous || offset_[s] > payload_.size())
+      in_.fail(std::string("offset of section ") + section_name(s), offset_[s],
+               "must lie in [" + std::to_string(previous) + ", " + std::to_string(payload_.size()) +
+                   "]");
   }
-  if (offset[sf::section_count] != payload.size())
-    in.fail("end offset", offset[sf::section_count],
-            "must equal the payload size " + std::to_string(payload.size()));
-  auto begin_of = [&](sf::Section s) { return std::size_t(offset[s]); };
-  auto end_of = [&](sf::Section s) { return std::size_t(offset[s + 1]); };
+  if (offset_[sf::section_count] != payload_.size())
+    in_.fail("end offset", offset_[sf::section_count],
+             "must equal the payload size " + std::to_string(payload_.size()));
+}
 
-  // Vertices.
+void Shard::Decoder::read_vertices() {
+  namespace sf = shard_format;
+  const std::uint32_t vertex_count = shard_.vertex_count_;
   const std::uint64_t coordinates = 3 * std::uint64_t(vertex_count);
-  if (shard.precision_ == StoredPrecision::float32)
-    in.array(shard.vertices32_, begin_of(sf::vertices), end_of(sf::vertices), coordinates,
-             "vertices");
+  const bool float32 = shard_.precision_ == StoredPrecision::float32;
+  if (float32)
+    in_.array(shard_.vertices32_, begin_of(sf::vertices), end_of(sf::vertices), coordinates,
+              "vertices");
   else
-    in.array(shard.vertices64_, begin_of(sf::vertices), end_of(sf::vertices), coordinates,
-             "vertices");
-  // The stored vertices, kept for the R-tree's leaf checks below (cheaper than each
-  // triangle's box there: a vertex is shared by about six triangles).
-  std::vector<geometry::Point> stored;
-  if (check_boxes && shard.kind_ == ShardKind::rtree) {
-    stored.resize(vertex_count);
+    in_.array(shard_.vertices64_, begin_of(sf::vertices), end_of(sf::vertices), coordinates,
+              "vertices");
+  if (check_boxes_ && shard_.kind_ == ShardKind::rtree) {
+    stored_.resize(vertex_count);
     for (std::uint32_t v = 0; v < vertex_count; ++v)
-      stored[v] = shard.precision_ == StoredPrecision::float32 ? shard.stored_vertex<float>(v)
-                                                               : shard.stored_vertex<double>(v);
+      stored_[v] = float32 ? shard_.stored_vertex<float>(v) : shard_.stored_vertex<double>(v);
   }
   // The bounds from the extreme stored values per axis (o + double(r) rounds monotonically in
   // r), in loops the compiler vectorises; the stored vertices are finite when their bounds are.
@@ -322,225 +359,275 @@ Shard Shard::decode(std::span<const std::byte> payload, std::string_view context
         hi[k] = std::max(hi[k], r);
       }
     for (int k = 0; k < 3; ++k) {
-      shard.bounds_.lo[k] = shard.origin_[k] + lo[k];
-      shard.bounds_.hi[k] = shard.origin_[k] + hi[k];
+      shard_.bounds_.lo[k] = shard_.origin_[k] + lo[k];
+      shard_.bounds_.hi[k] = shard_.origin_[k] + hi[k];
     }
-    return !nan && finite(shard.bounds_.lo) && finite(shard.bounds_.hi);
+    return !nan && finite(shard_.bounds_.lo) && finite(shard_.bounds_.hi);
   };
-  const bool all_finite = shard.precision_ == StoredPrecision::float32
-                              ? extremes(shard.vertices32_)
-                              : extremes(shard.vertices64_);
-  if (!all_finite) {
-    for (std::uint32_t v = 0; v < vertex_count; ++v) {
-      const geometry::Point p = shard.precision_ == StoredPrecision::float32
-                                    ? shard.stored_vertex<float>(v)
-                                    : shard.stored_vertex<double>(v);
-      if (!finite(p)) in.fail("stored vertex", v, "its coordinates are not finite");
-    }
-    in.fail("stored vertices' bounds are not finite");
+  if (float32 ? extremes(shard_.vertices32_) : extremes(shard_.vertices64_)) return;
+  for (std::uint32_t v = 0; v < vertex_count; ++v) {
+    const geometry::Point p =
+        float32 ? shard_.stored_vertex<float>(v) : shard_.stored_vertex<double>(v);
+    if (!finite(p)) in_.fail("stored vertex", v, "its coordinates are not finite");
   }
+  in_.fail("stored vertices' bounds are not finite");
+}
 
-  // Triangles.
-  const std::uint64_t corners = 3 * std::uint64_t(triangle_count);
-  if (vertex_index_bytes == 2)
-    in.array(shard.indices16_, begin_of(sf::triangles), end_of(sf::triangles), corners,
-             "triangles");
+void Shard::Decoder::read_triangles() {
+  namespace sf = shard_format;
+  const std::uint64_t corners = 3 * std::uint64_t(shard_.triangle_count_);
+  if (vertex_index_bytes_ == 2)
+    in_.array(shard_.indices16_, begin_of(sf::triangles), end_of(sf::triangles), corners,
+              "triangles");
   else
-    in.array(shard.indices32_, begin_of(sf::triangles), end_of(sf::triangles), corners,
-             "triangles");
-  for (std::uint32_t t = 0; t < triangle_count; ++t)
+    in_.array(shard_.indices32_, begin_of(sf::triangles), end_of(sf::triangles), corners,
+              "triangles");
+  for (std::uint32_t t = 0; t < shard_.triangle_count_; ++t)
     for (int k = 0; k < 3; ++k)
-      if (shard.corner(t, k) >= vertex_count)
-        in.fail("corner " + std::to_string(k) + " of triangle " + std::to_string(t),
-                shard.corner(t, k), "vertex_count is " + std::to_string(vertex_count));
+      if (shard_.corner(t, k) >= shard_.vertex_count_)
+        in_.fail("corner " + std::to_string(k) + " of triangle " + std::to_string(t),
+                 shard_.corner(t, k), "vertex_count is " + std::to_string(shard_.vertex_count_));
+}
 
-  // Ids and parts.
-  if (id_bytes == 4)
-    in.array(shard.id_offsets32_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
+void Shard::Decoder::read_ids_and_parts() {
+  namespace sf = shard_format;
+  const std::uint32_t triangle_count = shard_.triangle_count_;
+  if (id_bytes_ == 4)
+    in_.array(shard_.id_offsets32_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
   else
-    in.array(shard.id_offsets64_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
-  in.array(shard.part_palette_, begin_of(sf::part_palette), end_of(sf::part_palette), part_count,
-           "part_palette");
-  in.array(shard.part_indices_, begin_of(sf::part_indices), end_of(sf::part_indices),
-           std::uint64_t(triangle_count) * part_index_bytes, "part_indices");
+    in_.array(shard_.id_offsets64_, begin_of(sf::ids), end_of(sf::ids), triangle_count, "ids");
+  in_.array(shard_.part_palette_, begin_of(sf::part_palette), end_of(sf::part_palette), part_count_,
+            "part_palette");
+  in_.array(shard_.part_indices_, begin_of(sf::part_indices), end_of(sf::part_indices),
+            std::uint64_t(triangle_count) * part_index_bytes_, "part_indices");
   // One loop per index width: a copy of a variable width per triangle was an eighth of decode.
   auto check_part_indices = [&]<class Index>() {
     for (std::uint32_t t = 0; t < triangle_count; ++t) {
       Index i = 0;
-      std::memcpy(&i, shard.part_indices_.data() + std::size_t(t) * sizeof(Index), sizeof(Index));
-      if (i >= part_count)
-        in.fail("part index of triangle " + std::to_string(t), std::uint32_t(i),
-                "part_count is " + std::to_string(part_count));
+      std::memcpy(&i, shard_.part_indices_.data() + std::size_t(t) * sizeof(Index), sizeof(Index));
+      if (i >= part_count_)
+        in_.fail("part index of triangle " + std::to_string(t), std::uint32_t(i),
+                 "part_count is " + std::to_string(part_count_));
     }
   };
-  if (part_index_bytes == 1) check_part_indices.template operator()<std::uint8_t>();
-  if (part_index_bytes == 2) check_part_indices.template operator()<std::uint16_t>();
-  if (part_index_bytes == 4) check_part_indices.template operator()<std::uint32_t>();
+  if (part_index_bytes_ == 1) check_part_indices.template operator()<std::uint8_t>();
+  if (part_index_bytes_ == 2) check_part_indices.template operator()<std::uint16_t>();
+  if (part_index_bytes_ == 4) check_part_indices.template operator()<std::uint32_t>();
+}
 
-  if (shard.kind_ == ShardKind::grid) {
-    std::uint64_t cells = 1;
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t n = shard.grid_cells_[k];
-      if (n == 0) in.fail("grid cells along axis " + std::to_string(k), 0, "at least 1");
-      cells *= n;  // < 2^96 cannot overflow before the check below stops it
-      if (cells > structure_count)
-        in.fail("grid cell count", cells,
-                "the product of cells per axis must equal structure_count " +
-                    std::to_string(structure_count));
-      if (!(std::isfinite(shard.grid_lo_[k]) && std::isfinite(shard.grid_cell_size_[k]) &&
-            shard.grid_cell_size_[k] > 0 && std::isfinite(shard.grid_boundary(k, n))))
-        in.fail(
-            "grid lo / cell size along axis " + std::to_string(k),
-            std::to_string(shard.grid_lo_[k]) + " / " + std::to_string(shard.grid_cell_size_[k]),
-            "finite, with a positive cell size");
-      if (!(shard.grid_boundary(k, 0) <= shard.bounds_.lo[k] &&
-            shard.bounds_.hi[k] <= shard.grid_boundary(k, n)))
-        in.fail("grid extent along axis " + std::to_string(k),
-                std::to_string(shard.grid_boundary(k, 0)) + ".." +
-                    std::to_string(shard.grid_boundary(k, n)),
-                "must hold every stored vertex");
-    }
-    if (cells != structure_count)
-      in.fail("grid cell count", cells,
-              "must equal structure_count " + std::to_string(structure_count));
-    if (reference_bytes != (triangle_count <= 65536 ? 2 : 4))
-      in.fail("reference_bytes", unsigned(reference_bytes),
-              "2 when triangle_count <= 65536, else 4");
-    in.array(shard.cell_offsets_, begin_of(sf::structure), end_of(sf::structure), cells + 1,
-             "structure");
-    if (shard.cell_offsets_[0] != 0) in.fail("offset of cell 0", shard.cell_offsets_[0], "0");
-    for (std::uint64_t c = 0; c < cells; ++c)
-      if (shard.cell_offsets_[c + 1] < shard.cell_offsets_[c])
-        in.fail(
-            "offset of cell " + std::to_string(c + 1), shard.cell_offsets_[c + 1],
-            "offsets must not decrease; the previous is " + std::to_string(shard.cell_offsets_[c]));
-    if (shard.cell_offsets_[cells] != reference_count)
-      in.fail("last cell offset", shard.cell_offsets_[cells],
-              "must equal reference_count " + std::to_string(reference_count));
-    if (reference_bytes == 2)
-      in.array(shard.references16_, begin_of(sf::references), end_of(sf::references),
-               reference_count, "references");
-    else
-      in.array(shard.references32_, begin_of(sf::references), end_of(sf::references),
-               reference_count, "references");
-    for (std::uint32_t r = 0; r < reference_count; ++r) {
-      const std::uint32_t t =
-          reference_bytes == 2 ? shard.references16_[r] : shard.references32_[r];
-      if (t >= triangle_count)
-        in.fail("reference " + std::to_string(r), t,
-                "triangle_count is " + std::to_string(triangle_count));
-    }
-  } else {
-    if (reference_count != 0 || reference_bytes != 0)
-      in.fail("reference_count / reference_bytes of an R-tree",
-              std::to_string(reference_count) + " / " + std::to_string(reference_bytes), "0");
-    if (structure_count == 0) in.fail("R-tree node count", 0, "at least the root");
-    const std::size_t record = sf::node_record_bytes(shard.precision_);
-    const std::size_t begin = begin_of(sf::structure);
-    if (std::uint64_t(structure_count) > (end_of(sf::structure) - begin) / record)
-      in.fail("R-tree node count", structure_count,
-              "the structure section holds " + std::to_string(end_of(sf::structure) - begin) +
-                  " bytes of " + std::to_string(record) + "-byte nodes");
-    shard.nodes_.resize(structure_count);
-    shard.node_stride_ = std::size_t(structure_count) + kNodeBoxPadding;
-    // The padding holds empty boxes (never read into a result: children past a node's count
-    // are masked off).
-    shard.node_boxes_.assign(6 * shard.node_stride_, 0.0f);
-    // The stored coordinates by axis, converted to floats in one pass after the loop.
+void Shard::Decoder::check_grid_axes(std::uint64_t& cells) const {
+  cells = 1;
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t n = shard_.grid_cells_[k];
+    if (n == 0) in_.fail("grid cells along axis " + std::to_string(k), 0, "at least 1");
+    cells *= n;  // < 2^96 cannot overflow before the check below stops it
+    if (cells > structure_count_)
+      in_.fail("grid cell count", cells,
+               "the product of cells per axis must equal structure_count " +
+                   std::to_string(structure_count_));
+    if (!(std::isfinite(shard_.grid_lo_[k]) && std::isfinite(shard_.grid_cell_size_[k]) &&
+          shard_.grid_cell_size_[k] > 0 && std::isfinite(shard_.grid_boundary(k, n))))
+      in_.fail(
+          "grid lo / cell size along axis " + std::to_string(k),
+          std::to_string(shard_.grid_lo_[k]) + " / " + std::to_string(shard_.grid_cell_size_[k]),
+          "finite, with a positive cell size");
+    if (!(shard_.grid_boundary(k, 0) <= shard_.bounds_.lo[k] &&
+          shard_.bounds_.hi[k] <= shard_.grid_boundary(k, n)))
+      in_.fail("grid extent along axis " + std::to_string(k),
+               std::to_string(shard_.grid_boundary(k, 0)) + ".." +
+                   std::to_string(shard_.grid_boundary(k, n)),
+               "must hold every stored vertex");
+  }
+  if (cells != structure_count_)
+    in_.fail("grid cell count", cells,
+             "must equal structure_count " + std::to_string(structure_count_));
+}
+
+void Shard::Decoder::read_grid() {
+  namespace sf = shard_format;
+  std::uint64_t cells = 0;
+  check_grid_axes(cells);
+  if (reference_bytes_ != (shard_.triangle_count_ <= 65536 ? 2 : 4))
+    in_.fail("reference_bytes", unsigned(reference_bytes_),
+             "2 when triangle_count <= 65536, else 4");
+  std::pmr::vector<std::uint32_t>& offsets = shard_.cell_offsets_;
+  in_.array(offsets, begin_of(sf::structure), end_of(sf::structure), cells + 1, "structure");
+  if (offsets[0] != 0) in_.fail("offset of cell 0", offsets[0], "0");
+  for (std::uint64_t c = 0; c < cells; ++c)
+    if (offsets[c + 1] < offsets[c])
+      in_.fail("offset of cell " + std::to_string(c + 1), offsets[c + 1],
+               "offsets must not decrease; the previous is " + std::to_string(offsets[c]));
+  if (offsets[cells] != reference_count_)
+    in_.fail("last cell offset", offsets[cells],
+             "must equal reference_count " + std::to_string(reference_count_));
+  read_grid_references();
+}
+
+void Shard::Decoder::read_grid_references() {
+  namespace sf = shard_format;
+  if (reference_bytes_ == 2)
+    in_.array(shard_.references16_, begin_of(sf::references), end_of(sf::references),
+              reference_count_, "references");
+  else
+    in_.array(shard_.references32_, begin_of(sf::references), end_of(sf::references),
+              reference_count_, "references");
+  for (std::uint32_t r = 0; r < reference_count_; ++r) {
+    const std::uint32_t t =
+        reference_bytes_ == 2 ? shard_.references16_[r] : shard_.references32_[r];
+    if (t >= shard_.triangle_count_)
+      in_.fail("reference " + std::to_string(r), t,
+               "triangle_count is " + std::to_string(shard_.triangle_count_));
+  }
+}
+
+/// What the R-tree's nodes must agree on, gathered as they are read.
+struct Shard::Decoder::RtreeChecks {
+  RtreeChecks(std::uint32_t nodes, std::uint32_t triangles, bool check_boxes)
+      : relative(thread_relative()), depth(nodes, 0), has_parent(nodes, 0), covered(triangles, 0) {
+    relative.resize(6 * std::size_t(nodes));
+    if (check_boxes) boxes.resize(nodes);
+  }
+  // Reused by the thread's decodes (converted to floats in one pass after the nodes' loop).
+  static std::vector<double>& thread_relative() {
     thread_local std::vector<double> relative;
-    relative.resize(6 * std::size_t(structure_count));
-    std::vector<geometry::Box> boxes;  // in double, for the enclosure checks
-    if (check_boxes) boxes.resize(structure_count);
-    std::vector<std::uint32_t> depth(structure_count, 0);
-    std::vector<std::uint8_t> has_parent(structure_count, 0);
-    std::vector<std::uint8_t> covered(triangle_count, 0);
-    std::uint64_t leaf_triangles = 0;
-    for (std::uint32_t i = 0; i < structure_count; ++i) {
-      Node& node = shard.nodes_[i];
-      const std::size_t at = begin + std::size_t(i) * record;
-      geometry::Box box;
-      for (int k = 0; k < 3; ++k) {
-        const double lo = shard.precision_ == StoredPrecision::float32
-                              ? double(in.at<float>(at + 4 * k))
-                              : in.at<double>(at + 8 * k);
-        const double hi = shard.precision_ == StoredPrecision::float32
-                              ? double(in.at<float>(at + 12 + 4 * k))
-                              : in.at<double>(at + 24 + 8 * k);
-        box.lo[k] = shard.origin_[k] + lo;
-        box.hi[k] = shard.origin_[k] + hi;
-        relative[k * structure_count + i] = lo;
-        relative[(3 + k) * structure_count + i] = hi;
-      }
-      node.first = in.at<std::uint32_t>(at + record - 8);
-      node.count = in.at<std::uint32_t>(at + record - 4);
-      if (!finite(box.lo) || !finite(box.hi))
-        in.fail("box of R-tree node", i, "its coordinates are not finite");
-      if (check_boxes) boxes[i] = box;
-      if (i > 0 && !has_parent[i]) in.fail("R-tree node", i, "no node lists it as a child");
-      const std::uint32_t count = node.count & ~sf::kLeafFlag;
-      if (node.count & sf::kLeafFlag) {
-        if (count == 0 || node.first > triangle_count || count > triangle_count - node.first)
-          in.fail("triangle range of R-tree leaf " + std::to_string(i),
-                  std::to_string(node.first) + "+" + std::to_string(count),
-                  "non-empty, within triangle_count " + std::to_string(triangle_count));
-        for (std::uint32_t t = node.first; t < node.first + count; ++t) {
-          if (covered[t]) in.fail("triangle " + std::to_string(t), "", "in two R-tree leaves");
-          covered[t] = 1;
-          if (check_boxes)
-            for (int k = 0; k < 3; ++k)
-              if (!geometry::box_contains(box, stored[shard.corner(t, k)]))
-                in.fail("box of R-tree leaf " + std::to_string(i), "",
-                        "does not enclose its triangle " + std::to_string(t));
-        }
-        leaf_triangles += count;
-      } else {
-        if (count == 0 || count > sf::kMaxFanout || node.first <= i ||
-            node.first > structure_count || count > structure_count - node.first)
-          in.fail("children of R-tree node " + std::to_string(i),
-                  std::to_string(node.first) + "+" + std::to_string(count),
-                  "1.." + std::to_string(sf::kMaxFanout) + " nodes after it, within " +
-                      std::to_string(structure_count));
-        if (depth[i] + 1 >= sf::kMaxDepth)
-          in.fail("depth of R-tree node " + std::to_string(i), depth[i] + 1,
-                  "at most " + std::to_string(sf::kMaxDepth - 1));
-        for (std::uint32_t c = node.first; c < node.first + count; ++c) {
-          if (has_parent[c]) in.fail("R-tree node", c, "listed as a child twice");
-          has_parent[c] = 1;
-          depth[c] = depth[i] + 1;
-        }
-      }
+    return relative;
+  }
+  std::vector<double>& relative;     ///< the stored coordinates by axis, lo then hi
+  std::vector<geometry::Box> boxes;  ///< in double, for the enclosure checks
+  std::vector<std::uint32_t> depth;
+  std::vector<std::uint8_t> has_parent;
+  std::vector<std::uint8_t> covered;  ///< triangles in a leaf read so far
+  std::uint64_t leaf_triangles = 0;
+};
+
+void Shard::Decoder::read_rtree() {
+  namespace sf = shard_format;
+  if (reference_count_ != 0 || reference_bytes_ != 0)
+    in_.fail("reference_count / reference_bytes of an R-tree",
+             std::to_string(reference_count_) + " / " + std::to_string(reference_bytes_), "0");
+  if (structure_count_ == 0) in_.fail("R-tree node count", 0, "at least the root");
+  const std::size_t record = sf::node_record_bytes(shard_.precision_);
+  const std::size_t begin = begin_of(sf::structure);
+  if (std::uint64_t(structure_count_) > (end_of(sf::structure) - begin) / record)
+    in_.fail("R-tree node count", structure_count_,
+             "the structure section holds " + std::to_string(end_of(sf::structure) - begin) +
+                 " bytes of " + std::to_string(record) + "-byte nodes");
+  shard_.nodes_.resize(structure_count_);
+  shard_.node_stride_ = std::size_t(structure_count_) + kNodeBoxPadding;
+  // The padding holds empty boxes (never read into a result: children past a node's count
+  // are masked off).
+  shard_.node_boxes_.assign(6 * shard_.node_stride_, 0.0f);
+  RtreeChecks checks(structure_count_, shard_.triangle_count_, check_boxes_);
+  for (std::uint32_t i = 0; i < structure_count_; ++i)
+    read_rtree_node(i, begin + std::size_t(i) * record, checks);
+  round_node_boxes_outward(checks.relative);
+  if (checks.leaf_triangles != shard_.triangle_count_)
+    in_.fail("triangles in R-tree leaves", checks.leaf_triangles,
+             "must equal triangle_count " + std::to_string(shard_.triangle_count_));
+  if (check_boxes_) check_parents_enclose_children(checks.boxes);
+}
+
+void Shard::Decoder::read_rtree_node(std::uint32_t i, std::size_t at, RtreeChecks& checks) {
+  namespace sf = shard_format;
+  const std::size_t record = sf::node_record_bytes(shard_.precision_);
+  const bool float32 = shard_.precision_ == StoredPrecision::float32;
+  Node& node = shard_.nodes_[i];
+  geometry::Box box;
+  for (int k = 0; k < 3; ++k) {
+    const double lo = float32 ? double(in_.at<float>(at + 4 * k)) : in_.at<double>(at + 8 * k);
+    const double hi =
+        float32 ? double(in_.at<float>(at + 12 + 4 * k)) : in_.at<double>(at + 24 + 8 * k);
+    box.lo[k] = shard_.origin_[k] + lo;
+    box.hi[k] = shard_.origin_[k] + hi;
+    checks.relative[k * structure_count_ + i] = lo;
+    checks.relative[(3 + k) * structure_count_ + i] = hi;
+  }
+  node.first = in_.at<std::uint32_t>(at + record - 8);
+  node.count = in_.at<std::uint32_t>(at + record - 4);
+  if (!finite(box.lo) || !finite(box.hi))
+    in_.fail("box of R-tree node", i, "its coordinates are not finite");
+  if (check_boxes_) checks.boxes[i] = box;
+  if (i > 0 && !checks.has_parent[i]) in_.fail("R-tree node", i, "no node lists it as a child");
+  const std::uint32_t count = node.count & ~sf::kLeafFlag;
+  const std::uint32_t triangle_count = shard_.triangle_count_;
+  if (node.count & sf::kLeafFlag) {
+    if (count == 0 || node.first > triangle_count || count > triangle_count - node.first)
+      in_.fail("triangle range of R-tree leaf " + std::to_string(i),
+               std::to_string(node.first) + "+" + std::to_string(count),
+               "non-empty, within triangle_count " + std::to_string(triangle_count));
+    for (std::uint32_t t = node.first; t < node.first + count; ++t) {
+      if (checks.covered[t]) in_.fail("triangle " + std::to_string(t), "", "in two R-tree leaves");
+      checks.covered[t] = 1;
+      if (check_boxes_)
+        for (int k = 0; k < 3; ++k)
+          if (!geometry::box_contains(box, stored_[shard_.corner(t, k)]))
+            in_.fail("box of R-tree leaf " + std::to_string(i), "",
+                     "does not enclose its triangle " + std::to_string(t));
     }
-    // Rounded outward by a float's unit in the last place (at least; values near zero by the
-    // smallest normal float: a subnormal operand costs a microcode assist, which made decode
-    // of a float32 R-tree a quarter slower), clamped to the finite floats.
-    constexpr double kMost = std::numeric_limits<float>::max();
-    constexpr float kTiny = std::numeric_limits<float>::min();
-    double largest = 0;
-    for (std::size_t k = 0; k < 6; ++k) {
-      const double* from = relative.data() + k * structure_count;
-      float* to = shard.node_boxes_.data() + k * shard.node_stride_;
-      const float side = k < 3 ? -1.0f : 1.0f;
-      for (std::uint32_t i = 0; i < structure_count; ++i) {
-        largest = std::max(largest, std::fabs(from[i]));
-        const float f = float(std::clamp(from[i], -kMost, kMost));
-        to[i] =
-            std::clamp(f + side * (std::fabs(f) * 0x1p-23f + kTiny), -float(kMost), float(kMost));
-      }
-    }
-    shard.clamped_node_boxes_ = largest > kMost;
-    if (leaf_triangles != triangle_count)
-      in.fail("triangles in R-tree leaves", leaf_triangles,
-              "must equal triangle_count " + std::to_string(triangle_count));
-    // Parents enclose children: checked after every box is read.
-    for (std::uint32_t i = 0; i < structure_count && check_boxes; ++i) {
-      const Node& node = shard.nodes_[i];
-      if (node.count & sf::kLeafFlag) continue;
-      for (std::uint32_t c = node.first; c < node.first + node.count; ++c)
-        if (!box_contains_box(boxes[i], boxes[c]))
-          in.fail("box of R-tree node " + std::to_string(i), "",
-                  "does not enclose its child " + std::to_string(c));
+    checks.leaf_triangles += count;
+    return;
+  }
+  if (count == 0 || count > sf::kMaxFanout || node.first <= i || node.first > structure_count_ ||
+      count > structure_count_ - node.first)
+    in_.fail("children of R-tree node " + std::to_string(i),
+             std::to_string(node.first) + "+" + std::to_string(count),
+             "1.." + std::to_string(sf::kMaxFanout) + " nodes after it, within " +
+                 std::to_string(structure_count_));
+  if (checks.depth[i] + 1 >= sf::kMaxDepth)
+    in_.fail("depth of R-tree node " + std::to_string(i), checks.depth[i] + 1,
+             "at most " + std::to_string(sf::kMaxDepth - 1));
+  for (std::uint32_t c = node.first; c < node.first + count; ++c) {
+    if (checks.has_parent[c]) in_.fail("R-tree node", c, "listed as a child twice");
+    checks.has_parent[c] = 1;
+    checks.depth[c] = checks.depth[i] + 1;
+  }
+}
+
+void Shard::Decoder::round_node_boxes_outward(const std::vector<double>& relative) {
+  // Rounded outward by a float's unit in the last place (at least; values near zero by the
+  // smallest normal float: a subnormal operand costs a microcode assist, which made decode
+  // of a float32 R-tree a quarter slower), clamped to the finite floats.
+  constexpr double kMost = std::numeric_limits<float>::max();
+  constexpr float kTiny = std::numeric_limits<float>::min();
+  double largest = 0;
+  for (std::size_t k = 0; k < 6; ++k) {
+    const double* from = relative.data() + k * structure_count_;
+    float* to = shard_.node_boxes_.data() + k * shard_.node_stride_;
+    const float side = k < 3 ? -1.0f : 1.0f;
+    for (std::uint32_t i = 0; i < structure_count_; ++i) {
+      largest = std::max(largest, std::fabs(from[i]));
+      const float f = float(std::clamp(from[i], -kMost, kMost));
+      to[i] = std::clamp(f + side * (std::fabs(f) * 0x1p-23f + kTiny), -float(kMost), float(kMost));
     }
   }
+  shard_.clamped_node_boxes_ = largest > kMost;
+}
+
+void Shard::Decoder::check_parents_enclose_children(const std::vector<geometry::Box>& boxes) const {
+  // Checked after every box is read.
+  for (std::uint32_t i = 0; i < structure_count_; ++i) {
+    const Node& node = shard_.nodes_[i];
+    if (node.count & shard_format::kLeafFlag) continue;
+    for (std::uint32_t c = node.first; c < node.first + node.count; ++c)
+      if (!box_contains_box(boxes[i], boxes[c]))
+        in_.fail("box of R-tree node " + std::to_string(i), "",
+                 "does not enclose its child " + std::to_string(c));
+  }
+}
+
+Shard Shard::decode(std::span<const std::byte> payload, std::string_view context,
+                    DecodeChecks checks, std::pmr::memory_resource* memory) {
+  Shard shard(memory != nullptr ? memory : std::pmr::get_default_resource());
+  Decoder decoder(payload, context, checks, shard);
+  decoder.read_header();
+  decoder.read_section_offsets();
+  decoder.read_vertices();
+  decoder.read_triangles();
+  decoder.read_ids_and_parts();
+  if (shard.kind_ == ShardKind::grid)
+    decoder.read_grid();
+  else
+    decoder.read_rtree();
   return shard;
 }
 

@@ -189,6 +189,7 @@ class Shard {
   }
 
  private:
+  class Decoder;  // decode's steps, in Shard.cpp
   /// Empty, its arrays in `memory`.
   explicit Shard(std::pmr::memory_resource* memory);
 
