@@ -13,46 +13,37 @@ namespace tetrapage {
 
 PhaseTwo::PhaseTwo(const StepContext& step, const QueryOptions& options, bool solid_query,
                    const geometry::Box& box)
-    : index_(step.index),
-      model_(step.model),
-      object_(step.object),
-      shapes_(step.shapes),
-      solid_(step.solid),
-      coherence_(step.coherence),
-      containment_(step.containment),
-      met_triangles_(step.met_triangles),
-      contact_triangles_(step.contact_triangles),
+    : step_(step),
       options_(options),
       solid_query_(solid_query),
       all_(options.mode == QueryMode::all_contacts),
       may_enclose_(step.model.closed && step.index.may_hold_a_component(box)),
       box_(box),
-      result_(step.result),
       counters_(step.result.counters) {
-  solid_.built = false;
+  step_.solid.built = false;
   // A triangle stored in several of the step's shards is tested once: exact and double copies
   // are the input's coordinates, the same in every shard (rounded float copies each round to
   // their own shard's frame, so each is tested).
-  met_triangles_.clear();
+  step_.met_triangles.clear();
 }
 
 void PhaseTwo::add_contact(const Source& source, const geometry::Triangle& environment,
                            std::uint32_t object_triangle) {
-  result_.collides = true;
-  if (all_ && result_.contacts.size() == options_.max_contacts)
+  step_.result.collides = true;
+  if (all_ && step_.result.contacts.size() == options_.max_contacts)
     throw InputError("the step finds more than " + std::to_string(options_.max_contacts) +
                      " contacts (the limit of one step; raise it, or narrow the clearance)");
-  if (all_ || result_.contacts.empty()) {
+  if (all_ || step_.result.contacts.empty()) {
     if (source.part != kNoDynamicPart) {
-      result_.contacts.push_back(
+      step_.result.contacts.push_back(
           {Contact::kDynamicPart, source.local, object_triangle, 0, source.part});
     } else {
       const std::uint32_t component = source.shard->component_id(source.local);
       const std::uint64_t id = source.shard->triangle_id(source.local);
-      result_.contacts.push_back(
-          {index_.component_part(component), id, object_triangle, component, kNoDynamicPart});
-      if (contact_triangles_.empty() || contact_triangles_.back().first != id)
-        contact_triangles_.emplace_back(id, environment);
+      step_.result.contacts.push_back(
+          {step_.index.component_part(component), id, object_triangle, component, kNoDynamicPart});
+      if (step_.contact_triangles.empty() || step_.contact_triangles.back().first != id)
+        step_.contact_triangles.emplace_back(id, environment);
     }
   }
   if (!all_) stop_ = true;
@@ -81,9 +72,9 @@ void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environ
     const double bound = 2 * grow * n_size + uv_size * far * 0x1p-40;
     return !(lowest > bound || highest < -bound);
   };
-  model_.bvh.for_each_in_box(query, near_plane, [&](std::uint32_t object_triangle) {
+  step_.model.bvh.for_each_in_box(query, near_plane, [&](std::uint32_t object_triangle) {
     ++counters_.triangle_tests;
-    if (!geometry::triangles_collide(environment, object_.world_triangle(object_triangle),
+    if (!geometry::triangles_collide(environment, step_.object.world_triangle(object_triangle),
                                      options_.accuracy))
       return true;
     add_contact(source, environment, object_triangle);
@@ -93,34 +84,34 @@ void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environ
 
 void PhaseTwo::test_candidate(const Source& source, const geometry::Triangle& environment) {
   // The environment triangle in the object's frame (rounded: it only prunes).
-  const std::array<Vec3, 3> framed{object_.to_object_frame(environment[0]),
-                                   object_.to_object_frame(environment[1]),
-                                   object_.to_object_frame(environment[2])};
+  const std::array<Vec3, 3> framed{step_.object.to_object_frame(environment[0]),
+                                   step_.object.to_object_frame(environment[1]),
+                                   step_.object.to_object_frame(environment[2])};
   geometry::Box query;
   for (const auto& p : framed) query.extend(p);
   // The rotation back rounds by a few ulps of the coordinates' magnitude: grow far beyond.
-  const Vec3& translation = object_.translation();
-  double magnitude = model_.radius;
+  const Vec3& translation = step_.object.translation();
+  double magnitude = step_.model.radius;
   for (const auto& p : environment)
     for (int a = 0; a < 3; ++a)
       magnitude = std::max(magnitude, std::fabs(p[a]) + std::fabs(translation[a]));
-  const double grow = shapes_.reach() + magnitude * 0x1p-40;
+  const double grow = step_.shapes.reach() + magnitude * 0x1p-40;
   for (int a = 0; a < 3; ++a) query.lo[a] -= grow, query.hi[a] += grow;
   // In the object's own frame its box, hull and ball prune; the triangle against the world box
   // then pruned no visible share (the elk over the terrain: 28.5 candidates a near step with or
   // without it) for 5 % of the step's instructions: it is asked only of the solids.
-  if (shapes_.own_frame()
-          ? !geometry::boxes_overlap(query, model_.box) || shapes_.beyond_hull(query)
+  if (step_.shapes.own_frame()
+          ? !geometry::boxes_overlap(query, step_.model.box) || step_.shapes.beyond_hull(query)
           : !geometry::triangle_intersects_box(environment, box_))
     return;
-  if (shapes_.ball_prunes() &&
-      geometry::triangle_outside_ball(framed, model_.ball_centre, model_.ball_radius + grow))
+  if (step_.shapes.ball_prunes() &&
+      geometry::triangle_outside_ball(framed, step_.model.ball_centre, step_.model.ball_radius + grow))
     return;
   ++counters_.candidates;
   if (solid_query_) {
-    if (!solid_.built) solid_.build(options_, model_, object_, coherence_);
+    if (!step_.solid.built) step_.solid.build(options_, step_.model, step_.object, step_.coherence);
     ++counters_.triangle_tests;
-    if (solid_.collides(environment, options_.accuracy, shapes_.reach()))
+    if (step_.solid.collides(environment, options_.accuracy, step_.shapes.reach()))
       add_contact(source, environment, Contact::kNoObjectTriangle);
     return;
   }
@@ -135,10 +126,10 @@ void PhaseTwo::note_if_enclosed(const Shard& shard, std::uint32_t local,
   // step has found no contact).
   if (!inside_counts()) return;
   const std::uint32_t component = shard.component_id(local);
-  if (index_.component_part(component) != CollisionIndex::kNoPart &&
-      geometry::box_contains(box_, index_.component_bounds(component)) &&
-      object_.in_object_box(environment[0]))
-    containment_.note_enclosed(component, environment[0]);
+  if (step_.index.component_part(component) != CollisionIndex::kNoPart &&
+      geometry::box_contains(box_, step_.index.component_bounds(component)) &&
+      step_.object.in_object_box(environment[0]))
+    step_.containment.note_enclosed(component, environment[0]);
 }
 
 void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
@@ -146,14 +137,14 @@ void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
   // containment (the step answers as if the index did not hold them).
   const DynamicObstacles* mask = overlay != nullptr && overlay->hides_any() ? overlay : nullptr;
   const bool same_copies =
-      index_.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
+      step_.index.stores_input_coordinates() || shard.precision() == StoredPrecision::float64;
   // The leaf the visited triangles come from (each leaf's triangles follow its test) lies
   // inside the object, apart from its surface.
   bool in_leaf_inside_object = false;
   auto visit = [&](std::uint32_t local, const geometry::Triangle& environment) {
     if (stop_) return;  // the shard query cannot be cut short; skip the rest
-    if (mask != nullptr && mask->hidden(index_.component_part(shard.component_id(local)))) return;
-    if (same_copies && !met_triangles_.insert(shard.triangle_id(local))) {
+    if (mask != nullptr && mask->hidden(step_.index.component_part(shard.component_id(local)))) return;
+    if (same_copies && !step_.met_triangles.insert(shard.triangle_id(local))) {
       ++counters_.repeats;
       return;
     }
@@ -167,14 +158,14 @@ void PhaseTwo::test_shard(const Shard& shard, const DynamicObstacles* overlay) {
   // holds no triangle near its surface (a grid cell's triangles reach beyond the cell).
   const bool leaves_hold_triangles = shard.kind() == ShardKind::rtree;
   const auto meets_own_box = [&](const geometry::Box& b, std::uint32_t triangles) {
-    const PruningShapes::NodeReach reach = shapes_.reach_of(b, triangles);
+    const PruningShapes::NodeReach reach = step_.shapes.reach_of(b, triangles);
     in_leaf_inside_object = leaves_hold_triangles && reach == PruningShapes::NodeReach::inside;
     counters_.leaves_inside_object += in_leaf_inside_object;
     // Such a leaf's triangles matter only as part of a component inside the object.
     if (in_leaf_inside_object && !inside_counts()) return false;
     return reach != PruningShapes::NodeReach::apart;
   };
-  if (shapes_.prune_inner())
+  if (step_.shapes.prune_inner())
     shard.for_each_box_candidate_pruning_inner_nodes(box_, meets_own_box, visit);
   else
     shard.for_each_box_candidate(box_, meets_own_box, visit);
@@ -204,16 +195,16 @@ void PhaseTwo::test_dynamic_parts(const DynamicObstacles& overlay, PlacedObject&
 }
 
 void PhaseTwo::finish() {
-  if (!all_ || result_.contacts.size() <= 1) return;
+  if (!all_ || step_.result.contacts.size() <= 1) return;
   // A triangle that crosses regions is stored in each of their shards, and float copies are
   // each tested (above): report a pair once.
   auto key = [](const Contact& c) {
     return std::tie(c.dynamic_part, c.environment_triangle, c.object_triangle);
   };
-  std::sort(result_.contacts.begin(), result_.contacts.end(),
+  std::sort(step_.result.contacts.begin(), step_.result.contacts.end(),
             [&](const Contact& a, const Contact& b) { return key(a) < key(b); });
-  result_.contacts.erase(std::unique(result_.contacts.begin(), result_.contacts.end()),
-                         result_.contacts.end());
+  step_.result.contacts.erase(std::unique(step_.result.contacts.begin(), step_.result.contacts.end()),
+                         step_.result.contacts.end());
 }
 
 }  // namespace tetrapage

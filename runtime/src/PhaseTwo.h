@@ -74,17 +74,9 @@ class PhaseTwo {
                         const geometry::Triangle& environment);
   // Triangles that meet only the object's inside still count: some component may lie in it,
   // and no contact has been found.
-  bool inside_counts() const { return may_enclose_ && !result_.collides; }
+  bool inside_counts() const { return may_enclose_ && !step_.result.collides; }
 
-  const CollisionIndex& index_;
-  const ObjectModel& model_;
-  PlacedObject& object_;
-  const PruningShapes& shapes_;
-  ObjectSolid& solid_;
-  const Coherence& coherence_;
-  ContainmentCheck& containment_;
-  TriangleIdSet& met_triangles_;
-  ContactTriangles& contact_triangles_;
+  const StepContext step_;
   const QueryOptions& options_;
   const bool solid_query_;
   const bool all_;
@@ -92,7 +84,6 @@ class PhaseTwo {
   /// component fits in the box): only then do the triangles that meet only its inside count.
   const bool may_enclose_;
   const geometry::Box& box_;
-  QueryResult& result_;
   StepCounters& counters_;
   bool stop_ = false;
 };
