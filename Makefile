@@ -13,7 +13,7 @@ DEB_PACKAGES := cmake make g++ pkg-config \
   libeigen3-dev libcgal-dev libcgal-demo assimp-testmodels libgmp-dev libmpfr-dev libboost-dev \
   libhdf5-dev libtbb-dev libembree-dev libassimp-dev libcli11-dev nlohmann-json3-dev \
   libgtest-dev libbenchmark-dev libfcl-dev gnuplot-nox zlib1g-dev libdeflate-dev liblz4-dev hdf5-filter-plugin time python3 \
-  pybind11-dev python3-dev python3-numpy python3-pytest \
+  pybind11-dev python3-dev python3-numpy python3-pytest python3-venv \
   libocct-data-exchange-dev libocct-ocaf-dev libocct-modeling-algorithms-dev libocct-modeling-data-dev \
   libocct-foundation-dev occt-misc freecad-common
 

@@ -21,16 +21,19 @@ def usage_script():
     return blocks[0]
 
 
+def check_usage_output(output, work):
+    collide = re.search(r"(\d+) of 10000 poses collide", output)
+    assert collide and 0 < int(collide.group(1)) < 10000
+    assert "first collision at pose" in output and "one pose per call" in output
+    assert (work / "scene.tpi").exists()
+    plotted = importlib.util.find_spec("matplotlib") is not None
+    assert (work / "latency.png").exists() == plotted
+
+
 def test_the_usage_script_runs(tmp_path):
     script = tmp_path / "fly.py"
     script.write_text(usage_script())
     done = subprocess.run([sys.executable, script, tmp_path / "work"], capture_output=True,
                           text=True, timeout=300)
     assert done.returncode == 0, done.stderr
-    output = done.stdout
-    collide = re.search(r"(\d+) of 10000 poses collide", output)
-    assert collide and 0 < int(collide.group(1)) < 10000
-    assert "first collision at pose" in output and "one pose per call" in output
-    assert (tmp_path / "work" / "scene.tpi").exists()
-    plotted = importlib.util.find_spec("matplotlib") is not None
-    assert (tmp_path / "work" / "latency.png").exists() == plotted
+    check_usage_output(done.stdout, tmp_path / "work")
