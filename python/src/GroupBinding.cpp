@@ -104,10 +104,21 @@ pairs: structured array of the colliding pairs (first < second, sorted): contain
   triangle_pairs[triangle_pairs_begin:triangle_pairs_end].
 triangle_pairs: (P, 2) uint32, a triangle of the pair's first object and one of its second.
 world_boxes: (N, 2, 3).)")
-      .def_readonly("environment", &GroupAnswer::environment)
-      .def_readonly("pairs", &GroupAnswer::pairs)
-      .def_readonly("triangle_pairs", &GroupAnswer::triangle_pairs)
-      .def_readonly("world_boxes", &GroupAnswer::world_boxes);
+      .def_readonly("environment", &GroupAnswer::environment,
+                    "(N,) bool: whether object i collides with the environment (the index and "
+                    "the obstacles) at poses[i]; empty without an index or with "
+                    "environment=False.")
+      .def_readonly("pairs", &GroupAnswer::pairs,
+                    "The colliding pairs of objects, a structured array sorted by (first, "
+                    "second): first, second (indices in the group, first < second), "
+                    "containment, triangle_pairs_begin, triangle_pairs_end.")
+      .def_readonly("triangle_pairs", &GroupAnswer::triangle_pairs,
+                    "(P, 2) uint32: per row, a triangle of a pair's first object (its row in "
+                    "that object's triangles) that meets one of its second (pair_mode "
+                    "\"first_hit\": one row per pair; a containment has none).")
+      .def_readonly("world_boxes", &GroupAnswer::world_boxes,
+                    "(N, 2, 3): each object's world box at its pose (lowest and highest "
+                    "corner), in world coordinates.");
 
   py::class_<Group>(module, "ObjectGroup", R"(Several rigid objects moving together through one
 index (or none: object/object questions only). Object/object answers are always exact.)")

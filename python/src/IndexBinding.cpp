@@ -57,7 +57,9 @@ py::dict inspect(const Index& self) {
 
 void bind_index(py::module_& module) {
   py::class_<Part>(module, "Part", "A part of an indexed model (a contact's `part` is its id).")
-      .def_readonly("id", &Part::id)
+      .def_readonly("id", &Part::id,
+                    "Its number, its position in Index.parts: a contact's `part`, an answer's "
+                    "environment_part, what Obstacles.hide_part takes.")
       .def_readonly("name", &Part::name, "What the file calls the part.")
       .def_readonly("path", &Part::path, "Its instance path in the assembly, unique in the model.")
       .def_readonly("triangles", &Part::triangles,
@@ -75,7 +77,9 @@ thread, may share one Index.)")
            py::arg("prefetch") = true,
            "Opens and checks the index. Raises IoError, FormatError (not an index, damaged), "
            "InputError (a budget smaller than the largest shard).")
-      .def_property_readonly("path", [](const Index& i) { return i.index->path(); })
+      .def_property_readonly(
+          "path", [](const Index& i) { return i.index->path(); },
+          "The index file it was opened from, as a pathlib.Path.")
       .def_property_readonly(
           "bounds",
           [](const Index& i) {
@@ -91,13 +95,17 @@ thread, may share one Index.)")
           "How coordinates are stored: \"exact\", \"double\" or \"float\".")
       .def_property_readonly(
           "parts", [](const Index& i) { return parts_of(*i.index); }, "The model's parts, by id.")
-      .def_property_readonly("triangles",
-                             [](const Index& i) { return i.index->header().input_triangles; })
+      .def_property_readonly(
+          "triangles", [](const Index& i) { return i.index->header().input_triangles; },
+          "How many triangles the model holds: those read from the inputs, every placed "
+          "instance counted and degenerate ones dropped (the triangles' ids run below it).")
       .def_property_readonly(
           "shard_bytes", [](const Index& i) { return shard_bytes_of(*i.index); },
           "(S,) uint64: each shard's decoded bytes (what it costs resident).")
-      .def_property_readonly("total_shard_bytes",
-                             [](const Index& i) { return i.index->total_shard_bytes(); })
+      .def_property_readonly(
+          "total_shard_bytes", [](const Index& i) { return i.index->total_shard_bytes(); },
+          "The sum of shard_bytes: what every shard resident costs, in bytes (preload() needs "
+          "a memory budget at least this large).")
       .def_property_readonly(
           "memory", [](const Index& i) { return i.index->options().memory_budget_bytes; },
           "The shard budget in bytes.")

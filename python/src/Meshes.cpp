@@ -137,14 +137,20 @@ void bind_meshes(py::module_& module) {
                                               m.soup.part_of.data());
           },
           "(M,) uint32: each triangle's part.")
-      .def_property_readonly("part_names", [](const Mesh& m) { return m.soup.part_names; })
-      .def_property_readonly("part_paths",
-                             [](const Mesh& m) {
-                               std::vector<std::string> paths;
-                               for (std::size_t p = 0; p < m.soup.part_count(); ++p)
-                                 paths.push_back(m.soup.part_path(p));
-                               return paths;
-                             })
+      .def_property_readonly(
+          "part_names", [](const Mesh& m) { return m.soup.part_names; },
+          "Each part's name, by part (the values of part_of): what the file calls it (a STEP "
+          "product, an OBJ group, a manifest part); instances of one part share it.")
+      .def_property_readonly(
+          "part_paths",
+          [](const Mesh& m) {
+            std::vector<std::string> paths;
+            for (std::size_t p = 0; p < m.soup.part_count(); ++p)
+              paths.push_back(m.soup.part_path(p));
+            return paths;
+          },
+          "Each part's instance path, by part: the instances' names from the root down joined "
+          "by '/' (\"rack/board#3/U7\"), unique in the model; the part's name for one file.")
       .def_readonly("length_unit", &Mesh::length_unit,
                     "The unit the file states (\"mm\" for STEP and IGES), or \"\".")
       .def_property_readonly(

@@ -296,18 +296,38 @@ contacts: structured array, one row per contact (first_hit: at most one): part, 
   shape (0 none, 1 point, 2 segment, 3 polygon), point_count, point (a point both triangles
   share, NaN without geometry), points (6, 3), environment_normal, object_normal.
 counters: what the step did (dict). world_box: (2, 3).)")
-      .def_readonly("collides", &QueryAnswer::collides)
-      .def_property_readonly("containment",
-                             [](const QueryAnswer& a) { return to_string(a.containment); })
-      .def_readonly("containing_part", &QueryAnswer::containing_part)
-      .def_readonly("containing_dynamic_part", &QueryAnswer::containing_dynamic_part)
-      .def_readonly("outside_model", &QueryAnswer::outside_model)
-      .def_readonly("contacts", &QueryAnswer::contacts)
-      .def_property_readonly("counters",
-                             [](const QueryAnswer& a) { return counters_dict(a.counters); })
+      .def_readonly("collides", &QueryAnswer::collides,
+                    "True when the surfaces touch (contacts) or one body holds the other "
+                    "(containment); bool(answer) says the same.")
+      .def_property_readonly(
+          "containment", [](const QueryAnswer& a) { return to_string(a.containment); },
+          "A collision without touching surfaces: \"object_inside_obstacle\" (the object lies "
+          "inside a closed part: an index with interiors) or \"obstacle_inside_object\" (a part "
+          "lies inside the closed object); \"none\" otherwise.")
+      .def_readonly("containing_part", &QueryAnswer::containing_part,
+                    "The environment part of a containment, its id in Index.parts (4294967294 "
+                    "for an inserted obstacle: see containing_dynamic_part); 0 without one.")
+      .def_readonly("containing_dynamic_part", &QueryAnswer::containing_dynamic_part,
+                    "The id (from Obstacles.insert) of the inserted obstacle that holds the "
+                    "object or that it holds; 0 for the index's parts or without a containment.")
+      .def_readonly("outside_model", &QueryAnswer::outside_model,
+                    "The object's world box lies entirely outside the index's mesh: no triangle "
+                    "of the index can touch it (inserted obstacles are still checked).")
+      .def_readonly("contacts", &QueryAnswer::contacts,
+                    "The contacts, a structured array of tetrapage.contact_dtype (its fields "
+                    "above), one row per contact found (first_hit: at most one; a containment "
+                    "has none).")
+      .def_property_readonly(
+          "counters", [](const QueryAnswer& a) { return counters_dict(a.counters); },
+          "What the step did, as a new dict: the walk and search (searched, tets_crossed, "
+          "tets_visited, tets_overlapping), the shards (shards_touched, shard_misses: paged in "
+          "by this step), phases I and II (candidates, leaves_inside_object, repeats, "
+          "triangle_tests), the free box (in_free_box, found_free_box), and *_seconds timings.")
       .def_property_readonly(
           "world_box",
-          [](const QueryAnswer& a) { return box_array(a.world_box.lo, a.world_box.hi); })
+          [](const QueryAnswer& a) { return box_array(a.world_box.lo, a.world_box.hi); },
+          "(2, 3): the object's world box at the pose (lowest and highest corner, in the "
+          "index's coordinates), slightly enlarged over the placement's rounding.")
       .def("__bool__", [](const QueryAnswer& a) { return a.collides; })
       .def("__repr__", [](const QueryAnswer& a) {
         return std::string("<tetrapage.QueryAnswer ") + (a.collides ? "collides" : "free") + ", " +
@@ -317,13 +337,22 @@ counters: what the step did (dict). world_box: (2, 3).)")
   py::class_<DistanceAnswer>(module, "DistanceAnswer", R"(One distance query's answer: the true
 distance lies in [lower_bound, upper_bound] (certified); separation is "touching" (distance 0),
 "apart", or "farther" (than max_distance: distance is then the certified lower bound).)")
-      .def_property_readonly("separation",
-                             [](const DistanceAnswer& a) { return to_string(a.result.separation); })
-      .def_property_readonly("distance", [](const DistanceAnswer& a) { return a.result.distance; })
-      .def_property_readonly("lower_bound",
-                             [](const DistanceAnswer& a) { return a.result.lower_bound; })
-      .def_property_readonly("upper_bound",
-                             [](const DistanceAnswer& a) { return a.result.upper_bound; })
+      .def_property_readonly(
+          "separation", [](const DistanceAnswer& a) { return to_string(a.result.separation); },
+          "\"touching\" (surfaces touch or one body holds the other, decided as collides() "
+          "decides it with its defaults), \"apart\" (within max_distance) or \"farther\".")
+      .def_property_readonly(
+          "distance", [](const DistanceAnswer& a) { return a.result.distance; },
+          "The computed distance between the closest points, in the index's length unit "
+          "(Index.length_unit); 0 when touching; when farther, the certified lower bound.")
+      .def_property_readonly(
+          "lower_bound", [](const DistanceAnswer& a) { return a.result.lower_bound; },
+          "A certified lower bound of the true distance, in the index's unit (0 when touching; "
+          "at least max_distance when farther).")
+      .def_property_readonly(
+          "upper_bound", [](const DistanceAnswer& a) { return a.result.upper_bound; },
+          "A certified upper bound of the true distance, in the index's unit (0 when touching; "
+          "infinity when farther): the gap to lower_bound is the double computation's error.")
       .def_property_readonly(
           "on_environment",
           [](const DistanceAnswer& a) { return point_or_nan(a.result, a.result.on_environment); },
@@ -332,30 +361,45 @@ distance lies in [lower_bound, upper_bound] (certified); separation is "touching
           "on_object",
           [](const DistanceAnswer& a) { return point_or_nan(a.result, a.result.on_object); },
           "The closest point on the object; NaN when farther or for a containment.")
-      .def_property_readonly("environment_triangle",
-                             [](const DistanceAnswer& a) {
-                               return optional_triangle(
-                                   a.result.environment_triangle != DistanceResult::kNoTriangle,
-                                   a.result.environment_triangle);
-                             })
-      .def_property_readonly("environment_part",
-                             [](const DistanceAnswer& a) { return a.result.environment_part; })
-      .def_property_readonly("object_triangle",
-                             [](const DistanceAnswer& a) {
-                               return optional_triangle(
-                                   a.result.environment_triangle != DistanceResult::kNoTriangle,
-                                   a.result.object_triangle);
-                             })
-      .def_property_readonly("dynamic_part",
-                             [](const DistanceAnswer& a) { return a.result.dynamic_part; })
       .def_property_readonly(
-          "containment", [](const DistanceAnswer& a) { return to_string(a.result.containment); })
-      .def_property_readonly("containing_part",
-                             [](const DistanceAnswer& a) { return a.result.containing_part; })
-      .def_property_readonly("candidates",
-                             [](const DistanceAnswer& a) { return a.result.candidates; })
-      .def_property_readonly("pair_tests",
-                             [](const DistanceAnswer& a) { return a.result.pair_tests; })
+          "environment_triangle",
+          [](const DistanceAnswer& a) {
+            return optional_triangle(a.result.environment_triangle != DistanceResult::kNoTriangle,
+                                     a.result.environment_triangle);
+          },
+          "The closest pair's environment triangle, its id in the index (in an inserted "
+          "obstacle: its row in that obstacle's mesh); None when farther or for a containment.")
+      .def_property_readonly(
+          "environment_part", [](const DistanceAnswer& a) { return a.result.environment_part; },
+          "The part of environment_triangle, its id in Index.parts (4294967294 for an inserted "
+          "obstacle); meaningful only when environment_triangle is not None.")
+      .def_property_readonly(
+          "object_triangle",
+          [](const DistanceAnswer& a) {
+            return optional_triangle(a.result.environment_triangle != DistanceResult::kNoTriangle,
+                                     a.result.object_triangle);
+          },
+          "The closest pair's object triangle, its row in the object's triangles; None when "
+          "environment_triangle is None.")
+      .def_property_readonly(
+          "dynamic_part", [](const DistanceAnswer& a) { return a.result.dynamic_part; },
+          "The id (from Obstacles.insert) of the inserted obstacle that holds "
+          "environment_triangle, or 0 for the index's triangles.")
+      .def_property_readonly(
+          "containment", [](const DistanceAnswer& a) { return to_string(a.result.containment); },
+          "Touching without contact: \"object_inside_obstacle\" or \"obstacle_inside_object\" "
+          "(as QueryAnswer.containment); \"none\" otherwise.")
+      .def_property_readonly(
+          "containing_part", [](const DistanceAnswer& a) { return a.result.containing_part; },
+          "The environment part of a containment, its id in Index.parts (4294967294 for an "
+          "inserted obstacle); 0 without one.")
+      .def_property_readonly(
+          "candidates", [](const DistanceAnswer& a) { return a.result.candidates; },
+          "How many environment triangles were measured against the object (the query's work; "
+          "0 when the collision step found it touching or a free box answered \"farther\").")
+      .def_property_readonly(
+          "pair_tests", [](const DistanceAnswer& a) { return a.result.pair_tests; },
+          "How many triangle pairs had their distance computed.")
       .def("__repr__", [](const DistanceAnswer& a) {
         return std::string("<tetrapage.DistanceAnswer ") + to_string(a.result.separation) + " " +
                std::to_string(a.result.distance) + ">";
@@ -364,26 +408,41 @@ distance lies in [lower_bound, upper_bound] (certified); separation is "touching
   py::class_<ImpactAnswer>(module, "ImpactAnswer", R"(One time-of-impact answer over the motion's
 time [0, 1]: impact "none" (certified free), "hit" (first contact in (free_until, contact_at]),
 or "unresolved" (max_iterations ran out: free up to free_until).)")
-      .def_property_readonly("impact",
-                             [](const ImpactAnswer& a) { return to_string(a.result.impact); })
-      .def_property_readonly("free_until",
-                             [](const ImpactAnswer& a) { return a.result.free_until; })
-      .def_property_readonly("contact_at",
-                             [](const ImpactAnswer& a) { return a.result.contact_at; })
-      .def_property_readonly("environment_triangle",
-                             [](const ImpactAnswer& a) {
-                               return optional_triangle(a.result.has_contact,
-                                                        a.result.environment_triangle);
-                             })
-      .def_property_readonly("environment_part",
-                             [](const ImpactAnswer& a) { return a.result.environment_part; })
-      .def_property_readonly("object_triangle",
-                             [](const ImpactAnswer& a) {
-                               return optional_triangle(a.result.has_contact,
-                                                        a.result.object_triangle);
-                             })
-      .def_property_readonly("iterations",
-                             [](const ImpactAnswer& a) { return a.result.iterations; })
+      .def_property_readonly(
+          "impact", [](const ImpactAnswer& a) { return to_string(a.result.impact); },
+          "\"none\" (certified: nothing touched during the whole motion), \"hit\" or "
+          "\"unresolved\" (max_iterations ran out).")
+      .def_property_readonly(
+          "free_until", [](const ImpactAnswer& a) { return a.result.free_until; },
+          "The motion's time in [0, 1] (0 at start, 1 at end) before which nothing touches "
+          "(certified); 1 when impact is \"none\".")
+      .def_property_readonly(
+          "contact_at", [](const ImpactAnswer& a) { return a.result.contact_at; },
+          "For a hit, the motion's time in [0, 1] at which the pose collides (decided exactly), "
+          "at most tolerance after free_until; 1 when impact is \"none\" or \"unresolved\".")
+      .def_property_readonly(
+          "environment_triangle",
+          [](const ImpactAnswer& a) {
+            return optional_triangle(a.result.has_contact, a.result.environment_triangle);
+          },
+          "The environment triangle of the first contact found at contact_at, its id in the "
+          "index (in an inserted obstacle: its row in that obstacle's mesh); None without a "
+          "contact (no hit, or a hit that is a containment).")
+      .def_property_readonly(
+          "environment_part", [](const ImpactAnswer& a) { return a.result.environment_part; },
+          "The part of environment_triangle, its id in Index.parts (4294967294 for an inserted "
+          "obstacle); meaningful only when environment_triangle is not None.")
+      .def_property_readonly(
+          "object_triangle",
+          [](const ImpactAnswer& a) {
+            return optional_triangle(a.result.has_contact, a.result.object_triangle);
+          },
+          "The object triangle of that contact, its row in the object's triangles; None "
+          "without a contact.")
+      .def_property_readonly(
+          "iterations", [](const ImpactAnswer& a) { return a.result.iterations; },
+          "How many distance queries the conservative advancement ran (at most "
+          "max_iterations).")
       .def("__repr__", [](const ImpactAnswer& a) {
         return std::string("<tetrapage.ImpactAnswer ") + to_string(a.result.impact) +
                " free until " + std::to_string(a.result.free_until) + ">";
@@ -484,8 +543,9 @@ thread; Obstacles.insert(model, pose) and ObjectGroup take it too.)")
            }),
            py::arg("mesh"), py::arg("triangles") = py::none(),
            "Model(mesh) with a tetrapage.Mesh, or Model(vertices, triangles).")
-      .def_property_readonly("triangles",
-                             [](const Model& m) { return m.model->mesh.triangle_count(); })
+      .def_property_readonly(
+          "triangles", [](const Model& m) { return m.model->mesh.triangle_count(); },
+          "How many triangles its mesh holds, as given (object_triangle is a row of them).")
       .def_property_readonly(
           "closed", [](const Model& m) { return m.model->closed; },
           "Some component is closed (obstacles inside it are reported).")
@@ -572,8 +632,10 @@ the current pose: the poses are consecutive steps).)")
           "obstacles", [](const Object& o) { return o.obstacles; },
           [](Object& o, py::handle value) { hold_obstacles(o, *o.flying, value); },
           "The tetrapage.Obstacles merged into every query, or None.")
-      .def_property_readonly("triangles",
-                             [](const Object& o) { return o.flying->object().triangle_count(); })
+      .def_property_readonly(
+          "triangles", [](const Object& o) { return o.flying->object().triangle_count(); },
+          "How many triangles the object's mesh holds, as given (object_triangle is a row of "
+          "them).")
       .def_property_readonly(
           "closed", [](const Object& o) { return o.flying->closed(); },
           "Some component is closed (obstacles inside it are reported).");

@@ -77,14 +77,18 @@ threads and hold them off while they run.)")
             const Pose pose = pose_from_array(pose_value, "pose");
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.move(id, pose); });
           },
-          py::arg("id"), py::arg("pose"))
+          py::arg("id"), py::arg("pose"),
+          "Puts the inserted part `id` at `pose` (where it now stands, not a displacement); "
+          "raises InputError for an unknown id.")
       .def(
           "remove",
           [](Obstacles& obstacles, py::handle id_value) {
             const auto id = DynamicPartId(whole_number(id_value, "id", 0, 0xffffffffu));
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.remove(id); });
           },
-          py::arg("id"))
+          py::arg("id"),
+          "Removes the inserted part `id` (its id is never given again); raises InputError "
+          "for an unknown id.")
       .def(
           "hide_part",
           [](Obstacles& obstacles, py::handle part_value) {
@@ -98,12 +102,15 @@ threads and hold them off while they run.)")
             const auto part = std::uint32_t(whole_number(part_value, "part", 0, 0xffffffffu));
             change(obstacles, [&](DynamicObstacles& overlay) { overlay.show_part(part); });
           },
-          py::arg("part"))
+          py::arg("part"),
+          "Shows again a part of the index (its id in Index.parts) that hide_part hid (a part "
+          "not hidden stays shown); raises InputError for a part the index does not list.")
       .def_property_readonly(
           "hidden_parts",
           [](const Obstacles& o) {
             return read(o, [](const DynamicObstacles& overlay) { return overlay.hidden_parts(); });
-          })
+          },
+          "The ids (in Index.parts) of the index's parts hidden by hide_part, ascending.")
       .def_property_readonly(
           "parts",
           [](const Obstacles& o) {
@@ -132,7 +139,11 @@ threads and hold them off while they run.)")
             py::gil_scoped_release unlocked;
             return obstacles_of(DynamicObstacles::load(index.index, path, cell_size));
           },
-          py::arg("index"), py::arg("path"), py::kw_only(), py::arg("cell_size") = 0.0);
+          py::arg("index"), py::arg("path"), py::kw_only(), py::arg("cell_size") = 0.0,
+          "An overlay on `index` read from a file that save() wrote: the same ids, names, "
+          "poses, meshes and hidden parts (cell_size as for Obstacles()). Raises FormatError "
+          "for a missing, truncated or malformed file (naming the line at fault) or one that "
+          "does not fit `index`, IoError for a path that is not a regular file.");
 }
 
 }  // namespace tetrapage::python
