@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
   tetrapage_object* object = NULL;
   tetrapage_accuracy accuracy = TETRAPAGE_ACCURACY_EXACT;
   double parameter = 0.0;
+  tetrapage_query_args args;
   double* poses = NULL;
   long pose_count = 0, collisions = 0, k;
   int exit_code = 1;
@@ -104,15 +105,20 @@ int main(int argc, char** argv) {
   }
   pose_count = argc >= 4 ? read_poses(argv[3], &poses) : diagonal_poses(index, &poses);
   if (pose_count < 0) goto done;
+  /* The options: the defaults, then what this program changes (every contact, the accuracy). */
+  tetrapage_query_args_init(&args);
+  args.accuracy = accuracy;
+  args.parameter = parameter;
+  args.contacts = TETRAPAGE_CONTACTS_ALL;
 
   for (k = 0; k < pose_count; ++k) {
     const double* pose = poses + 7 * k;
-    tetrapage_contact contacts[kShownContacts];
+    tetrapage_hit contacts[kShownContacts];
     size_t count = 0, written = 0, c;
     int collides = 0;
-    if (tetrapage_query(object, pose, accuracy, parameter, 1, &collides) != TETRAPAGE_OK ||
+    if (tetrapage_collide(object, pose, &args, &collides) != TETRAPAGE_OK ||
         tetrapage_contact_count(object, &count) != TETRAPAGE_OK ||
-        tetrapage_get_contacts(object, contacts, kShownContacts, &written) != TETRAPAGE_OK) {
+        tetrapage_get_hits(object, contacts, kShownContacts, &written) != TETRAPAGE_OK) {
       fprintf(stderr, "error: pose %ld: %s\n", k, tetrapage_last_error());
       goto done;
     }

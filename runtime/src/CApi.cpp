@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <string>
@@ -51,6 +53,39 @@ tetrapage::geometry::Accuracy to_accuracy(int accuracy, double parameter) {
       return Accuracy::within(parameter);
   }
   throw tetrapage::InputError("unknown accuracy " + std::to_string(accuracy));
+}
+
+// The header restates the C++ conventions of a contact site; these keep them equal.
+static_assert(TETRAPAGE_NO_OBJECT_TRIANGLE == tetrapage::Contact::kNoObjectTriangle);
+static_assert(TETRAPAGE_DYNAMIC_PART == tetrapage::Contact::kDynamicPart);
+static_assert(TETRAPAGE_NO_TRIANGLE == tetrapage::DistanceResult::kNoTriangle);
+
+// An argument struct grows by fields appended at its end; read_args copies an older caller's
+// struct_size bytes over the defaults, which is right only if those bytes hold no padding a
+// newer field could occupy: no struct may end in padding.
+template <class Args, class Last>
+constexpr bool ends_without_padding(std::size_t last_offset) {
+  return last_offset + sizeof(Last) == sizeof(Args);
+}
+static_assert(ends_without_padding<tetrapage_query_args, std::uint64_t>(
+    offsetof(tetrapage_query_args, max_contacts)));
+static_assert(ends_without_padding<tetrapage_distance_args, double>(
+    offsetof(tetrapage_distance_args, max_distance)));
+static_assert(ends_without_padding<tetrapage_impact_args, std::uint64_t>(
+    offsetof(tetrapage_impact_args, max_iterations)));
+
+tetrapage_hit hit_of(const tetrapage::Contact& contact) {
+  return {contact.environment_triangle, contact.environment_part, contact.environment_component,
+          contact.object_triangle, contact.dynamic_part};
+}
+
+// A closest pair or first contact: the query names no component.
+tetrapage_hit hit_of(bool found, std::uint64_t environment_triangle, std::uint32_t environment_part,
+                     std::uint32_t object_triangle, std::uint32_t dynamic_part) {
+  if (!found)
+    return {TETRAPAGE_NO_TRIANGLE, 0, TETRAPAGE_NO_COMPONENT, TETRAPAGE_NO_OBJECT_TRIANGLE, 0};
+  return {environment_triangle, environment_part, TETRAPAGE_NO_COMPONENT, object_triangle,
+          dynamic_part};
 }
 
 }  // namespace
@@ -244,53 +279,105 @@ tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* 
   });
 }
 
-// The query with the caller's enums as ints (caller_value): forwarding an enum from one C
-// entry point to the other would load it.
-static tetrapage_status query_as_ints(const char* function, tetrapage_object* object, const double pose[7],
-                                      int accuracy, double parameter, int shape, int motion, int all_contacts,
-                                      int* collides) {
+void tetrapage_query_args_init(tetrapage_query_args* args) {
+  if (args == nullptr) return;
+  *args = tetrapage_query_args{};
+  args->struct_size = sizeof(tetrapage_query_args);
+  args->accuracy = TETRAPAGE_ACCURACY_EXACT;
+  args->shape = TETRAPAGE_SHAPE_MESH;
+  args->motion = TETRAPAGE_MOTION_DISCRETE;
+  args->contacts = TETRAPAGE_CONTACTS_FIRST;
+  args->max_contacts = tetrapage::kDefaultMaxContacts;
+}
+
+}  // extern "C"
+
+namespace {
+
+tetrapage::QueryOptions to_query_options(const tetrapage_query_args& args) {
+  tetrapage::QueryOptions options;
+  options.accuracy = to_accuracy(args.accuracy, args.parameter);
+  switch (args.shape) {
+    case TETRAPAGE_SHAPE_MESH:
+      options.shape = tetrapage::ObjectShape::mesh;
+      break;
+    case TETRAPAGE_SHAPE_HULL:
+      options.shape = tetrapage::ObjectShape::hull;
+      break;
+    case TETRAPAGE_SHAPE_BOX:
+      options.shape = tetrapage::ObjectShape::box;
+      break;
+    default:
+      throw tetrapage::InputError("unknown object shape " + std::to_string(args.shape));
+  }
+  switch (args.motion) {
+    case TETRAPAGE_MOTION_DISCRETE:
+      options.motion = tetrapage::Motion::discrete;
+      break;
+    case TETRAPAGE_MOTION_SWEPT:
+      options.motion = tetrapage::Motion::swept;
+      break;
+    default:
+      throw tetrapage::InputError("unknown motion " + std::to_string(args.motion));
+  }
+  switch (args.contacts) {
+    case TETRAPAGE_CONTACTS_FIRST:
+      options.mode = tetrapage::QueryMode::first_hit;
+      break;
+    case TETRAPAGE_CONTACTS_ALL:
+      options.mode = tetrapage::QueryMode::all_contacts;
+      break;
+    default:
+      throw tetrapage::InputError("unknown contacts value " + std::to_string(args.contacts));
+  }
+  if (args.max_contacts == 0) throw tetrapage::InputError("max_contacts must be at least 1, not 0");
+  options.max_contacts = std::size_t(std::min<std::uint64_t>(args.max_contacts, SIZE_MAX));
+  return options;
+}
+
+tetrapage::Pose pose_of(const double pose[7]) {
+  tetrapage::Pose placed;
+  placed.translation = {pose[0], pose[1], pose[2]};
+  placed.rotation = {pose[3], pose[4], pose[5], pose[6]};
+  return placed;
+}
+
+// tetrapage_collide and the deprecated tetrapage_query: `args` read already.
+tetrapage_status collide(const char* function, tetrapage_object* object, const double pose[7],
+                         const tetrapage_query_args* args, int* collides) {
   if (collides) *collides = 0;
   return guarded(function, [&] {
     const auto state = object_state(object);
     state->has_result = false;  // a failed query leaves no contact behind
     require(pose, "pose");
     require(collides, "collides");
-    tetrapage::QueryOptions options;
-    options.accuracy = to_accuracy(accuracy, parameter);
-    switch (shape) {
-      case TETRAPAGE_SHAPE_MESH: options.shape = tetrapage::ObjectShape::mesh; break;
-      case TETRAPAGE_SHAPE_HULL: options.shape = tetrapage::ObjectShape::hull; break;
-      case TETRAPAGE_SHAPE_BOX: options.shape = tetrapage::ObjectShape::box; break;
-      default: throw tetrapage::InputError("unknown object shape " + std::to_string(shape));
-    }
-    switch (motion) {
-      case TETRAPAGE_MOTION_DISCRETE: options.motion = tetrapage::Motion::discrete; break;
-      case TETRAPAGE_MOTION_SWEPT: options.motion = tetrapage::Motion::swept; break;
-      default: throw tetrapage::InputError("unknown motion " + std::to_string(motion));
-    }
-    options.mode = all_contacts ? tetrapage::QueryMode::all_contacts : tetrapage::QueryMode::first_hit;
-    tetrapage::Pose placed;
-    placed.translation = {pose[0], pose[1], pose[2]};
-    placed.rotation = {pose[3], pose[4], pose[5], pose[6]};
-    state->flying.query(placed, options, state->result);
+    tetrapage_query_args defaults;
+    tetrapage_query_args_init(&defaults);
+    const tetrapage::QueryOptions options = to_query_options(read_args(args, defaults, "args"));
+    state->flying.query(pose_of(pose), options, state->result);
     state->has_result = true;
     *collides = state->result.collides ? 1 : 0;
   });
 }
 
+}  // namespace
+
+extern "C" {
+
+tetrapage_status tetrapage_collide(tetrapage_object* object, const double pose[7],
+                                   const tetrapage_query_args* args, int* collides) {
+  return collide(__func__, object, pose, args, collides);
+}
+
 tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
                                  tetrapage_accuracy accuracy, double parameter, int all_contacts,
                                  int* collides) {
-  return query_as_ints(__func__, object, pose, caller_value(accuracy), parameter, TETRAPAGE_SHAPE_MESH,
-                       TETRAPAGE_MOTION_DISCRETE, all_contacts, collides);
-}
-
-tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double pose[7],
-                                        tetrapage_accuracy accuracy, double parameter,
-                                        tetrapage_object_shape shape, tetrapage_motion motion,
-                                        int all_contacts, int* collides) {
-  return query_as_ints(__func__, object, pose, caller_value(accuracy), parameter, caller_value(shape),
-                       caller_value(motion), all_contacts, collides);
+  tetrapage_query_args args;
+  tetrapage_query_args_init(&args);
+  args.accuracy = caller_value(accuracy);  // an enum outside its enumerators is not loaded
+  args.parameter = parameter;
+  args.contacts = all_contacts ? TETRAPAGE_CONTACTS_ALL : TETRAPAGE_CONTACTS_FIRST;
+  return collide(__func__, object, pose, &args, collides);
 }
 
 tetrapage_status tetrapage_contact_count(const tetrapage_object* object, size_t* count) {
@@ -316,6 +403,21 @@ tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
     for (std::size_t i = 0; i < n; ++i)
       contacts[i] = {found[i].environment_triangle, found[i].environment_part, found[i].object_triangle,
                      found[i].environment_component};
+    *written = n;
+  });
+}
+
+tetrapage_status tetrapage_get_hits(const tetrapage_object* object, tetrapage_hit* hits,
+                                    size_t capacity, size_t* written) {
+  if (written) *written = 0;
+  return guarded(__func__, [&] {
+    const auto state = object_state(object);
+    require(written, "written");
+    if (capacity > 0) require(hits, "hits");
+    if (!state->has_result) return;
+    const auto& found = state->result.contacts;
+    const std::size_t n = std::min(capacity, found.size());
+    for (std::size_t i = 0; i < n; ++i) hits[i] = hit_of(found[i]);
     *written = n;
   });
 }
@@ -352,13 +454,6 @@ tetrapage_status tetrapage_last_query_info(const tetrapage_object* object,
 }  // extern "C"
 
 namespace {
-
-tetrapage::Pose pose_of(const double pose[7]) {
-  tetrapage::Pose placed;
-  placed.translation = {pose[0], pose[1], pose[2]};
-  placed.rotation = {pose[3], pose[4], pose[5], pose[6]};
-  return placed;
-}
 
 void copy_point(const tetrapage::geometry::Point& from, double to[3]) {
   for (int a = 0; a < 3; ++a) to[a] = from[a];
@@ -433,6 +528,85 @@ tetrapage_status tetrapage_time_of_impact(tetrapage_object* object, const double
     result->environment_triangle = found.environment_triangle;
     result->environment_part = found.environment_part;
     result->object_triangle = found.object_triangle;
+    result->iterations = found.iterations;
+  });
+}
+
+void tetrapage_distance_args_init(tetrapage_distance_args* args) {
+  if (args == nullptr) return;
+  *args = tetrapage_distance_args{};
+  args->struct_size = sizeof(tetrapage_distance_args);
+  args->max_distance = tetrapage::DistanceOptions{}.max_distance;
+}
+
+tetrapage_status tetrapage_measure_distance(tetrapage_object* object, const double pose[7],
+                                            const tetrapage_distance_args* args,
+                                            tetrapage_distance_result* result) {
+  return guarded(__func__, [&] {
+    const auto state = object_state(object);
+    state->has_result = false;
+    require(pose, "pose");
+    require(result, "result");
+    *result = tetrapage_distance_result{};
+    tetrapage_distance_args defaults;
+    tetrapage_distance_args_init(&defaults);
+    const tetrapage_distance_args read = read_args(args, defaults, "args");
+    const tetrapage::DistanceResult found =
+        state->flying.distance(pose_of(pose), tetrapage::DistanceOptions{read.max_distance});
+    result->separation = int32_t(found.separation);
+    result->distance = found.distance;
+    result->lower_bound = found.lower_bound;
+    result->upper_bound = found.upper_bound;
+    copy_point(found.on_environment, result->on_environment);
+    copy_point(found.on_object, result->on_object);
+    result->closest = hit_of(found.environment_triangle != tetrapage::DistanceResult::kNoTriangle,
+                             found.environment_triangle, found.environment_part,
+                             found.object_triangle, found.dynamic_part);
+    result->containment = int32_t(found.containment);
+    result->containing_part = found.containing_part;
+    result->containing_dynamic_part = found.containing_dynamic_part;
+    result->pair_tests = found.pair_tests;
+  });
+}
+
+void tetrapage_impact_args_init(tetrapage_impact_args* args) {
+  if (args == nullptr) return;
+  *args = tetrapage_impact_args{};
+  args->struct_size = sizeof(tetrapage_impact_args);
+  args->tolerance = tetrapage::ImpactOptions{}.tolerance;
+  args->max_iterations = tetrapage::ImpactOptions{}.max_iterations;
+}
+
+tetrapage_status tetrapage_find_impact(tetrapage_object* object, const double from[7],
+                                       const double to[7], const tetrapage_impact_args* args,
+                                       tetrapage_impact_result* result) {
+  return guarded(__func__, [&] {
+    const auto state = object_state(object);
+    state->has_result = false;
+    require(from, "from");
+    require(to, "to");
+    require(result, "result");
+    *result = tetrapage_impact_result{};
+    tetrapage_impact_args defaults;
+    tetrapage_impact_args_init(&defaults);
+    const tetrapage_impact_args read = read_args(args, defaults, "args");
+    if (read.max_iterations == 0 || read.max_iterations > UINT32_MAX)
+      throw tetrapage::InputError("max_iterations must be in [1, 4294967295], not " +
+                                  std::to_string(read.max_iterations));
+    tetrapage::ImpactOptions options;
+    options.tolerance = read.tolerance;
+    options.max_iterations = std::uint32_t(read.max_iterations);
+    const tetrapage::ImpactResult found =
+        state->flying.time_of_impact(pose_of(from), pose_of(to), options);
+    result->impact = int32_t(found.impact);
+    result->free_until = found.free_until;
+    result->contact_at = found.contact_at;
+    result->first_contact =
+        hit_of(found.has_contact, found.environment_triangle, found.environment_part,
+               found.object_triangle, found.dynamic_part);
+    result->containment = int32_t(found.containment);
+    result->containing_part = found.containing_part;
+    result->containing_dynamic_part = found.containing_dynamic_part;
     result->iterations = found.iterations;
   });
 }

@@ -118,22 +118,6 @@ tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
   });
 }
 
-tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object,
-                                                     uint32_t* parts, size_t capacity,
-                                                     size_t* written) {
-  if (written) *written = 0;
-  return guarded(__func__, [&] {
-    const auto state = object_state(object);
-    require(written, "written");
-    if (capacity > 0) require(parts, "parts");
-    if (!state->has_result) return;
-    const auto& found = state->result.contacts;
-    const std::size_t n = std::min(capacity, found.size());
-    for (std::size_t i = 0; i < n; ++i) parts[i] = found[i].dynamic_part;
-    *written = n;
-  });
-}
-
 tetrapage_status tetrapage_obstacles_save(const tetrapage_obstacles* obstacles, const char* path) {
   return guarded(__func__, [&] {
     const auto state = obstacles_state(obstacles);

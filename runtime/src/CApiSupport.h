@@ -43,6 +43,37 @@ inline void require(const T* pointer, const char* name) {
   if (pointer == nullptr) throw NullArgument(name);
 }
 
+/// An argument struct whose struct_size this library cannot read: reported as
+/// TETRAPAGE_ERROR_INVALID_ARGUMENT.
+class BadStructSize : public std::exception {
+ public:
+  explicit BadStructSize(std::string message) : message_(std::move(message)) {}
+  const char* what() const noexcept override { return message_.c_str(); }
+
+ private:
+  std::string message_;
+};
+
+/// A caller's argument struct (tetrapage.h, "Argument structs"): `defaults` where `given` is
+/// null, and for each field its struct_size does not cover (a program compiled against an
+/// older header, whose struct ends before the fields added since).
+/// @throw BadStructSize for a size below the struct_size field, or beyond this library's struct.
+template <class Args>
+Args read_args(const Args* given, const Args& defaults, const char* name) {
+  // Fields are only ever appended, and no struct has tail padding (CApi.cpp asserts it): an
+  // older struct's bytes are exactly the fields it had.
+  if (given == nullptr) return defaults;
+  const std::size_t size = given->struct_size;
+  if (size < sizeof(std::size_t) || size > sizeof(Args))
+    throw BadStructSize(std::string(name) + "->struct_size is " + std::to_string(size) +
+                        ": this library reads " + std::to_string(sizeof(std::size_t)) + " to " +
+                        std::to_string(sizeof(Args)) + " bytes (set it with the init function)");
+  Args read = defaults;
+  std::memcpy(static_cast<void*>(&read), given, size);
+  read.struct_size = sizeof(Args);
+  return read;
+}
+
 /// A handle that names no live index or object: reported as TETRAPAGE_ERROR_STALE_HANDLE.
 class StaleHandle : public std::exception {
  public:
@@ -169,6 +200,8 @@ inline tetrapage_status guarded(const char* function, Body&& body) noexcept {
   } catch (const NullArgument& e) {
     return fail(TETRAPAGE_ERROR_INVALID_ARGUMENT, function,
                 (std::string(e.what()) + " is null").c_str());
+  } catch (const BadStructSize& e) {
+    return fail(TETRAPAGE_ERROR_INVALID_ARGUMENT, function, e.what());
   } catch (const StaleHandle& e) {
     return fail(TETRAPAGE_ERROR_STALE_HANDLE, function, e.what());
   } catch (const tetrapage::IoError& e) {

@@ -2,7 +2,8 @@
 // arguments, NaN poses, invalid accuracies), and its answers against the C++ FlyingObject and
 // a brute-force oracle (every environment triangle against every object triangle, exactly) on
 // random poses. The index is built once by preprocess from a few hundred triangles (stored in
-// double precision, so the stored coordinates are the input's).
+// double precision, so the stored coordinates are the input's). The deprecated calls of the first
+// release are covered too, against the calls that replace them.
 
 #include <unistd.h>
 
@@ -10,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -28,6 +30,9 @@
 #include "tetrapage/formats/Pose.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/runtime/CollisionIndex.h"
+
+// The deprecated calls stay tested until they go.
+#pragma GCC diagnostic ignored "-Wdeprecated-declarations"
 #include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
 #include "tetrapage/tetrapage.h"
@@ -121,6 +126,13 @@ Pose to_pose(const std::array<double, 7>& p) {
 }
 
 using ContactKey = std::tuple<std::uint32_t, std::uint64_t, std::uint32_t>;
+
+std::set<ContactKey> contact_set(const std::vector<tetrapage_hit>& contacts) {
+  std::set<ContactKey> out;
+  for (const auto& c : contacts)
+    out.emplace(c.environment_part, c.environment_triangle, c.object_triangle);
+  return out;
+}
 
 std::set<ContactKey> contact_set(const std::vector<tetrapage_contact>& contacts) {
   std::set<ContactKey> out;
@@ -421,25 +433,31 @@ TEST_F(CApiTest, ShapedQueriesCollideWhereTheMeshDoesAndRejectUnknownShapes) {
   ASSERT_NE(object, nullptr);
   const double touching[7] = {1.5, 0.75, 0.75, 1, 0, 0, 0};
   int collides = -1;
+  tetrapage_query_args args;
   for (const auto shape : {TETRAPAGE_SHAPE_MESH, TETRAPAGE_SHAPE_HULL, TETRAPAGE_SHAPE_BOX})
     for (const auto motion : {TETRAPAGE_MOTION_DISCRETE, TETRAPAGE_MOTION_SWEPT}) {
-      ASSERT_EQ(tetrapage_query_shaped(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, shape, motion, 0, &collides),
-                TETRAPAGE_OK);
+      tetrapage_query_args_init(&args);
+      args.shape = shape;
+      args.motion = motion;
+      ASSERT_EQ(tetrapage_collide(object, touching, &args, &collides), TETRAPAGE_OK);
       EXPECT_EQ(collides, 1) << int(shape) << " " << int(motion);  // coarser shapes hold the object
-      tetrapage_contact contact{};
+      tetrapage_hit hit{};
       std::size_t written = 0;
-      ASSERT_EQ(tetrapage_get_contacts(object, &contact, 1, &written), TETRAPAGE_OK);
+      ASSERT_EQ(tetrapage_get_hits(object, &hit, 1, &written), TETRAPAGE_OK);
       ASSERT_EQ(written, 1u);
       // Solids name no object triangle (the second query of the loop sweeps).
-      EXPECT_EQ(contact.object_triangle == UINT32_MAX, shape != TETRAPAGE_SHAPE_MESH || motion == TETRAPAGE_MOTION_SWEPT);
+      EXPECT_EQ(hit.object_triangle == TETRAPAGE_NO_OBJECT_TRIANGLE,
+                shape != TETRAPAGE_SHAPE_MESH || motion == TETRAPAGE_MOTION_SWEPT);
+      EXPECT_NE(hit.environment_component, TETRAPAGE_NO_COMPONENT);
+      EXPECT_EQ(hit.dynamic_part, 0u);
     }
-  EXPECT_EQ(tetrapage_query_shaped(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, static_cast<tetrapage_object_shape>(7),
-                                   TETRAPAGE_MOTION_DISCRETE, 0, &collides),
-            TETRAPAGE_ERROR_INPUT);
+  tetrapage_query_args_init(&args);
+  args.shape = 7;
+  EXPECT_EQ(tetrapage_collide(object, touching, &args, &collides), TETRAPAGE_ERROR_INPUT);
   EXPECT_EQ(collides, 0);
-  EXPECT_EQ(tetrapage_query_shaped(object, touching, TETRAPAGE_ACCURACY_EXACT, 0, TETRAPAGE_SHAPE_MESH,
-                                   static_cast<tetrapage_motion>(9), 0, &collides),
-            TETRAPAGE_ERROR_INPUT);
+  tetrapage_query_args_init(&args);
+  args.motion = 9;
+  EXPECT_EQ(tetrapage_collide(object, touching, &args, &collides), TETRAPAGE_ERROR_INPUT);
   EXPECT_NE(std::string(tetrapage_last_error()).find("9"), std::string::npos) << tetrapage_last_error();
   tetrapage_object_destroy(object);
 }
@@ -540,10 +558,26 @@ TEST_F(CApiTest, AnswersEqualTheCppApiAndBruteForce) {
       SCOPED_TRACE("pose " + std::to_string(k) + ", accuracy " + geometry::to_string(setting.cpp));
       const auto expected = brute_force(p, setting.cpp);
       for (const int all : {0, 1}) {
+        // The deprecated call answers as the call that replaces it (compared below).
+        int deprecated_collides = -1;
+        ASSERT_EQ(tetrapage_query(object, p.data(), setting.accuracy, setting.parameter, all,
+                                  &deprecated_collides),
+                  TETRAPAGE_OK);
+        std::size_t deprecated_count = 0, deprecated_written = 0;
+        ASSERT_EQ(tetrapage_contact_count(object, &deprecated_count), TETRAPAGE_OK);
+        std::vector<tetrapage_contact> deprecated(deprecated_count);
+        ASSERT_EQ(tetrapage_get_contacts(object, deprecated.data(), deprecated.size(),
+                                         &deprecated_written),
+                  TETRAPAGE_OK);
+        tetrapage_query_args args;
+        tetrapage_query_args_init(&args);
+        args.accuracy = setting.accuracy;
+        args.parameter = setting.parameter;
+        args.contacts = all ? TETRAPAGE_CONTACTS_ALL : TETRAPAGE_CONTACTS_FIRST;
         int collides = -1;
-        ASSERT_EQ(tetrapage_query(object, p.data(), setting.accuracy, setting.parameter, all, &collides),
-                  TETRAPAGE_OK)
+        ASSERT_EQ(tetrapage_collide(object, p.data(), &args, &collides), TETRAPAGE_OK)
             << tetrapage_last_error();
+        EXPECT_EQ(deprecated_collides, collides);
         const QueryResult cpp = reference.query(
             to_pose(p), QueryOptions{setting.cpp, all ? QueryMode::all_contacts : QueryMode::first_hit});
         EXPECT_EQ(collides, cpp.collides ? 1 : 0);
@@ -551,11 +585,13 @@ TEST_F(CApiTest, AnswersEqualTheCppApiAndBruteForce) {
 
         std::size_t count = 0, written = 0;
         ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
-        std::vector<tetrapage_contact> contacts(count + 1);
-        ASSERT_EQ(tetrapage_get_contacts(object, contacts.data(), contacts.size(), &written), TETRAPAGE_OK);
+        std::vector<tetrapage_hit> contacts(count + 1);
+        ASSERT_EQ(tetrapage_get_hits(object, contacts.data(), contacts.size(), &written),
+                  TETRAPAGE_OK);
         ASSERT_EQ(written, count);
         contacts.resize(written);
         EXPECT_EQ(contact_set(contacts), contact_set(cpp.contacts));
+        EXPECT_EQ(contact_set(deprecated), contact_set(contacts));
         if (all) {
           EXPECT_EQ(contact_set(contacts), expected);
         } else {
@@ -604,27 +640,43 @@ TEST_F(CApiTest, DistanceImpactAndContactGeometryEqualTheCppApi) {
   for (int k = 0; k < 150; ++k) {
     const auto p = random_pose(uniform);
     SCOPED_TRACE("pose " + std::to_string(k));
-    tetrapage_distance distance;
-    ASSERT_EQ(tetrapage_distance_query(object, p.data(), INFINITY, &distance), TETRAPAGE_OK) << tetrapage_last_error();
+    tetrapage_distance deprecated_distance;
+    ASSERT_EQ(tetrapage_distance_query(object, p.data(), INFINITY, &deprecated_distance),
+              TETRAPAGE_OK);
+    tetrapage_distance_result distance;
+    ASSERT_EQ(tetrapage_measure_distance(object, p.data(), nullptr, &distance), TETRAPAGE_OK)
+        << tetrapage_last_error();
+    EXPECT_EQ(deprecated_distance.distance, distance.distance);
+    EXPECT_EQ(deprecated_distance.environment_triangle, distance.closest.environment_triangle);
     const DistanceResult cpp = reference.distance(to_pose(p));
     EXPECT_EQ(distance.separation, int(cpp.separation));
     EXPECT_EQ(distance.distance, cpp.distance);
     EXPECT_EQ(distance.lower_bound, cpp.lower_bound);
     EXPECT_EQ(distance.upper_bound, cpp.upper_bound);
-    EXPECT_EQ(distance.environment_triangle, cpp.environment_triangle);
+    EXPECT_EQ(distance.closest.environment_triangle, cpp.environment_triangle);
+    EXPECT_EQ(distance.closest.environment_component, TETRAPAGE_NO_COMPONENT);
+    if (cpp.environment_triangle == DistanceResult::kNoTriangle) {
+      EXPECT_EQ(distance.closest.object_triangle, TETRAPAGE_NO_OBJECT_TRIANGLE);
+    } else {
+      EXPECT_EQ(distance.closest.object_triangle, cpp.object_triangle);
+      EXPECT_EQ(distance.closest.environment_part, cpp.environment_part);
+    }
     for (int a = 0; a < 3; ++a) EXPECT_EQ(distance.on_object[a], cpp.on_object[a]);
     touching += distance.separation == 0;
     apart += distance.separation == 1;
     // Touching is what the collision query says; its contacts' geometry is the C++ API's.
     int collides = -1;
-    ASSERT_EQ(tetrapage_query(object, p.data(), TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), TETRAPAGE_OK);
+    tetrapage_query_args all;
+    tetrapage_query_args_init(&all);
+    all.contacts = TETRAPAGE_CONTACTS_ALL;
+    ASSERT_EQ(tetrapage_collide(object, p.data(), &all, &collides), TETRAPAGE_OK);
     EXPECT_EQ(collides, distance.separation == 0 ? 1 : 0);
     const QueryResult contacts = reference.query(to_pose(p), QueryOptions{{}, QueryMode::all_contacts});
     std::size_t count = 0;
     ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
-    std::vector<tetrapage_contact> listed(count);
+    std::vector<tetrapage_hit> listed(count);
     std::size_t written = 0;
-    ASSERT_EQ(tetrapage_get_contacts(object, listed.data(), count, &written), TETRAPAGE_OK);
+    ASSERT_EQ(tetrapage_get_hits(object, listed.data(), count, &written), TETRAPAGE_OK);
     for (std::size_t c = 0; c < written; ++c) {
       tetrapage_contact_geometry geometry;
       ASSERT_EQ(tetrapage_get_contact_geometry(object, c, &geometry), TETRAPAGE_OK) << tetrapage_last_error();
@@ -641,16 +693,32 @@ TEST_F(CApiTest, DistanceImpactAndContactGeometryEqualTheCppApi) {
     tetrapage_contact_geometry none;
     EXPECT_EQ(tetrapage_get_contact_geometry(object, written, &none), TETRAPAGE_ERROR_INPUT);
     // The motion from the previous pose: the C++ API's answer.
-    tetrapage_impact impact;
-    ASSERT_EQ(tetrapage_time_of_impact(object, previous.data(), p.data(), 1e-3, &impact), TETRAPAGE_OK)
+    tetrapage_impact deprecated_impact;
+    ASSERT_EQ(tetrapage_time_of_impact(object, previous.data(), p.data(), 1e-3, &deprecated_impact),
+              TETRAPAGE_OK);
+    tetrapage_impact_args impact_args;
+    tetrapage_impact_args_init(&impact_args);
+    impact_args.tolerance = 1e-3;
+    tetrapage_impact_result impact;
+    ASSERT_EQ(tetrapage_find_impact(object, previous.data(), p.data(), &impact_args, &impact),
+              TETRAPAGE_OK)
         << tetrapage_last_error();
+    EXPECT_EQ(deprecated_impact.contact_at, impact.contact_at);
     ImpactOptions options;
     options.tolerance = 1e-3;
     const ImpactResult expected = reference.time_of_impact(to_pose(previous), to_pose(p), options);
     EXPECT_EQ(impact.impact, int(expected.impact));
     EXPECT_EQ(impact.free_until, expected.free_until);
     EXPECT_EQ(impact.contact_at, expected.contact_at);
-    EXPECT_EQ(impact.environment_triangle, expected.environment_triangle);
+    if (expected.has_contact) {
+      EXPECT_EQ(impact.first_contact.environment_triangle, expected.environment_triangle);
+      EXPECT_EQ(impact.first_contact.object_triangle, expected.object_triangle);
+      EXPECT_EQ(deprecated_impact.environment_triangle, expected.environment_triangle);
+    } else {
+      EXPECT_EQ(impact.first_contact.environment_triangle, TETRAPAGE_NO_TRIANGLE);
+      EXPECT_EQ(impact.first_contact.object_triangle, TETRAPAGE_NO_OBJECT_TRIANGLE);
+    }
+    EXPECT_EQ(impact.containment, int(expected.containment));
     previous = p;
   }
   EXPECT_GT(touching, 3);
@@ -666,6 +734,127 @@ TEST_F(CApiTest, DistanceImpactAndContactGeometryEqualTheCppApi) {
   EXPECT_EQ(tetrapage_time_of_impact(object, pose, pose, 0.0, &impact), TETRAPAGE_ERROR_INPUT);
   EXPECT_EQ(tetrapage_time_of_impact(object, pose, pose, 2.0, &impact), TETRAPAGE_ERROR_INPUT);
   EXPECT_EQ(tetrapage_time_of_impact(object, pose, nullptr, 0.1, &impact), TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  tetrapage_object_destroy(object);
+}
+
+// The growth rule of tetrapage.h: a struct_size that ends before a field (a caller compiled
+// against an older header) reads that field's default, however its bytes are set.
+TEST_F(CApiTest, ArgumentStructsReadTheFieldsTheirSizeCoversAndDefaultTheRest) {
+  tetrapage_object* object = create_object();
+  ASSERT_NE(object, nullptr);
+  const double pose[7] = {1.5, 1.5, 0.75, std::cos(0.3), 0.2, 0, std::sin(0.3)};
+  const double norm = std::sqrt(pose[3] * pose[3] + pose[4] * pose[4] + pose[6] * pose[6]);
+  const double unit[7] = {pose[0],        pose[1], pose[2],       pose[3] / norm,
+                          pose[4] / norm, 0,       pose[6] / norm};
+  int collides = -1;
+  std::size_t count = 0;
+
+  // Null: every default (the first contact only).
+  ASSERT_EQ(tetrapage_collide(object, unit, nullptr, &collides), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  EXPECT_EQ(collides, 1);
+  EXPECT_EQ(count, 1u);
+
+  tetrapage_query_args args;
+  tetrapage_query_args_init(&args);
+  EXPECT_EQ(args.struct_size, sizeof args);
+  args.contacts = TETRAPAGE_CONTACTS_ALL;
+  ASSERT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_OK);
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  const std::size_t all_contacts = count;
+  ASSERT_GT(all_contacts, 1u);
+
+  // max_contacts read: more contacts than it allows is an error naming the limit.
+  args.max_contacts = 1;
+  EXPECT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_ERROR_INPUT);
+  EXPECT_NE(std::string(tetrapage_last_error()).find("more than 1 contacts"), std::string::npos)
+      << tetrapage_last_error();
+  // A struct that ends before max_contacts: the default limit, not the bytes past its size.
+  args.struct_size = offsetof(tetrapage_query_args, max_contacts);
+  ASSERT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  EXPECT_EQ(count, all_contacts);
+  // One that ends before contacts: the first contact only.
+  args.struct_size = offsetof(tetrapage_query_args, contacts);
+  ASSERT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_OK);
+  ASSERT_EQ(tetrapage_contact_count(object, &count), TETRAPAGE_OK);
+  EXPECT_EQ(count, 1u);
+
+  // Sizes this library cannot read, and values outside the enumerations.
+  for (const std::size_t size : {std::size_t(0), sizeof(std::size_t) - 1, sizeof args + 8}) {
+    args.struct_size = size;
+    EXPECT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_ERROR_INVALID_ARGUMENT)
+        << size;
+    EXPECT_NE(std::string(tetrapage_last_error()).find("struct_size is " + std::to_string(size)),
+              std::string::npos)
+        << tetrapage_last_error();
+    EXPECT_EQ(collides, 0);
+  }
+  tetrapage_query_args_init(&args);
+  args.contacts = 2;
+  EXPECT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_ERROR_INPUT);
+  tetrapage_query_args_init(&args);
+  args.max_contacts = 0;
+  EXPECT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_ERROR_INPUT);
+  tetrapage_query_args_init(&args);
+  args.accuracy = 42;
+  EXPECT_EQ(tetrapage_collide(object, unit, &args, &collides), TETRAPAGE_ERROR_INPUT);
+  tetrapage_query_args_init(nullptr);  // ignored
+
+  // Distance: max_distance read, or its default (any distance) past the struct's size.
+  const double far[7] = {40, 40, 40, 1, 0, 0, 0};
+  tetrapage_distance_args near;
+  tetrapage_distance_args_init(&near);
+  near.max_distance = 1;
+  tetrapage_distance_result distance;
+  ASSERT_EQ(tetrapage_measure_distance(object, far, &near, &distance), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  EXPECT_EQ(distance.separation, 2);  // farther: not measured
+  EXPECT_EQ(distance.closest.environment_triangle, TETRAPAGE_NO_TRIANGLE);
+  EXPECT_EQ(distance.closest.object_triangle, TETRAPAGE_NO_OBJECT_TRIANGLE);
+  near.struct_size = offsetof(tetrapage_distance_args, max_distance);
+  ASSERT_EQ(tetrapage_measure_distance(object, far, &near, &distance), TETRAPAGE_OK);
+  EXPECT_EQ(distance.separation, 1);
+  EXPECT_NE(distance.closest.environment_triangle, TETRAPAGE_NO_TRIANGLE);
+  near.struct_size = 1;
+  EXPECT_EQ(tetrapage_measure_distance(object, far, &near, &distance),
+            TETRAPAGE_ERROR_INVALID_ARGUMENT);
+  tetrapage_distance_args_init(&near);
+  near.max_distance = -1;
+  EXPECT_EQ(tetrapage_measure_distance(object, far, &near, &distance), TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_measure_distance(object, far, nullptr, nullptr),
+            TETRAPAGE_ERROR_INVALID_ARGUMENT);
+
+  // Time of impact: one iteration leaves a long motion unresolved; the default limit resolves it.
+  const double from[7] = {-6, 0.75, 0.75, 1, 0, 0, 0};
+  tetrapage_impact_args impact_args;
+  tetrapage_impact_args_init(&impact_args);
+  EXPECT_EQ(impact_args.max_iterations, 10000u);
+  impact_args.max_iterations = 1;
+  tetrapage_impact_result impact;
+  ASSERT_EQ(tetrapage_find_impact(object, from, unit, &impact_args, &impact), TETRAPAGE_OK)
+      << tetrapage_last_error();
+  EXPECT_EQ(impact.impact, 2);
+  EXPECT_LE(impact.iterations, 1u);
+  impact_args.struct_size = offsetof(tetrapage_impact_args, max_iterations);
+  ASSERT_EQ(tetrapage_find_impact(object, from, unit, &impact_args, &impact), TETRAPAGE_OK);
+  EXPECT_EQ(impact.impact, 1);
+  EXPECT_NE(impact.first_contact.environment_triangle, TETRAPAGE_NO_TRIANGLE);
+  tetrapage_impact_args_init(&impact_args);
+  impact_args.max_iterations = 0;
+  EXPECT_EQ(tetrapage_find_impact(object, from, unit, &impact_args, &impact),
+            TETRAPAGE_ERROR_INPUT);
+  impact_args.max_iterations = std::uint64_t(1) << 32;
+  EXPECT_EQ(tetrapage_find_impact(object, from, unit, &impact_args, &impact),
+            TETRAPAGE_ERROR_INPUT);
+  tetrapage_impact_args_init(&impact_args);
+  impact_args.tolerance = 0;
+  EXPECT_EQ(tetrapage_find_impact(object, from, unit, &impact_args, &impact),
+            TETRAPAGE_ERROR_INPUT);
+  EXPECT_EQ(tetrapage_find_impact(object, from, nullptr, nullptr, &impact),
+            TETRAPAGE_ERROR_INVALID_ARGUMENT);
   tetrapage_object_destroy(object);
 }
 
@@ -765,15 +954,17 @@ TEST_F(CApiTest, StaleHandlesAreReportedNeverDereferenced) {
   EXPECT_TRUE(names("object handle")) << tetrapage_last_error();
   EXPECT_EQ(tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, 1, &collides), stale);
   EXPECT_EQ(collides, 0);
-  EXPECT_EQ(tetrapage_query_shaped(object, pose, TETRAPAGE_ACCURACY_EXACT, 0, TETRAPAGE_SHAPE_HULL,
-                                   TETRAPAGE_MOTION_SWEPT, 0, &collides),
-            stale);
+  EXPECT_EQ(tetrapage_collide(object, pose, nullptr, &collides), stale);
   std::size_t count = 7, written = 7;
   tetrapage_contact contact;
   tetrapage_query_info info;
   EXPECT_EQ(tetrapage_contact_count(object, &count), stale);
   EXPECT_EQ(count, 0u);
   EXPECT_EQ(tetrapage_get_contacts(object, &contact, 1, &written), stale);
+  EXPECT_EQ(written, 0u);
+  tetrapage_hit hit;
+  written = 7;
+  EXPECT_EQ(tetrapage_get_hits(object, &hit, 1, &written), stale);
   EXPECT_EQ(written, 0u);
   EXPECT_EQ(tetrapage_last_query_info(object, &info), stale);
 

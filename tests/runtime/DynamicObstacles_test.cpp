@@ -813,18 +813,19 @@ TEST(DynamicObstacles, TheCApiAnswersAsCxx) {
                          pose.rotation[0],    pose.rotation[1],    pose.rotation[2],
                          pose.rotation[3]};
     int collides = 0;
-    ASSERT_EQ(tetrapage_query(flying, p, TETRAPAGE_ACCURACY_EXACT, 0.0, 0, &collides),
-              TETRAPAGE_OK);
+    ASSERT_EQ(tetrapage_collide(flying, p, nullptr, &collides), TETRAPAGE_OK);
     const QueryResult expected = cxx.query(pose);
     EXPECT_EQ(collides != 0, expected.collides);
-    std::uint32_t part = 0;
+    tetrapage_hit hit{};
     std::size_t written = 0;
-    ASSERT_EQ(tetrapage_get_contact_dynamic_parts(flying, &part, 1, &written), TETRAPAGE_OK);
+    ASSERT_EQ(tetrapage_get_hits(flying, &hit, 1, &written), TETRAPAGE_OK);
     ASSERT_EQ(written, expected.contacts.size());
     if (written == 1) {
-      EXPECT_EQ(part, expected.contacts[0].dynamic_part);
+      EXPECT_EQ(hit.dynamic_part, expected.contacts[0].dynamic_part);
+      EXPECT_EQ(hit.environment_part == TETRAPAGE_DYNAMIC_PART, hit.dynamic_part != 0);
+      EXPECT_EQ(hit.environment_triangle, expected.contacts[0].environment_triangle);
     }
-    dynamic += written == 1 && part != 0;
+    dynamic += written == 1 && hit.dynamic_part != 0;
   }
   EXPECT_GT(dynamic, 0);
   // A group of the one object answers the same with the overlay.

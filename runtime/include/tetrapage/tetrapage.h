@@ -35,7 +35,7 @@
  *   }
  *   const double pose[7] = {0.5, 0.5, 0.5, 1, 0, 0, 0};  // tx ty tz qw qx qy qz
  *   int collides = 0;
- *   tetrapage_query(object, pose, TETRAPAGE_ACCURACY_EXACT, 0.0, 0, &collides);
+ *   tetrapage_collide(object, pose, NULL, &collides);  // NULL: the defaults (exact, first hit)
  *   tetrapage_object_destroy(object);
  *   tetrapage_close(index);
  */
@@ -46,6 +46,15 @@
 #include <stdint.h>
 
 #include "tetrapage/version.h"
+
+/* Marks a call kept for one release after its replacement: compilers warn where it is used. */
+#if defined(__GNUC__) || defined(__clang__)
+#define TETRAPAGE_DEPRECATED(message) __attribute__((deprecated(message)))
+#elif defined(_MSC_VER)
+#define TETRAPAGE_DEPRECATED(message) __declspec(deprecated(message))
+#else
+#define TETRAPAGE_DEPRECATED(message)
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -209,23 +218,6 @@ typedef enum tetrapage_accuracy {
 tetrapage_status tetrapage_parse_accuracy(const char* text, tetrapage_accuracy* accuracy,
                                           double* parameter);
 
-/* Places the object at `pose` and decides whether it touches the environment.
-   pose: tx, ty, tz, qw, qx, qy, qz (the pose-file order); it maps the object's coordinates x to
-   R(q) x + t, and q must be a unit quaternion (up to rounding).
-   all_contacts: 0 stops at the first contact found; non-zero collects every contact pair.
-   On success *collides is 1 or 0 and the contacts are kept in the object until its next
-   query (tetrapage_contact_count, tetrapage_get_contacts, tetrapage_last_query_info).
-   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, a translation beyond
-           1e150 in magnitude (distances from there would overflow), an invalid accuracy or
-           parameter), TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard this query needs
-           could not be read or failed its checksum, also when the background prefetcher met
-           the fault first: the message names the shard and the file; other shards and other
-           objects stay usable), TETRAPAGE_ERROR_INVALID_ARGUMENT,
-           TETRAPAGE_ERROR_STALE_HANDLE. After a failure the object holds no contact. */
-tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
-                                 tetrapage_accuracy accuracy, double parameter, int all_contacts,
-                                 int* collides);
-
 /* How finely the object is checked (the C++ ObjectShape): its triangles; the convex hull of
    its placed vertices as a solid; its world axis-aligned box as a solid. Coarser shapes never
    miss a contact of the finer ones under the exact accuracy, and answer yes more often. */
@@ -243,34 +235,84 @@ typedef enum tetrapage_motion {
   TETRAPAGE_MOTION_SWEPT = 1
 } tetrapage_motion;
 
-/* tetrapage_query with the object's shape and motion chosen (tetrapage_query is
-   TETRAPAGE_SHAPE_MESH, TETRAPAGE_MOTION_DISCRETE). Contacts of a solid (hull, box, swept)
-   name the environment triangle and UINT32_MAX as the object triangle.
-   Errors: as tetrapage_query; TETRAPAGE_ERROR_INPUT for an unknown shape or motion. */
-tetrapage_status tetrapage_query_shaped(tetrapage_object* object, const double pose[7],
-                                        tetrapage_accuracy accuracy, double parameter,
-                                        tetrapage_object_shape shape, tetrapage_motion motion,
-                                        int all_contacts, int* collides);
+/* ---- Argument structs: how this API grows ----
+   A query's options travel in an argument struct whose first field, struct_size, is the size
+   of the struct the caller was compiled with; its init function sets struct_size and every
+   default. A new option is a new field at the end of its struct, never a new function: the
+   library reads the fields that struct_size covers and takes the defaults for the others, so a
+   program compiled against an older header keeps its behaviour. A null args pointer means
+   every default. A struct_size below sizeof(size_t), or beyond the struct this library knows
+   (a program compiled against a newer header), is TETRAPAGE_ERROR_INVALID_ARGUMENT.
+   Enumerations are stored as int32_t fields (their values are the enumerators). */
 
-/* One contact: an environment triangle (its part, connected component and model-wide id) and
-   an object triangle (UINT32_MAX when the object was checked as a solid). */
-typedef struct tetrapage_contact {
+/* tetrapage_query_args.contacts */
+#define TETRAPAGE_CONTACTS_FIRST 0 /* stop at the first contact found */
+#define TETRAPAGE_CONTACTS_ALL 1   /* collect every contact pair */
+
+typedef struct tetrapage_query_args {
+  size_t struct_size;
+  int32_t accuracy; /* a tetrapage_accuracy; default TETRAPAGE_ACCURACY_EXACT */
+  double parameter; /* the accuracy's epsilon or clearance; default 0 */
+  int32_t shape;    /* a tetrapage_object_shape; default TETRAPAGE_SHAPE_MESH */
+  int32_t motion;   /* a tetrapage_motion; default TETRAPAGE_MOTION_DISCRETE */
+  int32_t contacts; /* TETRAPAGE_CONTACTS_FIRST (default) or _ALL */
+  /* TETRAPAGE_CONTACTS_ALL: a query that finds more contacts fails with TETRAPAGE_ERROR_INPUT
+     naming the limit, instead of growing without bound; default 1,000,000. */
+  uint64_t max_contacts;
+} tetrapage_query_args;
+
+/* Sets struct_size and the defaults above. A null args is ignored. */
+void tetrapage_query_args_init(tetrapage_query_args* args);
+
+/* The "no triangle" of every hit: no environment triangle (a distance farther than its limit,
+   a containment), no object triangle (the object checked as a solid: hull, box, swept), no
+   component (a query that does not name it). */
+#define TETRAPAGE_NO_TRIANGLE UINT64_MAX
+#define TETRAPAGE_NO_OBJECT_TRIANGLE UINT32_MAX
+#define TETRAPAGE_NO_COMPONENT UINT32_MAX
+/* environment_part of a hit on a dynamic obstacle (tetrapage_obstacles): no part of the index. */
+#define TETRAPAGE_DYNAMIC_PART 0xFFFFFFFEu
+
+/* Where a query's answer touches: one environment triangle and one object triangle. Every
+   query names its sites with it (contacts, the closest pair of a distance, the first contact
+   of a time of impact). */
+typedef struct tetrapage_hit {
+  /* The triangle's model-wide id (tetrapage_index_triangle), or for a dynamic obstacle its
+     index in that obstacle's mesh; TETRAPAGE_NO_TRIANGLE when none. */
   uint64_t environment_triangle;
-  uint32_t environment_part;
-  uint32_t object_triangle;
-  uint32_t environment_component;
-} tetrapage_contact;
+  uint32_t environment_part;      /* TETRAPAGE_DYNAMIC_PART for a dynamic obstacle */
+  uint32_t environment_component; /* the connected component; TETRAPAGE_NO_COMPONENT unnamed */
+  uint32_t object_triangle;       /* TETRAPAGE_NO_OBJECT_TRIANGLE for a solid, or none */
+  uint32_t dynamic_part;          /* the dynamic obstacle's id, 0 for the index's triangles */
+} tetrapage_hit;
 
-/* The number of contacts of the last successful query (first hit: 0 or 1).
+/* Places the object at `pose` and decides whether it touches the environment, with the options
+   of `args` (null: every default: exact, the object's mesh, discrete, first contact).
+   pose: tx, ty, tz, qw, qx, qy, qz (the pose-file order); it maps the object's coordinates x to
+   R(q) x + t, and q must be a unit quaternion (up to rounding).
+   On success *collides is 1 or 0 and the contacts are kept in the object until its next query
+   (tetrapage_contact_count, tetrapage_get_hits, tetrapage_last_query_info).
+   Errors: TETRAPAGE_ERROR_INPUT (non-finite pose, non-unit quaternion, a translation beyond
+           1e150 in magnitude (distances from there would overflow), an unknown accuracy, shape,
+           motion or contacts value, an invalid parameter, more contacts than max_contacts),
+           TETRAPAGE_ERROR_IO / TETRAPAGE_ERROR_FORMAT (a shard this query needs could not be
+           read or failed its checksum, also when the background prefetcher met the fault
+           first: the message names the shard and the file; other shards and other objects
+           stay usable), TETRAPAGE_ERROR_INVALID_ARGUMENT (a null object, pose or collides, a
+           bad struct_size), TETRAPAGE_ERROR_STALE_HANDLE. After a failure the object holds no
+           contact. */
+tetrapage_status tetrapage_collide(tetrapage_object* object, const double pose[7],
+                                   const tetrapage_query_args* args, int* collides);
+
+/* The number of contacts of the last successful query (first contact only: 0 or 1).
    Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_contact_count(const tetrapage_object* object, size_t* count);
 
-/* Copies the first min(capacity, count) contacts of the last query to `contacts` and their
-   number to *written. `contacts` may be null when capacity is 0.
+/* Copies the first min(capacity, count) contacts of the last query to `hits` and their number
+   to *written. `hits` may be null when capacity is 0.
    Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
-tetrapage_status tetrapage_get_contacts(const tetrapage_object* object,
-                                        tetrapage_contact* contacts, size_t capacity,
-                                        size_t* written);
+tetrapage_status tetrapage_get_hits(const tetrapage_object* object, tetrapage_hit* hits,
+                                    size_t capacity, size_t* written);
 
 /* What the last query did: the counters that explain its time. */
 typedef struct tetrapage_query_info {
@@ -316,20 +358,32 @@ typedef struct tetrapage_contact_geometry {
   double object_normal[3];
 } tetrapage_contact_geometry;
 
-/* The geometry of contact `contact` (an index < tetrapage_contact_count) of the object's last
-   query, at that query's pose. Computed in double from exactly decided topology: each point
-   lies within 2^-40 of the coordinates' magnitude of the exact intersection.
+/* The geometry of contact `contact` (an index < tetrapage_contact_count, as in tetrapage_get_hits)
+   of the object's last query, at that query's pose. Computed in double from exactly decided
+   topology: each point lies within 2^-40 of the coordinates' magnitude of the exact intersection.
    Errors: TETRAPAGE_ERROR_INPUT (no such contact), TETRAPAGE_ERROR_IO / _FORMAT (the
            triangle's shard could not be read), TETRAPAGE_ERROR_INVALID_ARGUMENT,
            TETRAPAGE_ERROR_STALE_HANDLE. */
 tetrapage_status tetrapage_get_contact_geometry(tetrapage_object* object, size_t contact,
                                                 tetrapage_contact_geometry* geometry);
 
+/* ---- Distance ---- */
+
+typedef struct tetrapage_distance_args {
+  size_t struct_size;
+  /* Distances beyond this are not measured (the answer is then "farther", cheap in free
+     space); >= 0, in the model's unit; default INFINITY (any distance is measured). */
+  double max_distance;
+} tetrapage_distance_args;
+
+/* Sets struct_size and the default above. A null args is ignored. */
+void tetrapage_distance_args_init(tetrapage_distance_args* args);
+
 /* The distance from the object at a pose to the environment. */
-typedef struct tetrapage_distance {
+typedef struct tetrapage_distance_result {
   /* 0 touching (distance 0: surfaces meet, or one body holds the other: see containment),
      1 apart, 2 farther than max_distance (not measured; lower_bound >= max_distance). */
-  int separation;
+  int32_t separation;
   double distance;
   /* The true distance lies in [lower_bound, upper_bound] (the double computation's error
      bound); upper_bound is +infinity when farther. */
@@ -337,43 +391,60 @@ typedef struct tetrapage_distance {
   double upper_bound;
   double on_environment[3]; /* the closest points (apart), or a shared point (touching) */
   double on_object[3];
-  uint64_t environment_triangle; /* UINT64_MAX when none (farther, or a containment) */
-  uint32_t environment_part;
-  uint32_t object_triangle;
-  int containment; /* as tetrapage_query_info.containment */
+  /* The closest pair (environment_component TETRAPAGE_NO_COMPONENT); both triangles
+     TETRAPAGE_NO_TRIANGLE / TETRAPAGE_NO_OBJECT_TRIANGLE when farther or a containment. */
+  tetrapage_hit closest;
+  int32_t containment; /* as tetrapage_query_info.containment */
   uint32_t containing_part;
-  uint64_t pair_tests; /* triangle pairs measured */
-} tetrapage_distance;
+  uint32_t containing_dynamic_part; /* the dynamic obstacle holding or held, else 0 */
+  uint64_t pair_tests;              /* triangle pairs measured */
+} tetrapage_distance_result;
 
-/* Places the object at `pose` (as tetrapage_query) and measures its distance to the
-   environment: exact touching decision first, then closest points within max_distance (pass
-   INFINITY to measure any distance). Consecutive poses of one object start from the last
-   closest pair. This is a query: it replaces the object's last contacts.
-   Errors: as tetrapage_query; TETRAPAGE_ERROR_INPUT for a negative or NaN max_distance. */
-tetrapage_status tetrapage_distance_query(tetrapage_object* object, const double pose[7],
-                                          double max_distance, tetrapage_distance* result);
+/* Places the object at `pose` (as tetrapage_collide) and measures its distance to the
+   environment: exact touching decision first, then closest points within max_distance.
+   Consecutive poses of one object start from the last closest pair. This is a query: it
+   replaces the object's last contacts.
+   Errors: as tetrapage_collide; TETRAPAGE_ERROR_INPUT for a negative or NaN max_distance. */
+tetrapage_status tetrapage_measure_distance(tetrapage_object* object, const double pose[7],
+                                            const tetrapage_distance_args* args,
+                                            tetrapage_distance_result* result);
+
+/* ---- Time of impact ---- */
+
+typedef struct tetrapage_impact_args {
+  size_t struct_size;
+  double tolerance;        /* the bracket's width at most, in (0, 1] of the motion's time;
+                              default 1e-4 */
+  uint64_t max_iterations; /* distance queries at most, in [1, 2^32 - 1]; default 10,000 */
+} tetrapage_impact_args;
+
+/* Sets struct_size and the defaults above. A null args is ignored. */
+void tetrapage_impact_args_init(tetrapage_impact_args* args);
 
 /* The first contact of the object moving from pose `from` to pose `to`. */
-typedef struct tetrapage_impact {
+typedef struct tetrapage_impact_result {
   /* 0 none (certified: no contact during the motion), 1 hit, 2 unresolved (the iterations ran
      out: no contact before free_until, nothing known after). */
-  int impact;
+  int32_t impact;
   double free_until; /* no contact at any time in [0, free_until) */
-  double contact_at; /* a hit: the pose at this time touches; contact_at - free_until <= tolerance */
-  int has_contact;   /* the contact below is set (a hit by containment has none) */
-  uint64_t environment_triangle;
-  uint32_t environment_part;
-  uint32_t object_triangle;
+  double contact_at; /* a hit: this pose touches; contact_at - free_until <= tolerance */
+  /* A hit's first contact (environment_component TETRAPAGE_NO_COMPONENT); no triangles when
+     there is none (no hit, or a hit by containment). */
+  tetrapage_hit first_contact;
+  int32_t containment; /* a hit by containment: as tetrapage_query_info.containment */
+  uint32_t containing_part;
+  uint32_t containing_dynamic_part;
   uint32_t iterations; /* distance queries run */
-} tetrapage_impact;
+} tetrapage_impact_result;
 
 /* The time of impact over the motion from `from` to `to` (translation linear, rotation by
    slerp over time [0, 1]) by conservative advancement, with a bracket of width `tolerance`
-   (in (0, 1]) closed by an exact collision query.
-   Errors: as tetrapage_query; TETRAPAGE_ERROR_INPUT for a tolerance outside (0, 1]. */
-tetrapage_status tetrapage_time_of_impact(tetrapage_object* object, const double from[7],
-                                          const double to[7], double tolerance,
-                                          tetrapage_impact* result);
+   closed by an exact collision query.
+   Errors: as tetrapage_collide; TETRAPAGE_ERROR_INPUT for a tolerance outside (0, 1] or a
+           max_iterations outside [1, 2^32 - 1]. */
+tetrapage_status tetrapage_find_impact(tetrapage_object* object, const double from[7],
+                                       const double to[7], const tetrapage_impact_args* args,
+                                       tetrapage_impact_result* result);
 
 /* ------------------------------------------------------------------------------------------ */
 /* Groups of objects                                                                           */
@@ -398,12 +469,12 @@ tetrapage_status tetrapage_group_create(tetrapage_index* index, tetrapage_object
    Errors: TETRAPAGE_ERROR_STALE_HANDLE (destroyed already, or not a group handle). */
 tetrapage_status tetrapage_group_destroy(tetrapage_group* group);
 
-/* One step: object k at poses[7k .. 7k+6] (tx, ty, tz, qw, qx, qy, qz, as tetrapage_query),
+/* One step: object k at poses[7k .. 7k+6] (tx, ty, tz, qw, qx, qy, qz, as tetrapage_collide),
    checked against the environment (exact accuracy, the object's mesh, discrete) and against
    every other object. all_contacts: 0 keeps the first contact found per object and per pair;
    non-zero every one. On success *colliding_pairs is the number of pairs of objects that
    collide; the answers are kept in the group until its next step.
-   Errors: as tetrapage_query (the message names the object of a bad pose),
+   Errors: as tetrapage_collide (the message names the object of a bad pose),
            TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. After a failure the
            group holds no answer. */
 tetrapage_status tetrapage_group_step(tetrapage_group* group, const double* poses, int all_contacts,
@@ -438,10 +509,10 @@ tetrapage_status tetrapage_group_environment(const tetrapage_group* group, int* 
    An overlay of parts inserted, moved and removed at run time on one index, and of index parts
    hidden from the answers. An object given the overlay (tetrapage_object_set_obstacles)
    answers as if the index held its visible parts plus the dynamic parts: a contact with a
-   dynamic part has environment_part 0xFFFFFFFE, environment_triangle the triangle's index in
-   that part's mesh, and its id in tetrapage_get_contact_dynamic_parts. Changes from one
-   thread, between the steps of the objects that hold the overlay. A pose is 7 doubles (tx, ty,
-   tz, qw, qx, qy, qz) as in tetrapage_query. */
+   dynamic part is a tetrapage_hit with environment_part TETRAPAGE_DYNAMIC_PART,
+   environment_triangle the triangle's index in that part's mesh, and dynamic_part its id.
+   Changes from one thread, between the steps of the objects that hold the overlay. A pose is
+   7 doubles (tx, ty, tz, qw, qx, qy, qz) as in tetrapage_collide. */
 typedef struct tetrapage_obstacles tetrapage_obstacles;
 
 /* An empty overlay on `index`.
@@ -486,13 +557,6 @@ tetrapage_status tetrapage_object_set_obstacles(tetrapage_object* object,
 tetrapage_status tetrapage_group_set_obstacles(tetrapage_group* group,
                                                tetrapage_obstacles* obstacles);
 
-/* Per contact of the last query (as tetrapage_get_contacts), its dynamic part's id or 0 for a
-   part of the index: the first min(capacity, count), their number to *written.
-   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
-tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* object,
-                                                     uint32_t* parts, size_t capacity,
-                                                     size_t* written);
-
 /* Writes the overlay to `path`; reads one back on `index` (same ids, names, poses, meshes and
    hidden parts).
    Errors: TETRAPAGE_ERROR_IO (cannot write), TETRAPAGE_ERROR_FORMAT (a missing, truncated or
@@ -501,6 +565,86 @@ tetrapage_status tetrapage_get_contact_dynamic_parts(const tetrapage_object* obj
 tetrapage_status tetrapage_obstacles_save(const tetrapage_obstacles* obstacles, const char* path);
 tetrapage_status tetrapage_obstacles_load(tetrapage_index* index, const char* path,
                                           tetrapage_obstacles** obstacles);
+
+/* ------------------------------------------------------------------------------------------ */
+/* Deprecated: the calls of the first release, thin wrappers over those above                   */
+/* They stay for one release; compilers warn where they are used (TETRAPAGE_DEPRECATED). */
+
+/* tetrapage_collide with the accuracy and parameter given, TETRAPAGE_SHAPE_MESH,
+   TETRAPAGE_MOTION_DISCRETE, and all_contacts non-zero for TETRAPAGE_CONTACTS_ALL.
+   Errors: as tetrapage_collide. */
+TETRAPAGE_DEPRECATED("use tetrapage_collide")
+tetrapage_status tetrapage_query(tetrapage_object* object, const double pose[7],
+                                 tetrapage_accuracy accuracy, double parameter, int all_contacts,
+                                 int* collides);
+
+/* One contact: an environment triangle (its part, connected component and model-wide id) and
+   an object triangle (UINT32_MAX when the object was checked as a solid). */
+typedef struct tetrapage_contact {
+  uint64_t environment_triangle;
+  uint32_t environment_part;
+  uint32_t object_triangle;
+  uint32_t environment_component;
+} tetrapage_contact;
+
+/* Copies the first min(capacity, count) contacts of the last query to `contacts` and their
+   number to *written. `contacts` may be null when capacity is 0.
+   Errors: TETRAPAGE_ERROR_INVALID_ARGUMENT, TETRAPAGE_ERROR_STALE_HANDLE. */
+TETRAPAGE_DEPRECATED("use tetrapage_get_hits")
+tetrapage_status tetrapage_get_contacts(const tetrapage_object* object, tetrapage_contact* contacts,
+                                        size_t capacity, size_t* written);
+
+/* The distance from the object at a pose to the environment. */
+typedef struct tetrapage_distance {
+  /* 0 touching (distance 0: surfaces meet, or one body holds the other: see containment),
+     1 apart, 2 farther than max_distance (not measured; lower_bound >= max_distance). */
+  int separation;
+  double distance;
+  /* The true distance lies in [lower_bound, upper_bound] (the double computation's error
+     bound); upper_bound is +infinity when farther. */
+  double lower_bound;
+  double upper_bound;
+  double on_environment[3]; /* the closest points (apart), or a shared point (touching) */
+  double on_object[3];
+  uint64_t environment_triangle; /* UINT64_MAX when none (farther, or a containment) */
+  uint32_t environment_part;
+  uint32_t object_triangle;
+  int containment; /* as tetrapage_query_info.containment */
+  uint32_t containing_part;
+  uint64_t pair_tests; /* triangle pairs measured */
+} tetrapage_distance;
+
+/* Places the object at `pose` (as tetrapage_collide) and measures its distance to the
+   environment: exact touching decision first, then closest points within max_distance (pass
+   INFINITY to measure any distance). Consecutive poses of one object start from the last
+   closest pair. This is a query: it replaces the object's last contacts.
+   Errors: as tetrapage_collide; TETRAPAGE_ERROR_INPUT for a negative or NaN max_distance. */
+TETRAPAGE_DEPRECATED("use tetrapage_measure_distance")
+tetrapage_status tetrapage_distance_query(tetrapage_object* object, const double pose[7],
+                                          double max_distance, tetrapage_distance* result);
+
+/* The first contact of the object moving from pose `from` to pose `to`. */
+typedef struct tetrapage_impact {
+  /* 0 none (certified: no contact during the motion), 1 hit, 2 unresolved (the iterations ran
+     out: no contact before free_until, nothing known after). */
+  int impact;
+  double free_until; /* no contact at any time in [0, free_until) */
+  double contact_at; /* a hit: this pose touches; contact_at - free_until <= tolerance */
+  int has_contact;   /* the contact below is set (a hit by containment has none) */
+  uint64_t environment_triangle;
+  uint32_t environment_part;
+  uint32_t object_triangle;
+  uint32_t iterations; /* distance queries run */
+} tetrapage_impact;
+
+/* The time of impact over the motion from `from` to `to` (translation linear, rotation by
+   slerp over time [0, 1]) by conservative advancement, with a bracket of width `tolerance`
+   (in (0, 1]) closed by an exact collision query.
+   Errors: as tetrapage_collide; TETRAPAGE_ERROR_INPUT for a tolerance outside (0, 1]. */
+TETRAPAGE_DEPRECATED("use tetrapage_find_impact")
+tetrapage_status tetrapage_time_of_impact(tetrapage_object* object, const double from[7],
+                                          const double to[7], double tolerance,
+                                          tetrapage_impact* result);
 
 #ifdef __cplusplus
 }
