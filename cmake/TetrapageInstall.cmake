@@ -47,7 +47,10 @@ install(TARGETS tetrapage_c
         EXPORT tetrapageCTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
-install(DIRECTORY ${PROJECT_SOURCE_DIR}/formats/include/ ${PROJECT_SOURCE_DIR}/runtime/include/
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/formats/base/include/ ${PROJECT_SOURCE_DIR}/formats/mesh/include/
+                  ${PROJECT_SOURCE_DIR}/formats/index/include/ ${PROJECT_SOURCE_DIR}/runtime/geometry/include/
+                  ${PROJECT_SOURCE_DIR}/runtime/paging/include/ ${PROJECT_SOURCE_DIR}/runtime/query/include/
+                  ${PROJECT_SOURCE_DIR}/runtime/capi/include/
         DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.h")
 install(FILES ${TETRAPAGE_VERSION_HEADER} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/tetrapage)
@@ -155,7 +158,7 @@ if(TETRAPAGE_BUILD_TESTS AND NOT TEST capi_example)
   add_test(NAME install_prefix
     COMMAND ${CMAKE_COMMAND} -DSTEP=prefix -DBUILD_DIR=${PROJECT_BINARY_DIR}
             -DPREFIX=${install_work}/prefix -DLIBDIR=${CMAKE_INSTALL_LIBDIR} -DNM=${CMAKE_NM}
-            -DHEADER=${PROJECT_SOURCE_DIR}/runtime/include/tetrapage/tetrapage.h
+            -DHEADER=${PROJECT_SOURCE_DIR}/runtime/capi/include/tetrapage/tetrapage.h
             -P ${capi_tests_source}/Install.cmake)
   set_tests_properties(install_prefix PROPERTIES FIXTURES_SETUP tetrapage_prefix LABELS install
                                                  TIMEOUT 300)

@@ -14,7 +14,7 @@
 #include <functional>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::test {
 

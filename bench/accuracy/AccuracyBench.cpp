@@ -33,18 +33,18 @@
 
 #include <oneapi/tbb/global_control.h>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/LatencySummary.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/ReferenceCollider.h"
-#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/tools/ReportFile.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 
 namespace tetrapage {
 namespace {

@@ -28,9 +28,9 @@
 #include <vector>
 
 #include "ChunkCodec.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/runtime/paging/Shard.h"
 
 namespace {
 

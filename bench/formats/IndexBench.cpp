@@ -23,8 +23,8 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/index/IndexWriter.h"
 #include "tetrapage/tools/Random.h"
 
 namespace {

@@ -23,10 +23,10 @@
 #include <oneapi/tbb/global_control.h>
 
 #include "tetrapage/bench/FclDistance.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/LatencySummary.h"
 #include "tetrapage/tools/ReportFile.h"
 

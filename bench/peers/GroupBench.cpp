@@ -29,9 +29,9 @@
 #include <utility>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/runtime/ObjectGroup.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/query/ObjectGroup.h"
 #include "tetrapage/tools/LatencySummary.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"

@@ -15,8 +15,8 @@
 #include <thread>
 #include <vector>
 
-#include "tetrapage/formats/SpinThenBlock.h"
-#include "tetrapage/runtime/ShardCache.h"
+#include "tetrapage/formats/base/SpinThenBlock.h"
+#include "tetrapage/runtime/paging/ShardCache.h"
 
 namespace {
 

@@ -18,12 +18,12 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/Random.h"
 
 namespace {

@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/index/IndexWriter.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
 #include "tetrapage/preprocess/ShardCostModel.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/paging/Shard.h"
 #include "tetrapage/tools/Random.h"
 
 namespace {

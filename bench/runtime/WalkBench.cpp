@@ -17,8 +17,8 @@
 #include <vector>
 
 #include "tetrapage/preprocess/CoarseMesh.h"
-#include "tetrapage/runtime/BoxSearch.h"
-#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/paging/BoxSearch.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace {
 

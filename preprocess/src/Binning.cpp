@@ -11,7 +11,7 @@
 
 #include "MortonGrid.h"
 #include "OrderedPipeline.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Progress.h"
 #include "tetrapage/preprocess/TriangleBinning.h"
 
 namespace tetrapage {

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "SpillPath.h"
-#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace tetrapage {
 namespace {

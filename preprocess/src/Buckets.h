@@ -14,9 +14,10 @@
 #include "Ingest.h"
 #include "MortonGrid.h"
 #include "TriangleRecord.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/TetMesh.h"
-#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/TetMesh.h"
+#include "tetrapage/preprocess/PreprocessOptions.h"
+#include "tetrapage/preprocess/PreprocessSummary.h"
 #include "tetrapage/preprocess/RecordSpill.h"
 #include "tetrapage/preprocess/SoupSpill.h"
 

@@ -4,8 +4,8 @@
 #include <string>
 
 #include "SpillPath.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/PositionBits.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/PositionBits.h"
 
 namespace tetrapage {
 namespace {

@@ -11,7 +11,7 @@
 #include <cmath>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

@@ -11,18 +11,18 @@
 #include <optional>
 #include <random>
 
-#include "tetrapage/preprocess/ChunkedComponents.h"
 #include "Interiors.h"
 #include "OrderedPipeline.h"
 #include "SpillPath.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/Progress.h"
-#include "tetrapage/formats/QuotedInput.h"
-#include "tetrapage/formats/TessellatedFile.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/base/QuotedInput.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/formats/mesh/TessellatedFile.h"
+#include "tetrapage/preprocess/ChunkedComponents.h"
 
 namespace tetrapage {
 namespace {

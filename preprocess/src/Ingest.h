@@ -9,9 +9,10 @@
 #include <vector>
 
 #include "TriangleRecord.h"
-#include "tetrapage/formats/SurfaceComponents.h"
-#include "tetrapage/formats/TriangleSoup.h"
-#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/SurfaceComponents.h"
+#include "tetrapage/preprocess/PreprocessOptions.h"
+#include "tetrapage/preprocess/PreprocessSummary.h"
 #include "tetrapage/preprocess/SoupSpill.h"
 
 namespace tetrapage {

@@ -9,12 +9,12 @@
 #include <mutex>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/Progress.h"
 #include "tetrapage/preprocess/RayParity.h"
-#include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace tetrapage {
 namespace {

@@ -7,8 +7,9 @@
 #include <vector>
 
 #include "Ingest.h"
-#include "tetrapage/formats/TetMesh.h"
-#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/formats/index/TetMesh.h"
+#include "tetrapage/preprocess/PreprocessOptions.h"
+#include "tetrapage/preprocess/PreprocessSummary.h"
 
 namespace tetrapage {
 

@@ -7,7 +7,7 @@
 #include <array>
 #include <cstdint>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 
 namespace tetrapage {
 

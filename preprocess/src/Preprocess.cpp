@@ -17,14 +17,14 @@
 #include "MortonGrid.h"
 #include "Shards.h"
 #include "WriteIndex.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
-#include "tetrapage/formats/IndexHeader.h"
-#include "tetrapage/formats/IndexWriter.h"
-#include "tetrapage/formats/MemoryUsage.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/TemporaryFiles.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
+#include "tetrapage/formats/base/TemporaryFiles.h"
+#include "tetrapage/formats/index/IndexHeader.h"
+#include "tetrapage/formats/index/IndexWriter.h"
+#include "tetrapage/formats/mesh/FileChecks.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 
 namespace tetrapage {
 namespace {

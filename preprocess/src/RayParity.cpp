@@ -5,7 +5,7 @@
 #include <numeric>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
 
 namespace tetrapage {

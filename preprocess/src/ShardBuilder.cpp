@@ -10,10 +10,10 @@
 #include <optional>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
+#include "tetrapage/runtime/paging/Shard.h"
 
 namespace tetrapage {
 namespace {

@@ -5,9 +5,9 @@
 #include <string>
 #include <utility>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/paging/Shard.h"
 
 namespace tetrapage {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "OrderedPipeline.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Progress.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
 #include "tetrapage/preprocess/ShardCostModel.h"
 

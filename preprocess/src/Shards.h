@@ -11,8 +11,9 @@
 
 #include "Buckets.h"
 #include "Ingest.h"
-#include "tetrapage/formats/IndexWriter.h"
-#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/formats/index/IndexWriter.h"
+#include "tetrapage/preprocess/PreprocessOptions.h"
+#include "tetrapage/preprocess/PreprocessSummary.h"
 
 namespace tetrapage {
 

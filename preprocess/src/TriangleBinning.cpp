@@ -4,11 +4,11 @@
 #include <cstdio>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/TriangleTetrahedron.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace tetrapage {
 

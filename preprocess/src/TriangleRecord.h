@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 #include "tetrapage/preprocess/SoupSpill.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
 

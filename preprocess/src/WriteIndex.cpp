@@ -3,8 +3,8 @@
 #include <span>
 #include <vector>
 
-#include "tetrapage/formats/IndexHeader.h"
-#include "tetrapage/formats/IndexSchema.h"
+#include "tetrapage/formats/index/IndexHeader.h"
+#include "tetrapage/formats/index/IndexSchema.h"
 
 namespace tetrapage {
 namespace {

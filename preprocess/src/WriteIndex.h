@@ -9,9 +9,10 @@
 #include "Ingest.h"
 #include "Interiors.h"
 #include "Shards.h"
-#include "tetrapage/formats/IndexWriter.h"
-#include "tetrapage/formats/TetMesh.h"
-#include "tetrapage/preprocess/Preprocess.h"
+#include "tetrapage/formats/index/IndexWriter.h"
+#include "tetrapage/formats/index/TetMesh.h"
+#include "tetrapage/preprocess/PreprocessOptions.h"
+#include "tetrapage/preprocess/PreprocessSummary.h"
 
 namespace tetrapage {
 

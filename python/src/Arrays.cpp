@@ -7,8 +7,8 @@
 #include <sstream>
 
 #include "Bindings.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::python {
 

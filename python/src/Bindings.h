@@ -12,12 +12,12 @@
 #include <string_view>
 #include <vector>
 
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/TriangleSoup.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/FlyingObject.h"
-#include "tetrapage/runtime/ObjectModel.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
+#include "tetrapage/runtime/query/ObjectModel.h"
 
 namespace tetrapage::python {
 

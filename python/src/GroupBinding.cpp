@@ -4,8 +4,8 @@
 #include <pybind11/stl.h>
 
 #include "Bindings.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/ObjectGroup.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/runtime/query/ObjectGroup.h"
 
 namespace tetrapage::python {
 

@@ -5,8 +5,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "Bindings.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/IndexSummary.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/index/IndexSummary.h"
 
 namespace tetrapage::python {
 

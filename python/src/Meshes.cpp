@@ -7,10 +7,10 @@
 #include <limits>
 
 #include "Bindings.h"
-#include "tetrapage/formats/CadReader.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/CadReader.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage::python {
 

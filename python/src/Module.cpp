@@ -1,7 +1,7 @@
 // The compiled part of the `tetrapage` package (python/tetrapage/__init__.py re-exports it).
 
 #include "Bindings.h"
-#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/base/ByteSize.h"
 #include "tetrapage/version.h"
 
 PYBIND11_MODULE(_tetrapage, module) {

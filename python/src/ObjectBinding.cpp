@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "Bindings.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::python {
 

@@ -4,7 +4,7 @@
 #include <pybind11/stl/filesystem.h>
 
 #include "Bindings.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::python {
 

@@ -13,12 +13,12 @@
 #include <memory>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/version.h"
 
 int main(int argc, char** argv) {

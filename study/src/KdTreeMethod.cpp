@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "Obstacles.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
 #include "tetrapage/study/BoxMethods.h"
 

@@ -17,13 +17,13 @@
 #include <vector>
 
 #include "Obstacles.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/TetMesh.h"
-#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/TetMesh.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/runtime/geometry/SegmentTriangle.h"
 #include "tetrapage/runtime/geometry/TriangleTetrahedron.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace tetrapage::study {
 namespace {

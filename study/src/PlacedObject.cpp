@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::study {
 namespace {

@@ -5,7 +5,7 @@
 #include <chrono>
 
 #include "Obstacles.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/study/BoxMethods.h"
 
 namespace tetrapage::study {

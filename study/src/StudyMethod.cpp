@@ -1,7 +1,7 @@
 #include "tetrapage/study/StudyMethod.h"
 
 #include "Obstacles.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::study {
 

@@ -6,11 +6,11 @@
 #include <memory>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/FlyingObject.h"
-#include "tetrapage/runtime/ObjectGroup.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
+#include "tetrapage/runtime/query/ObjectGroup.h"
 
 int main() {
   const auto index = std::make_shared<const tetrapage::CollisionIndex>("model.tpi");

@@ -3,8 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

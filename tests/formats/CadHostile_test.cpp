@@ -13,13 +13,13 @@
 #include <sstream>
 #include <thread>
 
+#include "../ResidentMemory.h"
 #include "../tools/RunCli.h"
 #include "CadIsolation.h"
 #include "StepPrescan.h"
-#include "../ResidentMemory.h"
-#include "tetrapage/formats/CadReader.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MemoryUsage.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
+#include "tetrapage/formats/mesh/CadReader.h"
 
 namespace tetrapage {
 namespace {

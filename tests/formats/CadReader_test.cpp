@@ -28,8 +28,8 @@
 #include <set>
 
 #include "TestSupport.h"
-#include "tetrapage/formats/CadReader.h"
-#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/mesh/CadReader.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 
 namespace tetrapage {
 namespace {

@@ -12,8 +12,8 @@
 #include <sys/stat.h>
 
 #include "TestSupport.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage::test {
 namespace {

@@ -9,8 +9,8 @@
 
 #include "ChunkCodec.h"
 #include "TestSupport.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/index/IndexWriter.h"
 
 namespace tetrapage {
 namespace {

@@ -14,8 +14,8 @@
 #include "../MemoryLimit.h"
 #include "Hdf5Metadata.h"
 #include "TestSupport.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/IndexWriter.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/index/IndexWriter.h"
 
 namespace tetrapage {
 namespace {

@@ -1,4 +1,4 @@
-// The block reader under every text and binary reader (formats/src/InputFile.h): lines and
+// The block reader under every text and binary reader (formats/mesh/src/InputFile.h): lines and
 // records that straddle block boundaries, lines longer than a block, line ends, truncation.
 
 #include "InputFile.h"

@@ -4,8 +4,8 @@
 #include <Eigen/Geometry>
 
 #include "TestSupport.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage::test {
 namespace {

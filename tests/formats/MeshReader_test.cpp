@@ -12,7 +12,7 @@
 #include <sstream>
 
 #include "TestSupport.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage::test {
 namespace {

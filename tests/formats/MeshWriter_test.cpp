@@ -12,8 +12,8 @@
 
 #include "../FileSizeLimit.h"
 #include "TestSupport.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage::test {
 namespace {

@@ -4,7 +4,7 @@
 #include <Eigen/Geometry>
 
 #include "TestSupport.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage::test {
 namespace {

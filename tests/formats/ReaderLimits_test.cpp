@@ -8,8 +8,8 @@
 
 #include "../MemoryLimit.h"
 #include "TestSupport.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage::test {
 namespace {

@@ -1,4 +1,4 @@
-#include "tetrapage/formats/SpinThenBlock.h"
+#include "tetrapage/formats/base/SpinThenBlock.h"
 
 #include <gtest/gtest.h>
 

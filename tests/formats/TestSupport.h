@@ -16,9 +16,9 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage::test {

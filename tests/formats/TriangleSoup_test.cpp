@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 
 namespace tetrapage {
 namespace {

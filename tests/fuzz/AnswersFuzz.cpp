@@ -1,7 +1,7 @@
 // The answer file reader (CSV step,collides) on arbitrary bytes.
 
 #include "FuzzSupport.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/AnswerFile.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

@@ -8,8 +8,8 @@
 
 #include "ChunkedRead.h"
 #include "FuzzSupport.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/TessellatedFile.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/TessellatedFile.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static tetrapage::fuzz::TempFile file(TETRAPAGE_FUZZ_EXTENSION);

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 
 namespace tetrapage::fuzz {
 

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/runtime/paging/Shard.h"
 
 namespace tetrapage::fuzz {
 

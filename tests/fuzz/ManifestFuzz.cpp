@@ -1,8 +1,8 @@
 // The assembly manifest parser (JSON) on arbitrary bytes: a manifest or a tetrapage::Error.
 
 #include "FuzzSupport.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/Manifest.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static tetrapage::fuzz::TempFile file(".json");

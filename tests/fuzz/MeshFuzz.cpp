@@ -8,10 +8,10 @@
 #include <optional>
 
 #include "ChunkedRead.h"
-#include "GltfDocument.h"
 #include "FuzzSupport.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
+#include "GltfDocument.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 
 namespace {
 

@@ -2,9 +2,9 @@
 // of the seed corpus: a FormatError or an overlay whose parts all lie on the index.
 
 #include "FuzzSupport.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const auto index =

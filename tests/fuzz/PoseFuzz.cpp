@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "FuzzSupport.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static tetrapage::fuzz::TempFile file(".csv");

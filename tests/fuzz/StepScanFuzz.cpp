@@ -1,4 +1,4 @@
-// The STEP pre-scan (formats/src/StepPrescan.h) on arbitrary bytes, fed whole and in pieces:
+// The STEP pre-scan (formats/mesh/src/StepPrescan.h) on arbitrary bytes, fed whole and in pieces:
 // it must finish without a crash or an unbounded allocation, and read the same either way.
 
 #include <cstddef>

@@ -13,8 +13,8 @@
 #include <map>
 #include <numeric>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 
 namespace tetrapage {
 namespace {

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <set>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/preprocess/CoarseMesh.h"
 #include "tetrapage/tools/Random.h"
 

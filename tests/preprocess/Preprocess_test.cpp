@@ -19,19 +19,19 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "../FileSizeLimit.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/Shard.h"
-#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/runtime/paging/Shard.h"
 #include "tetrapage/tools/IndexAudit.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/TetrasGenerator.h"
-#include "../FileSizeLimit.h"
 
 namespace tetrapage {
 namespace {

@@ -15,11 +15,11 @@
 #include <tuple>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
 #include "tetrapage/preprocess/ShardCostModel.h"
-#include "tetrapage/runtime/Shard.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
+#include "tetrapage/runtime/paging/Shard.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

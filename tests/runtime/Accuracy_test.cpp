@@ -4,7 +4,7 @@
 #include "tetrapage/runtime/geometry/Accuracy.h"
 
 #include "GeometryTestSupport.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/EpsilonTests.h"
 #include "tetrapage/runtime/geometry/SegmentTriangle.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"

@@ -11,13 +11,13 @@
 #include <vector>
 
 #include "GeometryTestSupport.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/preprocess/CoarseMesh.h"
-#include "tetrapage/runtime/BoxSearch.h"
-#include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/geometry/FloatBox.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/TriangleBox.h"
+#include "tetrapage/runtime/paging/BoxSearch.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace tetrapage {
 namespace {

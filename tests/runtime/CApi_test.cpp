@@ -24,17 +24,17 @@
 #include <tuple>
 #include <vector>
 
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
 
 // The deprecated calls stay tested until they go.
 #pragma GCC diagnostic ignored "-Wdeprecated-declarations"
-#include "tetrapage/runtime/FlyingObject.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tetrapage.h"
 
 namespace tetrapage {

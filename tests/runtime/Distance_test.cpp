@@ -15,17 +15,17 @@
 #include <filesystem>
 #include <memory>
 
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
+#include "TestSolids.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/FlyingObject.h"
-#include "tetrapage/runtime/PoseMotion.h"
 #include "tetrapage/runtime/geometry/Accuracy.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
+#include "tetrapage/runtime/query/PoseMotion.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
-#include "TestSolids.h"
 
 namespace tetrapage {
 namespace {

@@ -29,14 +29,14 @@
 #include <utility>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/FlyingObject.h"
-#include "tetrapage/runtime/ObjectGroup.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
+#include "tetrapage/runtime/query/ObjectGroup.h"
 #include "tetrapage/tetrapage.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"

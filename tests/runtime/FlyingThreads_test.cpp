@@ -11,9 +11,9 @@
 #include <random>
 #include <thread>
 
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 
 namespace tetrapage {
 namespace {

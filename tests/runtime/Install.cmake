@@ -26,7 +26,7 @@ if(STEP STREQUAL "prefix")
                     ${LIBDIR}/libtetrapage.so ${LIBDIR}/libtetrapage_runtime.a
                     ${LIBDIR}/libtetrapage_formats.a ${LIBDIR}/tetrapage/tetrapage_cad.so
                     include/tetrapage/tetrapage.h include/tetrapage/version.h
-                    include/tetrapage/runtime/FlyingObject.h include/tetrapage/formats/Error.h
+                    include/tetrapage/runtime/query/FlyingObject.h include/tetrapage/formats/base/Error.h
                     bin/tetrapage)
     if(NOT EXISTS "${PREFIX}/${installed}")
       message(FATAL_ERROR "not installed: ${PREFIX}/${installed}")

@@ -13,14 +13,14 @@
 #include <filesystem>
 #include <random>
 
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/SurfaceComponents.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/SurfaceComponents.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/FlyingObject.h"
-#include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
+#include "tetrapage/runtime/query/ObstacleInterior.h"
 #include "tetrapage/tools/EmbreeInteriorClassifier.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"

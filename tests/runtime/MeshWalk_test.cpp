@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "GeometryTestSupport.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/preprocess/CoarseMesh.h"
-#include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/geometry/SegmentTriangle.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 
 namespace tetrapage {
 namespace {

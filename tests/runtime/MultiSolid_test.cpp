@@ -15,14 +15,14 @@
 #include <filesystem>
 #include <memory>
 
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
+#include "TestSolids.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
-#include "TestSolids.h"
 
 namespace tetrapage {
 namespace {

@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "GeometryTestSupport.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/FloatRounding.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 

@@ -9,7 +9,7 @@
 #include <CGAL/Polygon_mesh_processing/polygon_soup_to_polygon_mesh.h>
 #include <gtest/gtest.h>
 
-#include "tetrapage/runtime/ObjectInteriorGrid.h"
+#include "tetrapage/runtime/query/ObjectInteriorGrid.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/Random.h"

@@ -15,10 +15,10 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"

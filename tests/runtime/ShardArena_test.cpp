@@ -1,4 +1,4 @@
-#include "tetrapage/runtime/ShardArena.h"
+#include "tetrapage/runtime/paging/ShardArena.h"
 
 #include <gtest/gtest.h>
 #include <sys/mman.h>

@@ -3,7 +3,7 @@
 // shard, errors propagate and leave the cache consistent, deadlocks are reported, the
 // prefetcher obeys its policy and winds down cleanly.
 
-#include "tetrapage/runtime/ShardCache.h"
+#include "tetrapage/runtime/paging/ShardCache.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

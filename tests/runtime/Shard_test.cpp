@@ -3,8 +3,8 @@
 // written, queries match brute force, and every truncation or corruption throws FormatError
 // naming the field, or decodes to a shard whose queries stay in range.
 
-#include "tetrapage/runtime/Shard.h"
-#include "tetrapage/runtime/ShardArena.h"
+#include "tetrapage/runtime/paging/Shard.h"
+#include "tetrapage/runtime/paging/ShardArena.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

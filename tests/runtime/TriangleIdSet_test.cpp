@@ -1,6 +1,6 @@
 // The step's set of met triangle ids against std::unordered_set, across growth and clears.
 
-#include "tetrapage/runtime/TriangleIdSet.h"
+#include "tetrapage/runtime/query/TriangleIdSet.h"
 
 #include <gtest/gtest.h>
 

@@ -8,9 +8,9 @@
 
 #include <filesystem>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 #include "tetrapage/study/BoxMethods.h"
 #include "tetrapage/tools/MeshLibrary.h"

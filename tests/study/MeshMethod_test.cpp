@@ -11,17 +11,17 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/runtime/geometry/Box.h"
 #include "tetrapage/runtime/geometry/TriangleTriangle.h"
 #include "tetrapage/study/MeshMethod.h"
-#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/study/PlacedObject.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/Random.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 
 namespace tetrapage::study {
 namespace {

@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <string>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 
 namespace tetrapage::test {
 

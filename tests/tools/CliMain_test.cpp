@@ -6,7 +6,7 @@
 #include <string>
 
 #include "RunCli.h"
-#include "tetrapage/formats/IndexHeader.h"
+#include "tetrapage/formats/index/IndexHeader.h"
 #include "tetrapage/version.h"
 
 namespace tetrapage {

@@ -16,12 +16,12 @@
 #include "../ResidentMemory.h"
 #include "RunCli.h"
 #include "TestFiles.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/ObjectModel.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/ObjectModel.h"
 
 namespace tetrapage {
 namespace {

@@ -17,17 +17,17 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/EmbreeCollider.h"
-#include "tetrapage/tools/StudyEnvironment.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
+#include "tetrapage/tools/StudyEnvironment.h"
 
 #include "BoxSoup.h"
 

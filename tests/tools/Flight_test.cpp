@@ -12,15 +12,15 @@
 #include <filesystem>
 #include <fstream>
 
-#include "tetrapage/formats/Error.h"
+#include <nlohmann/json.hpp>
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
-#include <nlohmann/json.hpp>
-#include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/tools/RuntimeJudge.h"
 
 #include "BoxSoup.h"

@@ -19,11 +19,11 @@
 
 #include "BoxSoup.h"
 #include "RunCli.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/PoseMotion.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/PoseMotion.h"
 
 namespace tetrapage {
 namespace {

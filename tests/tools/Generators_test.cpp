@@ -19,9 +19,9 @@
 #include <numeric>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/tools/BspPartition.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"

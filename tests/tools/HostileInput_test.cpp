@@ -16,7 +16,7 @@
 #include <thread>
 
 #include "HostileSupport.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage {
 namespace {

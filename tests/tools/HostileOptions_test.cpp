@@ -17,9 +17,9 @@
 #include <vector>
 
 #include "RunCli.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/UnitQuaternion.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/UnitQuaternion.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/tools/AnswerFile.h"
 
 namespace tetrapage {

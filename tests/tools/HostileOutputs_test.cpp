@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "HostileSupport.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage {
 namespace {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "RunCli.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/tools/TetrasGenerator.h"
 
 namespace tetrapage::test {

@@ -10,14 +10,14 @@
 #include <cstring>
 #include <filesystem>
 
-#include "tetrapage/formats/IndexWriter.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "RunCli.h"
+#include "tetrapage/formats/index/IndexWriter.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
 #include "tetrapage/preprocess/ShardBuilder.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/SceneGenerator.h"
-#include "RunCli.h"
 
 namespace tetrapage {
 namespace {

@@ -15,13 +15,13 @@
 
 #include "RunCli.h"
 #include "TestFiles.h"
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/IndexSchema.h"
-#include "tetrapage/formats/IndexWriter.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/index/IndexSchema.h"
+#include "tetrapage/formats/index/IndexWriter.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/runtime/paging/Shard.h"
 #include "tetrapage/tools/TetrasGenerator.h"
 
 namespace tetrapage {

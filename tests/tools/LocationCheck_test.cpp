@@ -24,12 +24,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "RunCli.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/preprocess/Preprocess.h"
-#include "tetrapage/runtime/MeshWalk.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
 #include "tetrapage/tools/LocationCheck.h"
 #include "tetrapage/tools/MeshLibrary.h"
@@ -37,7 +38,6 @@
 #include "tetrapage/tools/SceneGenerator.h"
 #include "tetrapage/tools/StabbingNumbers.h"
 #include "tetrapage/tools/TetrasGenerator.h"
-#include "RunCli.h"
 
 namespace tetrapage {
 namespace {

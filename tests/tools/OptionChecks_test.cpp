@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "RunCli.h"
-#include "tetrapage/formats/ByteSize.h"
+#include "tetrapage/formats/base/ByteSize.h"
 
 namespace tetrapage {
 namespace {

@@ -17,12 +17,12 @@
 
 #include "BoxSoup.h"
 #include "RunCli.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/IndexSchema.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/IndexSchema.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
 #include "tetrapage/tools/AnswerFile.h"
 
 namespace tetrapage {

@@ -11,7 +11,7 @@
 #include <map>
 #include <string>
 
-#include "tetrapage/formats/Manifest.h"
+#include "tetrapage/formats/mesh/Manifest.h"
 #include "tetrapage/tools/RackGenerator.h"
 
 #include "TestFiles.h"

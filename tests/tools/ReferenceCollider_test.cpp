@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"
 

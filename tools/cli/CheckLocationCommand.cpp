@@ -5,8 +5,8 @@
 #include <thread>
 
 #include "Commands.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/IndexReader.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/index/IndexReader.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
 #include "tetrapage/tools/LocationCheck.h"
 

@@ -8,7 +8,7 @@
 #include <functional>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/ReportFile.h"  // write_report, check_writable: every command uses them
 
 namespace tetrapage::cli {

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "TessellationArguments.h"
-#include "tetrapage/formats/TriangleSoup.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/DynamicObstacles.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/DynamicObstacles.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 
 namespace tetrapage::cli {
 

@@ -7,8 +7,8 @@
 #include <optional>
 
 #include "Commands.h"
-#include "tetrapage/formats/MemoryUsage.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/ObjectGenerator.h"
 #include "tetrapage/tools/SceneGenerator.h"

@@ -4,13 +4,13 @@
 #include <cstdio>
 
 #include "Commands.h"
-#include "tetrapage/formats/MemoryUsage.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/FlightGenerator.h"
 #include "tetrapage/tools/LatencySummary.h"
-#include "tetrapage/formats/ByteSize.h"
 #include "tetrapage/tools/RuntimeJudge.h"
 
 namespace tetrapage::cli {

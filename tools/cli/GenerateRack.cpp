@@ -5,8 +5,8 @@
 #include <cstdio>
 
 #include "Commands.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/MemoryUsage.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
 #include "tetrapage/tools/RackGenerator.h"
 
 namespace tetrapage::cli {

@@ -8,11 +8,11 @@
 #include <sstream>
 
 #include "Commands.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/Progress.h"
-#include "tetrapage/runtime/ObstacleInterior.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/runtime/query/ObstacleInterior.h"
 #include "tetrapage/tools/IndexAudit.h"
 #include "tetrapage/tools/Random.h"
 #include "tetrapage/tools/ReferenceCollider.h"

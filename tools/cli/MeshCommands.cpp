@@ -8,12 +8,12 @@
 
 #include "Commands.h"
 #include "TessellationArguments.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MemoryUsage.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
+#include "tetrapage/formats/mesh/FileChecks.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage::cli {
 namespace {

@@ -14,9 +14,9 @@
 #include <string>
 
 #include "Commands.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/QuotedInput.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/QuotedInput.h"
 
 namespace tetrapage::cli {
 

@@ -6,12 +6,12 @@
 #include <cstdio>
 
 #include "Commands.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
-#include "tetrapage/formats/Progress.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/ModelRenderer.h"
 
 namespace tetrapage::cli {

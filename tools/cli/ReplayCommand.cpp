@@ -5,10 +5,10 @@
 #include <optional>
 
 #include "Commands.h"
-#include "tetrapage/formats/MemoryUsage.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/MemoryUsage.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 #include "tetrapage/tools/AnswerCheck.h"
 #include "tetrapage/tools/AnswerFile.h"
 #include "tetrapage/tools/EmbreeCollider.h"

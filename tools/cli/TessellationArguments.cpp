@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "Commands.h"
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage::cli {
 namespace {

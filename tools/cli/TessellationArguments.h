@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string>
 
-#include "tetrapage/formats/CadReader.h"
+#include "tetrapage/formats/mesh/CadReader.h"
 
 namespace tetrapage::cli {
 

@@ -10,9 +10,9 @@
 #include <string>
 
 #include "Commands.h"
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/IndexHeader.h"
-#include "tetrapage/formats/TemporaryFiles.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/TemporaryFiles.h"
+#include "tetrapage/formats/index/IndexHeader.h"
 #include "tetrapage/version.h"
 
 namespace {

@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/AnswerFile.h"
 
 namespace tetrapage {

@@ -3,10 +3,10 @@
 #include <fstream>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
-#include "tetrapage/formats/OutputFile.h"
-#include "tetrapage/formats/QuotedInput.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/QuotedInput.h"
+#include "tetrapage/formats/mesh/FileChecks.h"
+#include "tetrapage/formats/mesh/OutputFile.h"
 
 namespace tetrapage {
 

@@ -5,7 +5,7 @@
 #include <limits>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

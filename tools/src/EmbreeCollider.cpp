@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/EmbreeHandles.h"
 
 namespace tetrapage {

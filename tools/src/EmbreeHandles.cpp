@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <mutex>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

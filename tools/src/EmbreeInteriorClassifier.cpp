@@ -7,7 +7,7 @@
 #include <limits>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/EmbreeHandles.h"
 
 namespace tetrapage {

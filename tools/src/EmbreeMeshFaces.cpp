@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/tools/EmbreeHandles.h"
 

@@ -7,7 +7,7 @@
 #include <functional>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

@@ -1,5 +1,5 @@
 #include "tetrapage/tools/IndexAudit.h"
-#include "tetrapage/formats/IndexSchema.h"
+#include "tetrapage/formats/index/IndexSchema.h"
 
 #include <CGAL/Exact_predicates_exact_constructions_kernel.h>
 #include <tbb/parallel_for.h>
@@ -12,10 +12,10 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/Manifest.h"
 #include "tetrapage/runtime/geometry/Box.h"
+#include "tetrapage/runtime/paging/Shard.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

@@ -9,11 +9,11 @@
 #include <cmath>
 #include <optional>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Progress.h"
-#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/Progress.h"
 #include "tetrapage/runtime/geometry/PointTetrahedron.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

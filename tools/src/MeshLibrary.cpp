@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <system_error>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshReader.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshReader.h"
 
 #ifndef TETRAPAGE_DEFAULT_MESH_DIR
 #define TETRAPAGE_DEFAULT_MESH_DIR ""

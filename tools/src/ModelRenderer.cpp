@@ -8,7 +8,7 @@
 #include <limits>
 #include <numbers>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/EmbreeHandles.h"
 
 namespace tetrapage {

@@ -17,7 +17,7 @@
 #include <numeric>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

@@ -8,9 +8,9 @@
 #include <iterator>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
-#include "tetrapage/formats/OutputFile.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/FileChecks.h"
+#include "tetrapage/formats/mesh/OutputFile.h"
 
 namespace tetrapage {
 namespace {

@@ -1,6 +1,6 @@
 #include "tetrapage/tools/QueryAnswerFile.h"
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/AnswerSite.h"
 
 namespace tetrapage {

@@ -4,7 +4,7 @@
 #include <cctype>
 #include <cstdio>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

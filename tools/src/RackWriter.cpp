@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/tools/RackGenerator.h"
 #include "tetrapage/tools/ReportFile.h"
 

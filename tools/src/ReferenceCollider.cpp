@@ -22,7 +22,7 @@
 #include <utility>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

@@ -4,9 +4,9 @@
 #include <cstring>
 #include <fstream>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/FileChecks.h"
-#include "tetrapage/formats/OutputFile.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/FileChecks.h"
+#include "tetrapage/formats/mesh/OutputFile.h"
 
 namespace tetrapage {
 

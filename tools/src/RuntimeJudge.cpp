@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 

@@ -8,9 +8,9 @@
 #include <span>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/SurfaceComponents.h"
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/formats/mesh/SurfaceComponents.h"
 #include "tetrapage/tools/BspPartition.h"
 
 namespace tetrapage {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/runtime/MeshWalk.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/runtime/query/MeshWalk.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

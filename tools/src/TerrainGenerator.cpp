@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

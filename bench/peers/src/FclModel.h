@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage::fcl_model {
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "tetrapage/formats/ByteSize.h"
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/ByteSize.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 namespace {

@@ -11,10 +11,10 @@
 #include <filesystem>
 #include <vector>
 
-#include "tetrapage/formats/EdgeParity.h"
-#include "tetrapage/formats/SurfaceComponents.h"
-#include "tetrapage/formats/TriangleSoup.h"
-#include "tetrapage/formats/UnionFind.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/EdgeParity.h"
+#include "tetrapage/formats/mesh/SurfaceComponents.h"
+#include "tetrapage/formats/mesh/UnionFind.h"
 #include "tetrapage/preprocess/RecordSpill.h"
 
 namespace tetrapage {

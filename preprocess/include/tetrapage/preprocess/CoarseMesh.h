@@ -7,8 +7,8 @@
 #include <span>
 #include <vector>
 
-#include "tetrapage/formats/TetMesh.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/index/TetMesh.h"
 
 namespace tetrapage {
 

@@ -11,8 +11,8 @@
 #include <span>
 #include <vector>
 
-#include "tetrapage/runtime/ShardKind.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
+#include "tetrapage/runtime/paging/ShardKind.h"
 
 namespace tetrapage {
 

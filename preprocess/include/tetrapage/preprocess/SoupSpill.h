@@ -15,8 +15,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "tetrapage/formats/Error.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/Error.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 #include "tetrapage/preprocess/SpillFile.h"
 
 namespace tetrapage {

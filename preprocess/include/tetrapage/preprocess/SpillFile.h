@@ -10,7 +10,7 @@
 #include <string>
 #include <utility>
 
-#include "tetrapage/formats/Error.h"
+#include "tetrapage/formats/base/Error.h"
 
 namespace tetrapage {
 

@@ -7,7 +7,7 @@
 #include <optional>
 #include <vector>
 
-#include "tetrapage/formats/TetMesh.h"
+#include "tetrapage/formats/index/TetMesh.h"
 #include "tetrapage/runtime/geometry/Predicates.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
 

@@ -9,7 +9,7 @@
 #include <span>
 #include <vector>
 
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/runtime/geometry/Box.h"
 
 namespace tetrapage::study {

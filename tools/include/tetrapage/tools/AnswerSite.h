@@ -28,7 +28,7 @@
 #include <optional>
 #include <string>
 
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 
 namespace tetrapage {
 

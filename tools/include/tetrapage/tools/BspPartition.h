@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

@@ -9,10 +9,10 @@
 #include <fstream>
 #include <optional>
 
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/TriangleSoup.h"
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/Pose.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/CsvFile.h"
 
 namespace tetrapage {

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <string>
 
-#include "tetrapage/formats/OutputFile.h"
+#include "tetrapage/formats/mesh/OutputFile.h"
 
 namespace tetrapage {
 

@@ -29,8 +29,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage {
 

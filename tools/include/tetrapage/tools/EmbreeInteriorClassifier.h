@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 
 namespace tetrapage {
 

@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-#include "tetrapage/formats/TetMesh.h"
+#include "tetrapage/formats/index/TetMesh.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
 
 namespace tetrapage {

@@ -9,8 +9,8 @@
 #include <optional>
 #include <vector>
 
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/tools/ReferenceCollider.h"
 
 namespace tetrapage {

@@ -13,10 +13,10 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/IndexReader.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/Progress.h"
-#include "tetrapage/runtime/Shard.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/index/IndexReader.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/runtime/paging/Shard.h"
 
 namespace tetrapage {
 

@@ -21,7 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/TetMesh.h"
+#include "tetrapage/formats/index/TetMesh.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
 

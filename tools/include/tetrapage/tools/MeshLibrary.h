@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/Progress.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 
 namespace tetrapage {
 

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tetrapage/runtime/CollisionIndex.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
 #include "tetrapage/tools/PngImage.h"
 
 namespace tetrapage {

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 #include "tetrapage/tools/MeshLibrary.h"
 
 namespace tetrapage {

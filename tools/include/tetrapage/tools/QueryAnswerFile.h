@@ -23,8 +23,8 @@
 #include <filesystem>
 #include <string>
 
-#include "tetrapage/runtime/CollisionIndex.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/paging/CollisionIndex.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/CsvFile.h"
 
 namespace tetrapage {

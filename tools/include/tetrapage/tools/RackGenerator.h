@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/CadReader.h"
-#include "tetrapage/formats/Manifest.h"
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/mesh/CadReader.h"
+#include "tetrapage/formats/mesh/Manifest.h"
+#include "tetrapage/formats/mesh/Pose.h"
 #include "tetrapage/tools/Random.h"
 
 namespace tetrapage {

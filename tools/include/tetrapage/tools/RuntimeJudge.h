@@ -7,7 +7,7 @@
 
 #include <memory>
 
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/FlightGenerator.h"
 
 namespace tetrapage {

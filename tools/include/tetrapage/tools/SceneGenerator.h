@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 #include "tetrapage/tools/MeshLibrary.h"
 #include "tetrapage/tools/Random.h"
 

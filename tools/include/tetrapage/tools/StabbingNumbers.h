@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 #include "tetrapage/runtime/geometry/Shapes.h"
 #include "tetrapage/tools/EmbreeMeshFaces.h"
 

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 
 namespace tetrapage {
 

@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "tetrapage/formats/MeshWriter.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage {
 

@@ -7,8 +7,8 @@
 
 #include <cstdint>
 
-#include "tetrapage/formats/MeshWriter.h"
-#include "tetrapage/formats/Progress.h"
+#include "tetrapage/formats/base/Progress.h"
+#include "tetrapage/formats/mesh/MeshWriter.h"
 
 namespace tetrapage {
 

@@ -11,7 +11,7 @@
 #include <memory>
 
 #include "tetrapage/bench/PeerCollider.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
 
 namespace tetrapage {
 

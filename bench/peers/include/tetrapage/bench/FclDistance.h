@@ -12,8 +12,8 @@
 #include <memory>
 #include <string>
 
-#include "tetrapage/formats/Pose.h"
-#include "tetrapage/formats/TriangleSoup.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage {
 

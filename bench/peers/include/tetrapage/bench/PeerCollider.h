@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "tetrapage/formats/Pose.h"
+#include "tetrapage/formats/mesh/Pose.h"
 
 namespace tetrapage {
 

@@ -11,8 +11,8 @@
 #include <optional>
 
 #include "tetrapage/bench/PeerCollider.h"
-#include "tetrapage/formats/TriangleSoup.h"
-#include "tetrapage/runtime/FlyingObject.h"
+#include "tetrapage/formats/base/TriangleSoup.h"
+#include "tetrapage/runtime/query/FlyingObject.h"
 #include "tetrapage/tools/StepTotals.h"
 
 namespace tetrapage {
