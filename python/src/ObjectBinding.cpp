@@ -214,15 +214,15 @@ DistanceRecord record_of(const DistanceResult& r) {
   record.distance = r.distance;
   record.lower_bound = r.lower_bound;
   record.upper_bound = r.upper_bound;
-  const bool measured = r.environment_triangle != DistanceResult::kNoTriangle;
+  const bool measured = r.closest.has_triangle();
   for (int a = 0; a < 3; ++a) {
     record.on_environment[a] = has_closest_points(r) ? r.on_environment[a] : kNaN;
     record.on_object[a] = has_closest_points(r) ? r.on_object[a] : kNaN;
   }
-  record.environment_triangle = measured ? std::int64_t(r.environment_triangle) : -1;
-  record.environment_part = r.environment_part;
-  record.object_triangle = measured ? std::int64_t(r.object_triangle) : -1;
-  record.dynamic_part = r.dynamic_part;
+  record.environment_triangle = measured ? std::int64_t(r.closest.environment_triangle) : -1;
+  record.environment_part = r.closest.environment_part;
+  record.object_triangle = measured ? std::int64_t(r.closest.object_triangle) : -1;
+  record.dynamic_part = r.closest.dynamic_part;
   record.containment = std::uint8_t(r.containment);
   record.containing_part = r.containing_part;
   return record;
@@ -255,9 +255,9 @@ py::array times_of_impact(Object& object, py::handle poses, double tolerance,
       records[k] = {std::uint8_t(r.impact),
                     r.free_until,
                     r.contact_at,
-                    r.has_contact ? std::int64_t(r.environment_triangle) : -1,
-                    r.environment_part,
-                    r.has_contact ? std::int64_t(r.object_triangle) : -1,
+                    r.contact.has_triangle() ? std::int64_t(r.contact.environment_triangle) : -1,
+                    r.contact.environment_part,
+                    r.contact.has_triangle() ? std::int64_t(r.contact.object_triangle) : -1,
                     r.iterations};
     });
   });
@@ -364,25 +364,26 @@ distance lies in [lower_bound, upper_bound] (certified); separation is "touching
       .def_property_readonly(
           "environment_triangle",
           [](const DistanceAnswer& a) {
-            return optional_triangle(a.result.environment_triangle != DistanceResult::kNoTriangle,
-                                     a.result.environment_triangle);
+            return optional_triangle(a.result.closest.has_triangle(),
+                                     a.result.closest.environment_triangle);
           },
           "The closest pair's environment triangle, its id in the index (in an inserted "
           "obstacle: its row in that obstacle's mesh); None when farther or for a containment.")
       .def_property_readonly(
-          "environment_part", [](const DistanceAnswer& a) { return a.result.environment_part; },
+          "environment_part",
+          [](const DistanceAnswer& a) { return a.result.closest.environment_part; },
           "The part of environment_triangle, its id in Index.parts (4294967294 for an inserted "
           "obstacle); meaningful only when environment_triangle is not None.")
       .def_property_readonly(
           "object_triangle",
           [](const DistanceAnswer& a) {
-            return optional_triangle(a.result.environment_triangle != DistanceResult::kNoTriangle,
-                                     a.result.object_triangle);
+            return optional_triangle(a.result.closest.has_triangle(),
+                                     a.result.closest.object_triangle);
           },
           "The closest pair's object triangle, its row in the object's triangles; None when "
           "environment_triangle is None.")
       .def_property_readonly(
-          "dynamic_part", [](const DistanceAnswer& a) { return a.result.dynamic_part; },
+          "dynamic_part", [](const DistanceAnswer& a) { return a.result.closest.dynamic_part; },
           "The id (from Obstacles.insert) of the inserted obstacle that holds "
           "environment_triangle, or 0 for the index's triangles.")
       .def_property_readonly(
@@ -423,19 +424,22 @@ or "unresolved" (max_iterations ran out: free up to free_until).)")
       .def_property_readonly(
           "environment_triangle",
           [](const ImpactAnswer& a) {
-            return optional_triangle(a.result.has_contact, a.result.environment_triangle);
+            return optional_triangle(a.result.contact.has_triangle(),
+                                     a.result.contact.environment_triangle);
           },
           "The environment triangle of the first contact found at contact_at, its id in the "
           "index (in an inserted obstacle: its row in that obstacle's mesh); None without a "
           "contact (no hit, or a hit that is a containment).")
       .def_property_readonly(
-          "environment_part", [](const ImpactAnswer& a) { return a.result.environment_part; },
+          "environment_part",
+          [](const ImpactAnswer& a) { return a.result.contact.environment_part; },
           "The part of environment_triangle, its id in Index.parts (4294967294 for an inserted "
           "obstacle); meaningful only when environment_triangle is not None.")
       .def_property_readonly(
           "object_triangle",
           [](const ImpactAnswer& a) {
-            return optional_triangle(a.result.has_contact, a.result.object_triangle);
+            return optional_triangle(a.result.contact.has_triangle(),
+                                     a.result.contact.object_triangle);
           },
           "The object triangle of that contact, its row in the object's triangles; None "
           "without a contact.")

@@ -653,13 +653,13 @@ TEST_F(CApiTest, DistanceImpactAndContactGeometryEqualTheCppApi) {
     EXPECT_EQ(distance.distance, cpp.distance);
     EXPECT_EQ(distance.lower_bound, cpp.lower_bound);
     EXPECT_EQ(distance.upper_bound, cpp.upper_bound);
-    EXPECT_EQ(distance.closest.environment_triangle, cpp.environment_triangle);
+    EXPECT_EQ(distance.closest.environment_triangle, cpp.closest.environment_triangle);
     EXPECT_EQ(distance.closest.environment_component, TETRAPAGE_NO_COMPONENT);
-    if (cpp.environment_triangle == DistanceResult::kNoTriangle) {
+    if (!cpp.closest.has_triangle()) {
       EXPECT_EQ(distance.closest.object_triangle, TETRAPAGE_NO_OBJECT_TRIANGLE);
     } else {
-      EXPECT_EQ(distance.closest.object_triangle, cpp.object_triangle);
-      EXPECT_EQ(distance.closest.environment_part, cpp.environment_part);
+      EXPECT_EQ(distance.closest.object_triangle, cpp.closest.object_triangle);
+      EXPECT_EQ(distance.closest.environment_part, cpp.closest.environment_part);
     }
     for (int a = 0; a < 3; ++a) EXPECT_EQ(distance.on_object[a], cpp.on_object[a]);
     touching += distance.separation == 0;
@@ -710,10 +710,10 @@ TEST_F(CApiTest, DistanceImpactAndContactGeometryEqualTheCppApi) {
     EXPECT_EQ(impact.impact, int(expected.impact));
     EXPECT_EQ(impact.free_until, expected.free_until);
     EXPECT_EQ(impact.contact_at, expected.contact_at);
-    if (expected.has_contact) {
-      EXPECT_EQ(impact.first_contact.environment_triangle, expected.environment_triangle);
-      EXPECT_EQ(impact.first_contact.object_triangle, expected.object_triangle);
-      EXPECT_EQ(deprecated_impact.environment_triangle, expected.environment_triangle);
+    if (expected.contact.has_triangle()) {
+      EXPECT_EQ(impact.first_contact.environment_triangle, expected.contact.environment_triangle);
+      EXPECT_EQ(impact.first_contact.object_triangle, expected.contact.object_triangle);
+      EXPECT_EQ(deprecated_impact.environment_triangle, expected.contact.environment_triangle);
     } else {
       EXPECT_EQ(impact.first_contact.environment_triangle, TETRAPAGE_NO_TRIANGLE);
       EXPECT_EQ(impact.first_contact.object_triangle, TETRAPAGE_NO_OBJECT_TRIANGLE);

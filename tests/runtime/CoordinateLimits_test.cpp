@@ -247,17 +247,17 @@ TEST_F(NearTheLimit, DistancesAreTheUnitCopysTimesTheScale) {
     EXPECT_GE(Exact::FT(upper) * Exact::FT(upper), exact);
     EXPECT_NEAR(got.distance / scale_, expected, 1e-9);
     // The closest points lie on the triangles named, as far apart as the distance says.
-    ASSERT_LT(got.environment_triangle, exact_environment_.size());
-    ASSERT_LT(got.object_triangle, placed_object.size());
+    ASSERT_LT(got.closest.environment_triangle, exact_environment_.size());
+    ASSERT_LT(got.closest.object_triangle, placed_object.size());
     const Vec3 on_environment = to_unit(got.on_environment), on_object = to_unit(got.on_object);
     const Exact::Point_3 e{on_environment[0], on_environment[1], on_environment[2]};
     const Exact::Point_3 o{on_object[0], on_object[1], on_object[2]};
     EXPECT_LE(std::sqrt(CGAL::to_double(
-                  CGAL::squared_distance(exact_environment_[got.environment_triangle], e))),
+                  CGAL::squared_distance(exact_environment_[got.closest.environment_triangle], e))),
               point_slack);
-    EXPECT_LE(
-        std::sqrt(CGAL::to_double(CGAL::squared_distance(placed_object[got.object_triangle], o))),
-        point_slack);
+    EXPECT_LE(std::sqrt(CGAL::to_double(
+                  CGAL::squared_distance(placed_object[got.closest.object_triangle], o))),
+              point_slack);
     EXPECT_NEAR(std::sqrt(CGAL::to_double(CGAL::squared_distance(e, o))), expected,
                 2 * point_slack);
   }

@@ -154,14 +154,15 @@ class Distance : public ::testing::TestWithParam<Variant> {
     const double magnitude = GetParam().scale + std::fabs(GetParam().offset[0]) + std::fabs(GetParam().offset[1]);
     EXPECT_LE(got.upper_bound - got.lower_bound, 1e-12 * magnitude) << "distance " << true_distance;
     // The closest points lie on the triangles named, as far apart as the distance says.
-    ASSERT_LT(got.environment_triangle, environment_.triangles.size());
-    ASSERT_LT(got.object_triangle, object_.triangles.size());
+    ASSERT_LT(got.closest.environment_triangle, environment_.triangles.size());
+    ASSERT_LT(got.closest.object_triangle, object_.triangles.size());
     const double slack = 1e-12 * magnitude;
-    EXPECT_LE(std::sqrt(CGAL::to_double(CGAL::squared_distance(exact_environment_[got.environment_triangle],
-                                                               exact_point(got.on_environment)))),
-              slack);
     EXPECT_LE(std::sqrt(CGAL::to_double(
-                  CGAL::squared_distance(object[got.object_triangle], exact_point(got.on_object)))),
+                  CGAL::squared_distance(exact_environment_[got.closest.environment_triangle],
+                                         exact_point(got.on_environment)))),
+              slack);
+    EXPECT_LE(std::sqrt(CGAL::to_double(CGAL::squared_distance(object[got.closest.object_triangle],
+                                                               exact_point(got.on_object)))),
               slack);
     const double between = std::sqrt(CGAL::to_double(
         CGAL::squared_distance(exact_point(got.on_environment), exact_point(got.on_object))));
@@ -229,13 +230,14 @@ TEST_P(Distance, TouchingReportsAPointBothTrianglesShare) {
   ASSERT_TRUE(oracle.query(pose).surfaces_touch);
   const DistanceResult got = flying.distance(pose);
   ASSERT_EQ(got.separation, Separation::touching);
-  ASSERT_LT(got.environment_triangle, environment_.triangles.size());
+  ASSERT_LT(got.closest.environment_triangle, environment_.triangles.size());
   const double slack = 1e-12 * (GetParam().scale + std::fabs(GetParam().offset[0]));
-  EXPECT_LE(std::sqrt(CGAL::to_double(CGAL::squared_distance(exact_environment_[got.environment_triangle],
-                                                             exact_point(got.on_environment)))),
-            slack);
-  EXPECT_LE(std::sqrt(CGAL::to_double(CGAL::squared_distance(exact_object(pose)[got.object_triangle],
-                                                             exact_point(got.on_object)))),
+  EXPECT_LE(
+      std::sqrt(CGAL::to_double(CGAL::squared_distance(
+          exact_environment_[got.closest.environment_triangle], exact_point(got.on_environment)))),
+      slack);
+  EXPECT_LE(std::sqrt(CGAL::to_double(CGAL::squared_distance(
+                exact_object(pose)[got.closest.object_triangle], exact_point(got.on_object)))),
             slack);
 }
 
@@ -270,7 +272,7 @@ TEST_P(Distance, TimeOfImpactBracketsTheFirstContact) {
   EXPECT_LE(hit.free_until, 0.85 / 3);
   EXPECT_GE(hit.contact_at, 0.85 / 3 - 1e-12);
   EXPECT_LE(hit.contact_at - hit.free_until, options.tolerance);
-  EXPECT_TRUE(hit.has_contact);
+  EXPECT_TRUE(hit.contact.has_triangle());
   const PoseMotion motion(from, to);
   EXPECT_TRUE(oracle.query(motion.at(hit.contact_at)).collides);
   EXPECT_FALSE(oracle.query(motion.at(hit.free_until)).collides);

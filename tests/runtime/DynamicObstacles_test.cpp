@@ -335,7 +335,7 @@ TEST(DynamicObstacles, DistancesAreTheVisibleWorldsExactDistance) {
       const DistanceResult got = flying.distance(pose);
       if (got.separation != Separation::apart) continue;
       ++apart;
-      on_dynamic += got.dynamic_part != 0;
+      on_dynamic += got.closest.dynamic_part != 0;
       // CGAL's double kernel picks the pairs near the least distance (its error is far below the
       // 1 % margin); the exact kernel measures those.
       std::vector<std::array<Vec3, 3>> placed(object.triangle_count());
@@ -362,11 +362,11 @@ TEST(DynamicObstacles, DistancesAreTheVisibleWorldsExactDistance) {
           }
       EXPECT_LE(Exact::FT(got.lower_bound) * Exact::FT(got.lower_bound), least) << "round " << round << " pose " << i;
       EXPECT_GE(Exact::FT(got.upper_bound) * Exact::FT(got.upper_bound), least) << "round " << round << " pose " << i;
-      if (got.dynamic_part != 0) {
-        EXPECT_EQ(got.environment_part, Contact::kDynamicPart);
-        EXPECT_NE(overlay->find(got.dynamic_part), nullptr);
+      if (got.closest.dynamic_part != 0) {
+        EXPECT_EQ(got.closest.environment_part, Contact::kDynamicPart);
+        EXPECT_NE(overlay->find(got.closest.dynamic_part), nullptr);
       } else {
-        EXPECT_FALSE(overlay->hidden(got.environment_part));
+        EXPECT_FALSE(overlay->hidden(got.closest.environment_part));
       }
     }
   }
@@ -433,7 +433,7 @@ TEST(DynamicObstacles, APartInsertedIntoTheFreeBoxIsSeenOnTheNextStep) {
   // The distance query decides touching with the overlay: 0, at the dynamic contact.
   const DistanceResult touching = flying.distance(pose);
   EXPECT_EQ(touching.distance, 0.0);
-  EXPECT_EQ(touching.environment_part, Contact::kDynamicPart);
+  EXPECT_EQ(touching.closest.environment_part, Contact::kDynamicPart);
 }
 
 // Steps of 0.001 along x from `pose` until the object sits in a free box; false if it never does.

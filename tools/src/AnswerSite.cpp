@@ -120,11 +120,12 @@ AnswerSite containment_site(Containment containment, std::uint32_t part,
 
 AnswerSite distance_site(const DistanceResult& result) {
   if (result.separation == Separation::farther) return {};
-  if (result.environment_triangle == DistanceResult::kNoTriangle)
+  const ContactSite& closest = result.closest;
+  if (!closest.has_triangle())
     return containment_site(result.containment, result.containing_part,
                             result.containing_dynamic_part);
-  AnswerSite site = pair_site(result.environment_part, result.dynamic_part,
-                              result.environment_triangle, result.object_triangle);
+  AnswerSite site = pair_site(closest.environment_part, closest.dynamic_part,
+                              closest.environment_triangle, closest.object_triangle);
   if (site.kind == AnswerSite::Kind::solid) return site;
   site.kind = result.separation == Separation::touching ? AnswerSite::Kind::surface
                                                         : AnswerSite::Kind::near;
@@ -137,15 +138,10 @@ AnswerSite distance_site(const DistanceResult& result) {
 
 AnswerSite impact_site(FlyingObject& object, const ImpactResult& result) {
   if (result.impact != Impact::hit) return {};
-  if (!result.has_contact)
+  if (!result.contact.has_triangle())
     return containment_site(result.containment, result.containing_part,
                             result.containing_dynamic_part);
-  Contact contact;
-  contact.environment_part = result.environment_part;
-  contact.environment_triangle = result.environment_triangle;
-  contact.object_triangle = result.object_triangle;
-  contact.dynamic_part = result.dynamic_part;
-  return contact_site(object, contact);
+  return contact_site(object, result.contact);
 }
 
 std::string site_fields(const AnswerSite& site, const CollisionIndex& index,

@@ -58,7 +58,8 @@ tetrapage::geometry::Accuracy to_accuracy(int accuracy, double parameter) {
 // The header restates the C++ conventions of a contact site; these keep them equal.
 static_assert(TETRAPAGE_NO_OBJECT_TRIANGLE == tetrapage::Contact::kNoObjectTriangle);
 static_assert(TETRAPAGE_DYNAMIC_PART == tetrapage::Contact::kDynamicPart);
-static_assert(TETRAPAGE_NO_TRIANGLE == tetrapage::DistanceResult::kNoTriangle);
+static_assert(TETRAPAGE_NO_TRIANGLE == tetrapage::ContactSite::kNoTriangle);
+static_assert(TETRAPAGE_NO_COMPONENT == tetrapage::ContactSite::kNoComponent);
 
 // An argument struct grows by fields appended at its end; read_args copies an older caller's
 // struct_size bytes over the defaults, which is right only if those bytes hold no padding a
@@ -74,18 +75,10 @@ static_assert(ends_without_padding<tetrapage_distance_args, double>(
 static_assert(ends_without_padding<tetrapage_impact_args, std::uint64_t>(
     offsetof(tetrapage_impact_args, max_iterations)));
 
-tetrapage_hit hit_of(const tetrapage::Contact& contact) {
+// The C++ site's fields and "none" conventions are the C hit's (asserted above).
+tetrapage_hit hit_of(const tetrapage::ContactSite& contact) {
   return {contact.environment_triangle, contact.environment_part, contact.environment_component,
           contact.object_triangle, contact.dynamic_part};
-}
-
-// A closest pair or first contact: the query names no component.
-tetrapage_hit hit_of(bool found, std::uint64_t environment_triangle, std::uint32_t environment_part,
-                     std::uint32_t object_triangle, std::uint32_t dynamic_part) {
-  if (!found)
-    return {TETRAPAGE_NO_TRIANGLE, 0, TETRAPAGE_NO_COMPONENT, TETRAPAGE_NO_OBJECT_TRIANGLE, 0};
-  return {environment_triangle, environment_part, TETRAPAGE_NO_COMPONENT, object_triangle,
-          dynamic_part};
 }
 
 }  // namespace
@@ -499,9 +492,7 @@ tetrapage_status measure_distance(const char* function, tetrapage_object* object
     result->upper_bound = found.upper_bound;
     copy_point(found.on_environment, result->on_environment);
     copy_point(found.on_object, result->on_object);
-    result->closest = hit_of(found.environment_triangle != tetrapage::DistanceResult::kNoTriangle,
-                             found.environment_triangle, found.environment_part,
-                             found.object_triangle, found.dynamic_part);
+    result->closest = hit_of(found.closest);
     result->containment = int32_t(found.containment);
     result->containing_part = found.containing_part;
     result->containing_dynamic_part = found.containing_dynamic_part;
@@ -550,9 +541,7 @@ tetrapage_status find_impact(const char* function, tetrapage_object* object, con
     result->impact = int32_t(found.impact);
     result->free_until = found.free_until;
     result->contact_at = found.contact_at;
-    result->first_contact =
-        hit_of(found.has_contact, found.environment_triangle, found.environment_part,
-               found.object_triangle, found.dynamic_part);
+    result->first_contact = hit_of(found.contact);
     result->containment = int32_t(found.containment);
     result->containing_part = found.containing_part;
     result->containing_dynamic_part = found.containing_dynamic_part;

@@ -21,11 +21,8 @@ void report_touching(const QueryResult& touch, DistanceResult& result) {
   result.containing_part = touch.containing_part;
   result.containing_dynamic_part = touch.containing_dynamic_part;
   if (touch.contacts.empty()) return;
-  const Contact& contact = touch.contacts.front();
-  result.environment_triangle = contact.environment_triangle;
-  result.environment_part = contact.environment_part;
-  result.object_triangle = contact.object_triangle;
-  result.dynamic_part = contact.dynamic_part;
+  result.closest = touch.contacts.front();
+  result.closest.environment_component = ContactSite::kNoComponent;  // a distance names none
 }
 
 }  // namespace

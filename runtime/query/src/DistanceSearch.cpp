@@ -45,9 +45,10 @@ void DistanceSearch::measure(const ObjectModel& model, PlacedObject& object,
     result.from_last_pair = true;
     ++result.pair_tests;
     const Pair last = last_;
-    offer(geometry::triangle_distance(last.environment, object.world_triangle(last.object_triangle)),
-          last.environment, last.environment_triangle, last.environment_part, last.object_triangle,
-          last.dynamic_part);
+    offer(geometry::triangle_distance(last.environment,
+                                      object.world_triangle(last.site.object_triangle)),
+          last.environment, last.site.environment_triangle, last.site.environment_part,
+          last.site.object_triangle, last.site.dynamic_part);
   }
   // Without a bound yet, a radius grown until it holds some triangle; then the triangles
   // within the best distance found.
@@ -81,10 +82,7 @@ void DistanceSearch::report(double max_distance) {
   result.upper_bound = std::max(lowest_upper_, result.distance);
   result.on_environment = best_.distance.on_first;
   result.on_object = best_.distance.on_second;
-  result.environment_triangle = best_.environment_triangle;
-  result.environment_part = best_.environment_part;
-  result.object_triangle = best_.object_triangle;
-  result.dynamic_part = best_.dynamic_part;
+  result.closest = best_.site;
   has_last_ = true;
   last_ = best_;
 }
@@ -230,7 +228,8 @@ void DistanceSearch::offer(const geometry::TriangleDistance& distance,
   reach_ = std::min(reach_, distance.upper_bound);
   if (found_ && distance.distance >= best_.distance.distance) return;
   found_ = true;
-  best_ = {distance, environment, id, part, object_triangle, dynamic_part};
+  best_ = {
+      distance, environment, {part, id, object_triangle, ContactSite::kNoComponent, dynamic_part}};
   for (int a = 0; a < 3; ++a) axis_[a] = distance.on_second[a] - distance.on_first[a];
 }
 

@@ -35,10 +35,7 @@ class DistanceSearch {
   struct Pair {
     geometry::TriangleDistance distance;
     geometry::Triangle environment;
-    std::uint64_t environment_triangle = 0;
-    std::uint32_t environment_part = 0;
-    std::uint32_t object_triangle = 0;
-    std::uint32_t dynamic_part = 0;  ///< the dynamic obstacle's id, or 0 for the index's
+    ContactSite site;  ///< no component
   };
   // The triangles that meet `search_box` (the world box grown by the search's radius), from
   // the searched region's shards or, for a box centred beyond the coarse mesh, from every

@@ -24,12 +24,8 @@ void report_hit(const QueryResult& touch, double free_until, double at, ImpactRe
   result.containing_part = touch.containing_part;
   result.containing_dynamic_part = touch.containing_dynamic_part;
   if (touch.contacts.empty()) return;
-  const Contact& contact = touch.contacts.front();
-  result.has_contact = true;
-  result.environment_triangle = contact.environment_triangle;
-  result.environment_part = contact.environment_part;
-  result.object_triangle = contact.object_triangle;
-  result.dynamic_part = contact.dynamic_part;
+  result.contact = touch.contacts.front();
+  result.contact.environment_component = ContactSite::kNoComponent;  // as a distance's site
 }
 
 // How far the poses that PoseMotion::at computes may lie from the exact motion's (their

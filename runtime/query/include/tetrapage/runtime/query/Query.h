@@ -63,22 +63,34 @@ struct QueryOptions {
   std::size_t max_contacts = kDefaultMaxContacts;
 };
 
-/// One contact: an environment triangle (its part, connected component and model-wide id) and
-/// an object triangle (kNoObjectTriangle when the object was checked as a solid: hull, box, or
-/// swept). A contact with a dynamic obstacle (DynamicObstacles.h) has dynamic_part set to the
-/// part's id, environment_triangle the triangle's index in that part's mesh, environment_part
-/// kDynamicPart and environment_component 0; a contact with the index has dynamic_part 0.
-struct Contact {
+/// Where an answer touches, named the same way by every query (a step's contacts, a distance's
+/// closest pair, a time of impact's first contact): an environment triangle (its part,
+/// connected component and model-wide id) and an object triangle, with one "none" per field,
+/// which a default site holds. The object triangle is kNoObjectTriangle also when the object
+/// was checked as a solid (hull, box, or swept). A site on a dynamic obstacle
+/// (DynamicObstacles.h) has dynamic_part set to the obstacle's id, environment_triangle the
+/// triangle's index in that obstacle's mesh, environment_part kDynamicPart and
+/// environment_component 0; a site on the index has dynamic_part 0. A distance or a time of
+/// impact names no component (kNoComponent).
+struct ContactSite {
+  static constexpr std::uint64_t kNoTriangle = std::numeric_limits<std::uint64_t>::max();
   static constexpr std::uint32_t kNoObjectTriangle = 0xffffffffu;
-  /// environment_part of a contact with a dynamic obstacle (no part of the index).
+  static constexpr std::uint32_t kNoComponent = 0xffffffffu;
+  /// environment_part of a site on a dynamic obstacle (no part of the index).
   static constexpr std::uint32_t kDynamicPart = 0xfffffffeu;
   std::uint32_t environment_part = 0;
-  std::uint64_t environment_triangle = 0;
-  std::uint32_t object_triangle = 0;
-  std::uint32_t environment_component = 0;
+  std::uint64_t environment_triangle = kNoTriangle;
+  std::uint32_t object_triangle = kNoObjectTriangle;
+  std::uint32_t environment_component = kNoComponent;
   std::uint32_t dynamic_part = 0;  ///< the dynamic obstacle's id, or 0 (kNoDynamicPart)
-  bool operator==(const Contact&) const = default;
+  /// Whether the site names an environment triangle (a containment, or a distance farther than
+  /// its limit, names none).
+  bool has_triangle() const { return environment_triangle != kNoTriangle; }
+  bool operator==(const ContactSite&) const = default;
 };
+
+/// One contact of a step: a site with both triangles.
+using Contact = ContactSite;
 
 /// What one step did (the counters that explain its time).
 struct StepCounters {
@@ -177,15 +189,8 @@ struct DistanceResult {
   /// or nothing measured for a containment).
   geometry::Point on_environment{};
   geometry::Point on_object{};
-  /// The closest pair's triangles (none when farther, or for a containment).
-  static constexpr std::uint64_t kNoTriangle = std::numeric_limits<std::uint64_t>::max();
-  std::uint64_t environment_triangle = kNoTriangle;
-  std::uint32_t environment_part = 0;
-  std::uint32_t object_triangle = 0;
-  /// The closest triangle belongs to a dynamic obstacle (DynamicObstacles.h) with this id:
-  /// environment_part is then Contact::kDynamicPart and environment_triangle the triangle's
-  /// index in that part's mesh; 0 for the index's triangles.
-  std::uint32_t dynamic_part = 0;
+  /// The closest pair's triangles (none when farther, or for a containment; no component).
+  ContactSite closest;
   /// Touching without contact: which body holds the other (its part in containing_part).
   Containment containment{};
   std::uint32_t containing_part = 0;
@@ -226,14 +231,9 @@ struct ImpactResult {
   double free_until = 1;
   /// The pose at this time collides (decided exactly); contact_at - free_until <= tolerance.
   double contact_at = 1;
-  /// The first contact found at contact_at (the collision query's first hit; absent for a
-  /// containment).
-  bool has_contact = false;
-  std::uint64_t environment_triangle = 0;
-  std::uint32_t environment_part = 0;
-  std::uint32_t object_triangle = 0;
-  /// The contact's dynamic obstacle (DynamicObstacles.h), or 0 for the index's triangles.
-  std::uint32_t dynamic_part = 0;
+  /// The first contact found at contact_at (the collision query's first hit; none for a
+  /// containment or without a hit; no component).
+  ContactSite contact;
   /// A hit with no contact: which body holds the other at contact_at, and its environment
   /// part (Contact::kDynamicPart with containing_dynamic_part for a dynamic obstacle).
   Containment containment{};
@@ -244,9 +244,8 @@ struct ImpactResult {
 
 inline bool has_closest_points(const DistanceResult& result) {
   return result.separation == Separation::apart ||
-         (result.separation == Separation::touching &&
-          result.environment_triangle != DistanceResult::kNoTriangle &&
-          result.object_triangle != Contact::kNoObjectTriangle);
+         (result.separation == Separation::touching && result.closest.has_triangle() &&
+          result.closest.object_triangle != ContactSite::kNoObjectTriangle);
 }
 
 struct QueryResult {
