@@ -80,8 +80,11 @@ void IndexReader::Impl::require_compact_storage(hid_t root) const {
       continue;  // named as missing where it is needed
     }
     GroupHandle group(H5Gopen2(root, name, H5P_DEFAULT));
-    if (!group) hdf5_format_error("cannot open group '/" + std::string(name) + "'");
-    require_compact_links(group.get(), ("/" + std::string(name)).c_str());
+    // Appended, not "/" + name: GCC 12 warns (-Wrestrict, falsely) on that insertion here.
+    std::string path = "/";
+    path += name;
+    if (!group) hdf5_format_error("cannot open group '" + path + "'");
+    require_compact_links(group.get(), path.c_str());
   }
 }
 
