@@ -73,10 +73,19 @@ class ObjectBVH {
     for_each_in_box(box, [](const Box&) { return true; }, visit, counters);
   }
   /// The same, also skipping the triangles whose box `near(box)` rejects (a conservative
-  /// filter of the caller's, e.g. the box misses a slab around a plane; asked of the nodes
-  /// too, it cost more than it pruned on objects whose queries reach few triangles).
+  /// filter of the caller's, e.g. the box misses a slab around a plane).
   template <class Near, class Visit>
-  void for_each_in_box(const Box& box, Near&& near, Visit&& visit, QueryCounters* counters = nullptr) const {
+  void for_each_in_box(const Box& box, Near&& near, Visit&& visit,
+                       QueryCounters* counters = nullptr) const {
+    for_each_in_box_pruning_nodes(
+        box, [](const Box&) { return true; }, near, visit, counters);
+  }
+  /// The same, also skipping the nodes whose (outward-rounded) box `near_node(box)` rejects:
+  /// `near_node` must keep every box that holds a box `near` keeps (e.g. the same slab test).
+  /// The box of a large, tilted query triangle holds most of the object; its plane does not.
+  template <class NearNode, class Near, class Visit>
+  void for_each_in_box_pruning_nodes(const Box& box, NearNode&& near_node, Near&& near,
+                                     Visit&& visit, QueryCounters* counters = nullptr) const {
     FloatBox q;
     for (int k = 0; k < 3; ++k) {
       q.lo[k] = float_below(box.lo[k]);
@@ -95,7 +104,7 @@ class ObjectBVH {
       for (unsigned mask = query.overlapping(node); mask != 0;) {
         const int c = 31 - __builtin_clz(mask);
         mask &= ~(1u << c);
-        stack[top++] = {node.first[c], node.count[c]};
+        if (near_node(child_box(node, c))) stack[top++] = {node.first[c], node.count[c]};
       }
     };
     push_children(wide_nodes_[0]);
@@ -260,6 +269,10 @@ class ObjectBVH {
     std::uint32_t count[4];  ///< a leaf's triangles (> 0), or 0 for a wide node
     std::uint32_t children;  ///< 1 to 4: the slots used, from the first
   };
+  static Box child_box(const WideNode& node, int c) {
+    return Box{{node.lo[0][c], node.lo[1][c], node.lo[2][c]},
+               {node.hi[0][c], node.hi[1][c], node.hi[2][c]}};
+  }
   /// Each level of the wide hierarchy leaves at most three siblings pending.
   static constexpr int kMaxWideStack = 3 * kMaxStack + 4;
   /// A box query's bounds, broadcast once for the tests of four children at a time.
