@@ -82,7 +82,7 @@ void PhaseTwo::test_mesh(const Source& source, const geometry::Triangle& environ
   };
   // The plane prunes the object's nodes too: a large environment triangle's box holds most of
   // the object (the lion among assimp's models: 1,000 box tests a candidate without it).
-  step_.model.bvh.for_each_in_box_pruning_nodes(query, near_plane, near_plane, test);
+  step_.model.bvh.for_each_in_box(query, near_plane, test);
 }
 
 void PhaseTwo::test_candidate(const Source& source, const geometry::Triangle& environment) {

@@ -72,20 +72,13 @@ class ObjectBVH {
   void for_each_in_box(const Box& box, Visit&& visit, QueryCounters* counters = nullptr) const {
     for_each_in_box(box, [](const Box&) { return true; }, visit, counters);
   }
-  /// The same, also skipping the triangles whose box `near(box)` rejects (a conservative
-  /// filter of the caller's, e.g. the box misses a slab around a plane).
+  /// The same, also skipping the nodes and triangles whose (outward-rounded) box `near(box)`
+  /// rejects: a conservative filter of the caller's that keeps every box holding a box it keeps
+  /// (e.g. the box misses a slab around a plane). The box of a large, tilted query triangle holds
+  /// most of the object; its plane does not.
   template <class Near, class Visit>
   void for_each_in_box(const Box& box, Near&& near, Visit&& visit,
                        QueryCounters* counters = nullptr) const {
-    for_each_in_box_pruning_nodes(
-        box, [](const Box&) { return true; }, near, visit, counters);
-  }
-  /// The same, also skipping the nodes whose (outward-rounded) box `near_node(box)` rejects:
-  /// `near_node` must keep every box that holds a box `near` keeps (e.g. the same slab test).
-  /// The box of a large, tilted query triangle holds most of the object; its plane does not.
-  template <class NearNode, class Near, class Visit>
-  void for_each_in_box_pruning_nodes(const Box& box, NearNode&& near_node, Near&& near,
-                                     Visit&& visit, QueryCounters* counters = nullptr) const {
     FloatBox q;
     for (int k = 0; k < 3; ++k) {
       q.lo[k] = float_below(box.lo[k]);
@@ -104,7 +97,7 @@ class ObjectBVH {
       for (unsigned mask = query.overlapping(node); mask != 0;) {
         const int c = 31 - __builtin_clz(mask);
         mask &= ~(1u << c);
-        if (near_node(child_box(node, c))) stack[top++] = {node.first[c], node.count[c]};
+        if (near(child_box(node, c))) stack[top++] = {node.first[c], node.count[c]};
       }
     };
     push_children(wide_nodes_[0]);
